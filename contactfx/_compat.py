@@ -1,0 +1,138 @@
+"""Every difference between the supported dolfinx stacks, in one place.
+
+Supported: dolfinx 0.5.2 / PETSc 3.18 (Debian 12) and dolfinx 0.9.0 / PETSc 3.22 (Debian 13).
+No other module of contactfx checks a version; they call the functions below.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from petsc4py import PETSc
+
+import dolfinx
+import dolfinx.fem.petsc
+
+__all__ = [
+    "DOLFINX_VERSION",
+    "function_space",
+    "petsc_vec",
+    "model_to_mesh",
+    "create_interval",
+    "expression",
+    "assemble_matrix",
+    "create_matrix",
+    "create_vector",
+    "assemble_vector",
+    "write_function",
+    "num_owned_vertices",
+    "dof_coordinates",
+    "bc_dofs",
+    "locate_dofs_topological",
+    "dirichletbc",
+    "cell_name",
+]
+
+DOLFINX_VERSION: tuple[int, int] = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
+_NEW = DOLFINX_VERSION >= (0, 8)
+
+
+def function_space(mesh, family: str, degree: int, shape: tuple[int, ...] | None = None):
+    """A (vector-valued when ``shape`` is given) Lagrange / DG function space."""
+    if _NEW:
+        element = (family, degree, shape) if shape else (family, degree)
+        return dolfinx.fem.functionspace(mesh, element)
+    if shape:
+        return dolfinx.fem.VectorFunctionSpace(mesh, (family, degree), dim=shape[0])
+    return dolfinx.fem.FunctionSpace(mesh, (family, degree))
+
+
+def petsc_vec(u: dolfinx.fem.Function) -> PETSc.Vec:
+    """The PETSc vector that wraps a Function's degrees of freedom (ghosted)."""
+    return u.x.petsc_vec if _NEW else u.vector
+
+
+def model_to_mesh(model, comm, rank: int, gdim: int):
+    """gmsh model (built on ``rank``) -> (mesh, cell_tags, facet_tags) on ``comm``."""
+    from dolfinx.io import gmshio
+
+    out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    if hasattr(out, "mesh"):  # dolfinx >= 0.10 returns a MeshData named tuple
+        return out.mesh, out.cell_tags, out.facet_tags
+    return out[0], out[1], out[2]
+
+
+def create_interval(comm, n: int, length: float):
+    """Interval mesh (0, length) with n cells."""
+    return dolfinx.mesh.create_interval(comm, n, [0.0, length])
+
+
+def expression(expr, space) -> dolfinx.fem.Expression:
+    """A compiled UFL expression evaluated at the interpolation points of ``space``."""
+    element = space.element
+    points = element.interpolation_points() if _NEW else element.interpolation_points
+    if callable(points):
+        points = points()
+    return dolfinx.fem.Expression(expr, points)
+
+
+def create_matrix(form) -> PETSc.Mat:
+    return dolfinx.fem.petsc.create_matrix(form)
+
+
+def create_vector(form) -> PETSc.Vec:
+    return dolfinx.fem.petsc.create_vector(form)
+
+
+def assemble_matrix(A: PETSc.Mat, form) -> PETSc.Mat:
+    """Zero ``A`` and assemble ``form`` into it (no boundary conditions), finalised."""
+    A.zeroEntries()
+    dolfinx.fem.petsc.assemble_matrix(A, form)
+    A.assemble()
+    return A
+
+
+def assemble_vector(b: PETSc.Vec, form) -> PETSc.Vec:
+    """Zero ``b``, assemble ``form`` and accumulate ghost contributions on the owners."""
+    with b.localForm() as b_local:
+        b_local.set(0.0)
+    dolfinx.fem.petsc.assemble_vector(b, form)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    return b
+
+
+def write_function(xdmf, u: dolfinx.fem.Function, t: float) -> None:
+    xdmf.write_function(u, t)
+
+
+def num_owned_vertices(mesh) -> int:
+    return mesh.topology.index_map(0).size_local
+
+
+def dof_coordinates(space) -> np.ndarray:
+    """Coordinates (num_dofs_local + ghosts, 3) of the (scalar) space's dofs."""
+    return space.tabulate_dof_coordinates()
+
+
+def locate_dofs_topological(space, dim: int, entities: np.ndarray) -> np.ndarray:
+    return dolfinx.fem.locate_dofs_topological(space, dim, entities)
+
+
+def dirichletbc(value, dofs, space=None):
+    if space is None:
+        return dolfinx.fem.dirichletbc(value, dofs)
+    return dolfinx.fem.dirichletbc(value, dofs, space)
+
+
+def bc_dofs(bc) -> np.ndarray:
+    """Local indices (owned and ghost) of the dofs a Dirichlet condition fixes."""
+    dofs, _ = bc.dof_indices()
+    return dofs
+
+
+def cell_name(mesh) -> str:
+    return mesh.topology.cell_type.name
+
+
+def cell_diameter(mesh):
+    return ufl.CellDiameter(mesh)

@@ -1,0 +1,35 @@
+"""Penalty method for frictionless contact with a rigid obstacle.
+
+p = kappa [-g(u)]_+ with kappa = kappa0 E / h; the residual adds int p v.n ds (Kikuchi & Oden
+1988, doi:10.1137/1.9781611970845). The penetration is O(p h / (kappa0 E)): the method is not
+consistent, the error falls as kappa0 grows (and the conditioning worsens).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+from contactfx.contact.gap import ContactSurface
+from contactfx.contact.laws import positive_part
+
+__all__ = ["Penalty"]
+
+
+@dataclass(frozen=True)
+class Penalty:
+    """kappa0 > 0 (kappa = kappa0 E / h)."""
+
+    kappa0: float = 100.0
+    name = "penalty"
+
+    def __post_init__(self) -> None:
+        if not self.kappa0 > 0.0:
+            raise ValueError(f"penalty parameter must be > 0, got {self.kappa0}")
+
+    def pressure(self, s: ContactSurface):
+        return self.kappa0 * s.E / s.h * positive_part(-s.gap())
+
+    def residual(self, s: ContactSurface):
+        return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

@@ -1,0 +1,39 @@
+"""Helpers shared by the scene definitions."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+import dolfinx
+from contactfx import _compat
+from contactfx.meshes import build
+
+__all__ = ["gmsh_mesh", "fix", "fix_component"]
+
+
+def gmsh_mesh(comm, builder, gdim: int, name: str, **kwargs):
+    """(mesh, facet_tags) of a gmsh builder from :mod:`contactfx.meshes`."""
+    data = build(comm, functools.partial(builder, **kwargs), gdim, name)
+    return data.mesh, data.facet_tags
+
+
+def _facets(facet_tags, tag: int) -> np.ndarray:
+    return facet_tags.indices[facet_tags.values == tag]
+
+
+def fix(V, facet_tags, tag: int):
+    """u = 0 on the facets tagged ``tag``."""
+    mesh = V.mesh
+    dofs = _compat.locate_dofs_topological(V, mesh.topology.dim - 1, _facets(facet_tags, tag))
+    zero = np.zeros(mesh.geometry.dim, dtype=np.float64)
+    return _compat.dirichletbc(zero, dofs, V)
+
+
+def fix_component(V, facet_tags, tag: int, component: int):
+    """u_component = 0 on the facets tagged ``tag`` (symmetry plane or roller)."""
+    mesh = V.mesh
+    sub = V.sub(component)
+    dofs = _compat.locate_dofs_topological(sub, mesh.topology.dim - 1, _facets(facet_tags, tag))
+    return _compat.dirichletbc(np.float64(0.0), dofs, sub)

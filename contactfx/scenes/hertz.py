@@ -1,0 +1,136 @@
+"""Hertz line contact (2D, plane strain) and sphere contact (3D, quarter model).
+
+A rigid cylinder / sphere of radius R is pressed by the depth ``depth`` into an elastic block
+whose bottom is clamped. The reference is evaluated at the computed force P (the finite block
+changes the force-depth relation, not a and p0 at given P; BENCHMARKS.md section 1):
+
+    2D: a = sqrt(4 P R / (pi E*)),  p0 = 2 P / (pi a)
+    3D: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2)
+
+(Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, sections 4.2 and 5.2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
+from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
+from contactfx.scenes._common import fix, fix_component, gmsh_mesh
+from contactfx.scenes.base import Scene, param, validate
+
+__all__ = ["Hertz2D", "Hertz3D", "hertz_2d", "hertz_3d"]
+
+
+def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
+    a = np.sqrt(4.0 * force * radius / (np.pi * E_star))
+    return {"a": a, "p0": 2.0 * force / (np.pi * a)}
+
+
+def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
+    a = (3.0 * force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+    return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
+
+
+def _indenter(profile: str, radius: float) -> Obstacle:
+    return Ball(radius) if profile == "circle" else Paraboloid(radius)
+
+
+@dataclass(frozen=True)
+class Hertz2DParams:
+    radius: float = param(1.0, "indenter radius R", positive=True)
+    profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
+    depth: float = param(1.5e-3, "indentation depth (ramped over the load steps)", positive=True)
+    half_width: float = param(1.0, "block half-width", positive=True)
+    height: float = param(1.0, "block height", positive=True)
+    E: float = param(1000.0, "Young's modulus", positive=True)
+    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
+    h_contact: float = param(3e-3, "element size in the contact zone", positive=True)
+    h_far: float = param(0.1, "element size far from the contact zone", positive=True)
+    refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+
+class Hertz2D(Scene):
+    name = "hertz2d"
+    summary = "rigid cylinder pressed into a plane-strain block; reference Hertz a and p0"
+    Params = Hertz2DParams
+    contact_tag = RectangleFacets.TOP
+
+    def build_mesh(self, comm):
+        p = self.p
+        return gmsh_mesh(
+            comm, rectangle, 2, self.name,
+            x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
+            refine_x0=-p.refine_half_width, refine_x1=p.refine_half_width,
+            h_contact=p.h_contact, h_far=p.h_far,
+        )  # fmt: skip
+
+    def obstacle(self) -> Obstacle:
+        return _indenter(self.p.profile, self.p.radius)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return np.array([0.0, -t * self.p.depth])
+
+    def dirichlet(self, V, facet_tags):
+        return [fix(V, facet_tags, RectangleFacets.BOTTOM)]
+
+    def reference(self, force: float) -> dict[str, float]:
+        return hertz_2d(force, self.p.radius, self.material().E_star)
+
+
+@dataclass(frozen=True)
+class Hertz3DParams:
+    radius: float = param(1.0, "indenter radius R", positive=True)
+    profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
+    depth: float = param(0.01, "indentation depth (ramped over the load steps)", positive=True)
+    size: float = param(1.0, "edge of the quarter block (x, y in [0, size])", positive=True)
+    height: float = param(1.0, "block height", positive=True)
+    E: float = param(1000.0, "Young's modulus", positive=True)
+    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
+    h_contact: float = param(0.02, "element size in the contact zone", positive=True)
+    h_far: float = param(0.3, "element size far from the contact zone", positive=True)
+    refine_radius: float = param(0.15, "radius of the refined zone", positive=True)
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+
+class Hertz3D(Scene):
+    name = "hertz3d"
+    summary = "rigid sphere pressed into a block (quarter model); reference Hertz a and p0"
+    Params = Hertz3DParams
+    contact_tag = BoxFacets.ZMAX
+    symmetry = 4.0
+
+    def build_mesh(self, comm):
+        p = self.p
+        return gmsh_mesh(
+            comm, box, 3, self.name,
+            x0=0.0, x1=p.size, y0=0.0, y1=p.size, z0=-p.height, z1=0.0,
+            refine_center=(0.0, 0.0), refine_radius=p.refine_radius,
+            h_contact=p.h_contact, h_far=p.h_far,
+        )  # fmt: skip
+
+    def obstacle(self) -> Obstacle:
+        return _indenter(self.p.profile, self.p.radius)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return np.array([0.0, 0.0, -t * self.p.depth])
+
+    def dirichlet(self, V, facet_tags):
+        return [
+            fix(V, facet_tags, BoxFacets.ZMIN),
+            fix_component(V, facet_tags, BoxFacets.XMIN, 0),
+            fix_component(V, facet_tags, BoxFacets.YMIN, 1),
+        ]
+
+    def contact_size(self, measure: float) -> float:
+        return float(np.sqrt(measure / np.pi))
+
+    def reference(self, force: float) -> dict[str, float]:
+        return hertz_3d(force, self.p.radius, self.material().E_star)

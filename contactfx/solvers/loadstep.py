@@ -1,0 +1,89 @@
+"""Load stepping with a secant predictor and automatic cut-back on divergence."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats
+
+__all__ = ["StepRecord", "run_load_program"]
+
+
+@dataclass
+class StepRecord:
+    step: int
+    load: float
+    stats: SolveStats
+    cutbacks: int
+
+
+def run_load_program(
+    solver: ContactSNES,
+    apply_load: Callable[[float], None],
+    *,
+    steps: int,
+    on_step: Callable[[StepRecord], None] | None = None,
+    max_cutbacks: int = 6,
+) -> list[StepRecord]:
+    """Solve at load factors t = 1/steps, 2/steps, ..., 1.
+
+    ``apply_load(t)`` sets the load program's constants (obstacle position, tractions) for the
+    load factor t. Each step starts from the secant extrapolation of the last two converged
+    states. A failed step is retried with half the increment, up to ``max_cutbacks`` halvings in
+    a row; then ``ConvergenceError`` names the SNES reason, the step and the load factor.
+    """
+    if steps < 1:
+        raise ValueError(f"load steps must be >= 1, got {steps}")
+    x = _compat.petsc_vec(solver.u)
+    previous = x.copy()  # last converged state
+    older = None  # the one before, for the secant predictor
+    t_prev, t_older = 0.0, 0.0
+    records: list[StepRecord] = []
+    dt = 1.0 / steps
+    cutbacks = 0
+    step = 0
+    try:
+        while t_prev < 1.0 - 1e-12:
+            t = min(1.0, t_prev + dt)
+            if older is not None and t_prev > t_older:
+                factor = (t - t_prev) / (t_prev - t_older)
+                previous.copy(x)
+                x.axpy(factor, previous)
+                x.axpy(-factor, older)
+            else:
+                previous.copy(x)
+            x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+            apply_load(t)
+            solver.assemble_load()
+            try:
+                stats = solver.solve()
+            except ConvergenceError as err:
+                cutbacks += 1
+                if cutbacks > max_cutbacks:
+                    previous.copy(x)
+                    raise ConvergenceError(err.reason, step + 1, t) from None
+                dt *= 0.5
+                continue
+            step += 1
+            if older is None:
+                older = previous.copy()
+            else:
+                previous.copy(older)
+            x.copy(previous)
+            t_older, t_prev = t_prev, t
+            record = StepRecord(step=step, load=t, stats=stats, cutbacks=cutbacks)
+            records.append(record)
+            if on_step is not None:
+                on_step(record)
+            if cutbacks == 0:
+                dt = min(1.0 / steps, 2.0 * dt)
+            cutbacks = 0
+    finally:
+        previous.destroy()
+        if older is not None:
+            older.destroy()
+    return records

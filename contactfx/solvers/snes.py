@@ -1,0 +1,266 @@
+"""PETSc SNES wrapper for contact problems with a linear bulk and a nonlinear contact boundary.
+
+The residual is split into the bulk part, linear in u for small-strain elasticity, and the
+contact part, which lives on the contact facets only:
+
+    F(u) = K u - b + F_c(u),        J(u) = K + dF_c/du(u).
+
+K is assembled once per run; every Newton iteration assembles only the boundary integrals,
+which makes an iteration cheap compared with a linear-elastic solve on the same mesh.
+Dirichlet conditions are imposed on the rows and columns of J (identity) and F (u - g).
+Bound constraints (SNES-VI, ``vinewtonrsls``) are supported for the reference solutions.
+
+Options live in PETSc's database under a deterministic prefix (``contactfx_<scene>_``); the
+defaults are overridden by the user's command-line options (unprefixed options given by the
+user are copied under the prefix as well).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from petsc4py import PETSc
+
+import dolfinx
+from contactfx import _compat
+
+__all__ = ["ConvergenceError", "SolveStats", "ContactSNES", "DEFAULT_OPTIONS", "GAMG_OPTIONS"]
+
+
+class ConvergenceError(RuntimeError):
+    """The nonlinear solve failed; names the SNES reason, the load step and the load factor."""
+
+    def __init__(self, reason: str, step: int | None = None, load: float | None = None):
+        self.reason = reason
+        self.step = step
+        self.load = load
+        where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
+        super().__init__(f"nonlinear solve diverged{where}: {reason}")
+
+
+#: Newton with a backtracking line search, MUMPS LU.
+DEFAULT_OPTIONS: dict[str, object] = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-10,
+    "snes_atol": 1e-12,
+    "snes_stol": 0.0,
+    "snes_max_it": 50,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+#: Iterative alternative: GMRES + smoothed aggregation AMG with the rigid-body near-nullspace.
+GAMG_OPTIONS: dict[str, object] = {
+    "ksp_type": "gmres",
+    "ksp_rtol": 1e-10,
+    "ksp_max_it": 500,
+    "pc_type": "gamg",
+    "pc_gamg_type": "agg",
+    "pc_gamg_agg_nsmooths": 1,
+    "pc_gamg_threshold": 0.01,
+    "mg_levels_ksp_type": "chebyshev",
+    "mg_levels_pc_type": "jacobi",
+}
+
+_REASONS = {
+    v: k for k, v in vars(PETSc.SNES.ConvergedReason).items() if isinstance(v, int) and k[0] != "_"
+}
+
+
+def snes_reason_name(reason: int) -> str:
+    return _REASONS.get(reason, str(reason))
+
+
+@dataclass
+class SolveStats:
+    """Iterations and wall time (s) of one nonlinear solve."""
+
+    newton: int = 0
+    ksp: int = 0
+    assembly: float = 0.0
+    solve: float = 0.0
+    reason: str = ""
+
+
+@dataclass
+class _Timer:
+    assembly: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+
+def rigid_body_modes(V) -> PETSc.NullSpace:
+    """Orthonormalised rigid-body modes of a 2D / 3D vector space (near-nullspace for AMG)."""
+    mesh = V.mesh
+    gdim = mesh.geometry.dim
+    bs = V.dofmap.index_map_bs
+    n_local = V.dofmap.index_map.size_local
+    x = _compat.dof_coordinates(V)[:n_local]
+    num_modes = 3 if gdim == 2 else 6
+    vecs = [dolfinx.la.create_petsc_vector(V.dofmap.index_map, bs) for _ in range(num_modes)]
+    arrays = [np.zeros((n_local, bs)) for _ in range(num_modes)]
+    for i in range(gdim):
+        arrays[i][:, i] = 1.0
+    if gdim == 2:
+        arrays[2][:, 0] = -x[:, 1]
+        arrays[2][:, 1] = x[:, 0]
+    else:
+        arrays[3][:, 0], arrays[3][:, 1] = -x[:, 1], x[:, 0]
+        arrays[4][:, 0], arrays[4][:, 2] = x[:, 2], -x[:, 0]
+        arrays[5][:, 2], arrays[5][:, 1] = x[:, 1], -x[:, 2]
+    for vec, arr in zip(vecs, arrays):
+        vec.array[:] = arr.ravel()
+    dolfinx.la.orthonormalize(vecs)
+    return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)
+
+
+class ContactSNES:
+    """Newton (or SNES-VI) for F(u) = K u - b + F_c(u) = 0 with Dirichlet conditions.
+
+    Parameters are keyword-only: ``stiffness`` (bilinear form, compiled), ``load`` (linear
+    form, compiled), ``contact_residual`` / ``contact_jacobian`` (compiled forms, or None),
+    ``bcs`` (dolfinx DirichletBCs), ``prefix`` (PETSc options prefix), ``options`` (defaults,
+    overridden by the command line), ``user_options`` (from the command line).
+    """
+
+    def __init__(
+        self,
+        u: dolfinx.fem.Function,
+        *,
+        stiffness,
+        load,
+        contact_residual=None,
+        contact_jacobian=None,
+        bcs=(),
+        prefix: str,
+        options: Mapping[str, object] | None = None,
+        user_options: Mapping[str, object] | None = None,
+        near_nullspace: bool = False,
+    ) -> None:
+        self.u = u
+        self.comm = u.function_space.mesh.comm
+        self.bcs = list(bcs)
+        self._a_c = contact_jacobian
+        self._F_c = contact_residual
+        self.prefix = prefix
+        self.timer = _Timer()
+
+        t0 = time.perf_counter()
+        self.K = _compat.assemble_matrix(_compat.create_matrix(stiffness), stiffness)
+        self.load_form = load
+        self.b = _compat.create_vector(load)
+        self.J = self.K.duplicate(copy=True)
+        self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
+        self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
+        self.timer.assembly += time.perf_counter() - t0
+
+        dofmap = u.function_space.dofmap
+        n_owned = dofmap.index_map.size_local * dofmap.index_map_bs
+        dofs = [_compat.bc_dofs(bc) for bc in self.bcs]
+        rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0)
+        self._bc_rows = rows[rows < n_owned].astype(np.int32)
+
+        if near_nullspace and u.function_space.mesh.geometry.dim > 1:
+            self.J.setNearNullSpace(rigid_body_modes(u.function_space))
+
+        self.snes = PETSc.SNES().create(self.comm)
+        self.snes.setOptionsPrefix(prefix)
+        self._set_options({**DEFAULT_OPTIONS, **(options or {})}, user_options or {})
+        self.residual_vec = self.K.createVecLeft()
+        self.snes.setFunction(self._residual, self.residual_vec)
+        self.snes.setJacobian(self._jacobian, self.J, self.J)
+        self.snes.setFromOptions()
+        self.snes.getKSP().setFromOptions()
+
+    # -- options -------------------------------------------------------------------------
+    def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
+        opts = PETSc.Options()
+        for key, value in defaults.items():
+            opts[self.prefix + key] = _option_value(value)
+        for key, value in user.items():
+            name = key if key.startswith("contactfx_") else self.prefix + key
+            opts[name] = _option_value(value)
+
+    def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
+        """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
+        self.snes.setVariableBounds(lower, upper)
+
+    # -- callbacks -----------------------------------------------------------------------
+    def _sync(self, x: PETSc.Vec) -> None:
+        """Make u (which the compiled forms read) equal to the SNES iterate x."""
+        uvec = _compat.petsc_vec(self.u)
+        if x.handle != uvec.handle:
+            x.copy(uvec)
+        uvec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def assemble_load(self) -> None:
+        """Assemble b for the current load (call after the load program changed constants)."""
+        t0 = time.perf_counter()
+        _compat.assemble_vector(self.b, self.load_form)
+        self.timer.assembly += time.perf_counter() - t0
+
+    def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
+        t0 = time.perf_counter()
+        self._sync(x)
+        self.K.mult(x, F)
+        F.axpy(-1.0, self.b)
+        if self._F_c is not None:
+            _compat.assemble_vector(self.fc, self._F_c)
+            F.axpy(1.0, self.fc)
+        dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
+        self.timer.assembly += time.perf_counter() - t0
+
+    def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
+        t0 = time.perf_counter()
+        self._sync(x)
+        self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        if self._a_c is not None:
+            _compat.assemble_matrix(self.Jc, self._a_c)
+            J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
+        self.timer.assembly += time.perf_counter() - t0
+
+    # -- solve ---------------------------------------------------------------------------
+    def solve(self) -> SolveStats:
+        """Solve from the current u (its Dirichlet values are set first); raise on failure."""
+        x = _compat.petsc_vec(self.u)
+        dolfinx.fem.petsc.set_bc(x, self.bcs)
+        self._sync(x)
+        a0 = self.timer.assembly
+        t0 = time.perf_counter()
+        self.snes.solve(None, x)
+        self._sync(x)
+        wall = time.perf_counter() - t0
+        reason = self.snes.getConvergedReason()
+        assembly = self.timer.assembly - a0
+        stats = SolveStats(
+            newton=self.snes.getIterationNumber(),
+            ksp=self.snes.getLinearSolveIterations(),
+            assembly=assembly,
+            solve=wall - assembly,
+            reason=snes_reason_name(reason),
+        )
+        if reason <= 0:
+            raise ConvergenceError(stats.reason)
+        return stats
+
+    def destroy(self) -> None:
+        for obj in (self.snes, self.K, self.J, self.Jc, self.b, self.fc, self.residual_vec):
+            if obj is not None:
+                obj.destroy()
+        opts = PETSc.Options()
+        for key in list(opts.getAll()):
+            if key.startswith(self.prefix):
+                opts.delValue(key)
+
+
+def _option_value(value: object) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)

@@ -1,0 +1,39 @@
+"""gmsh geometry definitions (installed as :mod:`contactfx.meshes`).
+
+Each geometry is a *builder* function with keyword-only parameters that creates the geometry,
+its physical groups and a graded mesh in a gmsh model; :func:`build` runs a builder on rank 0
+and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` file::
+
+    from functools import partial
+    from mpi4py import MPI
+    from contactfx.meshes import RectangleFacets, build, rectangle
+
+    data = build(
+        MPI.COMM_WORLD,
+        partial(rectangle, x0=-1.0, x1=1.0, y0=-1.0, y1=0.0, refine_x0=-0.1, refine_x1=0.1,
+                h_contact=0.005, h_far=0.1),
+        gdim=2,
+        name="block",
+    )
+    top = data.facet_tags.find(RectangleFacets.TOP)
+
+Command line: ``python3 -m contactfx.meshes {rectangle,box} ... --out mesh.msh``.
+"""
+
+from contactfx.meshes._build import Builder, MeshData, MshInfo, build, write_msh
+from contactfx.meshes.box import BoxCells, BoxFacets, box
+from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
+
+__all__ = [
+    "BoxCells",
+    "BoxFacets",
+    "Builder",
+    "MeshData",
+    "MshInfo",
+    "RectangleCells",
+    "RectangleFacets",
+    "box",
+    "build",
+    "rectangle",
+    "write_msh",
+]

@@ -1,0 +1,311 @@
+"""Build gmsh models on one rank and hand them to dolfinx or to a ``.msh`` file.
+
+A *builder* is a function ``builder(model)`` that receives the ``gmsh.model`` namespace of an open
+gmsh session, creates the geometry, the physical groups and the mesh-size field, and calls
+``model.mesh.generate(gdim)``. The geometry modules (:mod:`contactfx.meshes.rectangle`,
+:mod:`contactfx.meshes.box`) define builders with keyword-only parameters that they validate
+before any gmsh call; callers bind the parameters with :func:`functools.partial`::
+
+    data = build(comm, partial(rectangle, x0=-1.0, x1=1.0, ...), gdim=2, name="block")
+
+:func:`build` runs the builder on rank 0 only and distributes the mesh and its physical groups
+with ``dolfinx.io.gmshio.model_to_mesh``, as the dolfinx demos do; if the builder fails, every
+rank raises the same exception instead of waiting in a collective. :func:`write_msh` runs a
+builder with gmsh alone (no dolfinx, no MPI) and writes a gmsh 4.1 ``.msh`` file.
+
+Mesh grading (:func:`set_graded_size`): with d the exact Euclidean distance to the refinement
+zone, written as a gmsh MathEval expression (no sampling error), a gmsh Threshold field imposes
+the element size
+
+    h(d) = h_min                                        for d <= d_min,
+    h(d) = min(h_max, h_min + grading * (d - d_min))    for d >  d_min,
+
+so ``grading`` is the size increase per unit distance and neighbouring elements differ in size
+by a factor of about ``1 + grading``. Point, curvature and boundary size sources are disabled:
+the field alone decides.
+
+gmsh is imported inside the functions, never at module level: importing gmsh replaces the SIGINT
+handler, and importing contactfx must have no side effects.
+
+Reference: C. Geuzaine, J.-F. Remacle, Gmsh: a 3-D finite element mesh generator with built-in
+pre- and post-processing facilities, Int. J. Numer. Meth. Eng. 79 (2009) 1309-1331,
+doi:10.1002/nme.2579.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from enum import IntEnum
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import dolfinx.mesh
+    import gmsh
+    from mpi4py import MPI
+
+__all__ = [
+    "GMSH_RANK",
+    "Builder",
+    "MeshData",
+    "MshInfo",
+    "add_physical_groups",
+    "build",
+    "check_finite",
+    "check_less",
+    "check_less_equal",
+    "check_positive",
+    "matheval_number",
+    "model_to_mesh",
+    "set_graded_size",
+    "write_msh",
+]
+
+GMSH_RANK = 0
+"""The rank that runs gmsh in :func:`build`."""
+
+Builder = Callable[["type[gmsh.model]"], None]
+"""A function that builds and meshes a geometry in the ``gmsh.model`` namespace it is given."""
+
+
+@dataclass(frozen=True)
+class MeshData:
+    """A distributed dolfinx mesh with its physical groups as mesh tags.
+
+    ``cell_tags`` holds the physical groups of the cells (named ``"cells"``), ``facet_tags``
+    those of the boundary facets (named ``"facets"``); the tag values are the IntEnum values of
+    the geometry module that built the mesh.
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    cell_tags: dolfinx.mesh.MeshTags
+    facet_tags: dolfinx.mesh.MeshTags
+
+
+@dataclass(frozen=True)
+class MshInfo:
+    """What :func:`write_msh` wrote: the file and the size of the mesh in it."""
+
+    path: Path
+    num_nodes: int
+    num_cells: int
+
+
+def model_to_mesh(
+    model: type[gmsh.model], comm: MPI.Comm, rank: int, gdim: int
+) -> tuple[dolfinx.mesh.Mesh, dolfinx.mesh.MeshTags, dolfinx.mesh.MeshTags]:
+    """Distribute the gmsh model that lives on ``rank`` as a dolfinx mesh with cell and facet tags.
+
+    The only dolfinx call of :mod:`contactfx.meshes`. Collective on ``comm``.
+    """
+    # dolfinx 0.5 needs the submodule import; dolfinx >= 0.10 returns a NamedTuple whose first
+    # three fields are these, earlier versions a 3-tuple.
+    from dolfinx.io import gmshio
+
+    result = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    return result[0], result[1], result[2]
+
+
+@contextlib.contextmanager
+def _gmsh_session(name: str) -> Iterator[type[gmsh.model]]:
+    """Open a quiet gmsh session (no user configuration files) with one empty model."""
+    import gmsh
+
+    gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add(name)
+        yield gmsh.model
+    finally:
+        gmsh.finalize()
+
+
+def _check_gdim(gdim: int) -> None:
+    if gdim not in (2, 3):
+        raise ValueError(f"gdim must be 2 or 3, got {gdim}")
+
+
+def _check_generated(model: type[gmsh.model], gdim: int) -> None:
+    """Raise if the builder left no meshed physical group of dimension ``gdim``."""
+    if not model.getPhysicalGroups(gdim):
+        raise RuntimeError(f"builder defined no physical group of dimension {gdim}")
+    _, element_tags, _ = model.mesh.getElements(gdim)
+    if sum(len(tags) for tags in element_tags) == 0:
+        raise RuntimeError(f"builder did not generate a {gdim}D mesh")
+
+
+def build(comm: MPI.Comm, builder: Builder, gdim: int, name: str) -> MeshData:
+    """Run ``builder`` with gmsh on rank 0 and distribute the mesh over ``comm``.
+
+    Collective on ``comm``. If the builder raises on rank 0 (invalid parameters raise
+    ``ValueError``), every rank raises an exception of the same type and message.
+
+    Args:
+        comm: The communicator of the mesh.
+        builder: A geometry function with its parameters bound, e.g.
+            ``functools.partial(rectangle, x0=-1.0, ...)``.
+        gdim: Geometric dimension of the mesh (2 or 3).
+        name: Name of the gmsh model and of the dolfinx mesh.
+    """
+    import gmsh
+
+    _check_gdim(gdim)
+    on_gmsh_rank = comm.rank == GMSH_RANK
+    session = _gmsh_session(name) if on_gmsh_rank else contextlib.nullcontext(gmsh.model)
+    with session as model:
+        failure: Exception | None = None
+        if on_gmsh_rank:
+            try:
+                builder(model)
+                _check_generated(model, gdim)
+            except Exception as exc:
+                failure = exc
+        # The other ranks receive a copy of the exception; rank 0 re-raises the original one,
+        # which keeps the builder's traceback.
+        shared_failure = comm.bcast(failure, root=GMSH_RANK)
+        if failure is not None:
+            raise failure
+        if shared_failure is not None:
+            raise shared_failure
+        mesh, cell_tags, facet_tags = model_to_mesh(model, comm, GMSH_RANK, gdim)
+    mesh.name = name
+    cell_tags.name = "cells"
+    facet_tags.name = "facets"
+    return MeshData(mesh, cell_tags, facet_tags)
+
+
+def write_msh(builder: Builder, gdim: int, path: str | os.PathLike[str], name: str) -> MshInfo:
+    """Run ``builder`` with gmsh alone and write the mesh to ``path`` (gmsh format 4.1).
+
+    Only the elements of physical groups are written, with their physical tags (gmsh's default
+    ``Mesh.SaveAll`` 0). Returns the path and the numbers of nodes and of cells written.
+    """
+    _check_gdim(gdim)
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"output directory {str(path.parent)!r} does not exist")
+    import gmsh
+
+    with _gmsh_session(name) as model:
+        builder(model)
+        _check_generated(model, gdim)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(str(path))
+        node_tags, _, _ = model.mesh.getNodes()
+        _, element_tags, _ = model.mesh.getElements(gdim)
+        return MshInfo(path, len(node_tags), sum(len(tags) for tags in element_tags))
+
+
+def check_finite(**values: float) -> None:
+    """Raise ``ValueError`` naming the first value that is not a finite number."""
+    for name, value in values.items():
+        if not math.isfinite(value):
+            raise ValueError(f"{name} must be finite, got {value}")
+
+
+def check_positive(**values: float) -> None:
+    """Raise ``ValueError`` naming the first value that is not > 0."""
+    for name, value in values.items():
+        if not value > 0:
+            raise ValueError(f"{name} must be > 0, got {value}")
+
+
+def check_less(lower_name: str, lower: float, upper_name: str, upper: float) -> None:
+    """Raise ``ValueError`` unless ``lower < upper``."""
+    if not lower < upper:
+        raise ValueError(
+            f"{lower_name} must be < {upper_name}, got {lower_name}={lower}, {upper_name}={upper}"
+        )
+
+
+def check_less_equal(lower_name: str, lower: float, upper_name: str, upper: float) -> None:
+    """Raise ``ValueError`` unless ``lower <= upper``."""
+    if not lower <= upper:
+        raise ValueError(
+            f"{lower_name} must be <= {upper_name}, got {lower_name}={lower}, {upper_name}={upper}"
+        )
+
+
+def add_physical_groups(
+    model: type[gmsh.model],
+    domain: IntEnum,
+    sides: Mapping[IntEnum, tuple[int, float]],
+) -> None:
+    """Tag all entities of the top dimension as ``domain`` and their boundary by planes.
+
+    ``sides`` maps each facet tag to ``(axis, value)``, the plane ``x[axis] == value`` its
+    boundary entities lie in. Every boundary entity must lie in exactly one of the planes, so
+    the facet tags cover the boundary exactly once. Physical names are the lower-case enum names.
+    Call after the geometry is synchronised.
+    """
+    dim = model.getDimension()
+    cells = [tag for _, tag in model.getEntities(dim)]
+    model.addPhysicalGroup(dim, cells, domain.value)
+    model.setPhysicalName(dim, domain.value, domain.name.lower())
+
+    xmin, ymin, zmin, xmax, ymax, zmax = model.getBoundingBox(-1, -1)
+    # OCC bounding boxes are enlarged by the geometric tolerance (~1e-7).
+    tol = 1e-6 * max(xmax - xmin, ymax - ymin, zmax - zmin)
+    members: dict[IntEnum, list[int]] = {side: [] for side in sides}
+    for _, tag in model.getBoundary([(dim, cell) for cell in cells], oriented=False):
+        box = model.getBoundingBox(dim - 1, tag)
+        matches = [
+            side
+            for side, (axis, value) in sides.items()
+            if abs(box[axis] - value) <= tol and abs(box[axis + 3] - value) <= tol
+        ]
+        if len(matches) != 1:
+            raise RuntimeError(f"boundary entity {tag} lies on {len(matches)} sides, expected 1")
+        members[matches[0]].append(tag)
+    for side, tags in members.items():
+        if not tags:
+            raise RuntimeError(f"no boundary entity on side {side.name}")
+        model.addPhysicalGroup(dim - 1, tags, side.value)
+        model.setPhysicalName(dim - 1, side.value, side.name.lower())
+
+
+def set_graded_size(
+    model: type[gmsh.model],
+    distance: str,
+    *,
+    size_min: float,
+    size_max: float,
+    dist_min: float,
+    grading: float,
+) -> None:
+    """Make the mesh size grow linearly from ``size_min`` to ``size_max`` away from a zone.
+
+    ``distance`` is a gmsh MathEval expression in x, y, z for the distance to the zone; the size
+    is ``size_min`` up to ``dist_min`` and grows by ``grading`` per unit distance beyond (see
+    the module docstring). Also disables every other source of mesh size.
+    """
+    import gmsh
+
+    field = model.mesh.field
+    if size_min == size_max:
+        # Uniform size. A Threshold field with DistMin == DistMax evaluates to NaN at distance
+        # DistMin, and gmsh then leaves a hole in the boundary discretisation.
+        size = field.add("MathEval")
+        field.setString(size, "F", matheval_number(size_min))
+    else:
+        distance_field = field.add("MathEval")
+        field.setString(distance_field, "F", distance)
+        size = field.add("Threshold")
+        field.setNumber(size, "InField", distance_field)
+        field.setNumber(size, "SizeMin", size_min)
+        field.setNumber(size, "SizeMax", size_max)
+        field.setNumber(size, "DistMin", dist_min)
+        field.setNumber(size, "DistMax", dist_min + (size_max - size_min) / grading)
+    field.setAsBackgroundMesh(size)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+
+
+def matheval_number(value: float) -> str:
+    """Format ``value`` for a gmsh MathEval expression: full precision, in parentheses."""
+    return f"({float(value)!r})"

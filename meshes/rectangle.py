@@ -1,0 +1,119 @@
+"""Rectangle [x0, x1] x [y0, y1] meshed with triangles graded towards a contact zone on its top.
+
+The contact zone is the segment [refine_x0, refine_x1] x {y1} of the top edge, e.g. where a rigid
+indenter touches an elastic block (Hertz, punch and ironing benchmarks). The element size is
+``h_contact`` within the distance ``(refine_x1 - refine_x0) / 2`` of the zone and grows linearly
+with the distance, by ``grading`` per unit distance, up to ``h_far`` (see
+:func:`contactfx.meshes._build.set_graded_size`). ``h_contact == h_far`` gives a uniform mesh for
+convergence studies. Meshing: OpenCASCADE geometry, Frontal-Delaunay triangulation (gmsh
+``Mesh.Algorithm`` 6), linear triangles.
+
+Physical groups: the cells are tagged :attr:`RectangleCells.DOMAIN`, the four edges
+:class:`RectangleFacets` (every boundary edge carries exactly one tag).
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+from typing import TYPE_CHECKING
+
+from contactfx.meshes._build import (
+    add_physical_groups,
+    check_finite,
+    check_less,
+    check_less_equal,
+    check_positive,
+    matheval_number,
+    set_graded_size,
+)
+
+if TYPE_CHECKING:
+    import gmsh
+
+__all__ = ["RectangleCells", "RectangleFacets", "rectangle"]
+
+
+class RectangleCells(IntEnum):
+    """Cell tags of :func:`rectangle`."""
+
+    DOMAIN = 1
+
+
+class RectangleFacets(IntEnum):
+    """Facet tags of :func:`rectangle`: the four edges."""
+
+    BOTTOM = 1
+    RIGHT = 2
+    TOP = 3
+    LEFT = 4
+
+
+def rectangle(
+    model: type[gmsh.model],
+    *,
+    x0: float,
+    x1: float,
+    y0: float,
+    y1: float,
+    refine_x0: float,
+    refine_x1: float,
+    h_contact: float,
+    h_far: float,
+    grading: float = 0.3,
+) -> None:
+    """Build and mesh the rectangle [x0, x1] x [y0, y1] in ``model`` (a gmsh builder).
+
+    Args:
+        model: The ``gmsh.model`` namespace of an open gmsh session.
+        x0, x1, y0, y1: Corners of the rectangle (length).
+        refine_x0, refine_x1: Ends of the contact zone on the top edge y = y1, with
+            x0 <= refine_x0 < refine_x1 <= x1 (length).
+        h_contact: Element size in and near the contact zone (length).
+        h_far: Element size far from the contact zone, >= h_contact (length).
+        grading: Size increase per unit distance from the contact zone (dimensionless).
+
+    Raises:
+        ValueError: Before any gmsh call, if a parameter is invalid.
+    """
+    check_finite(
+        x0=x0, x1=x1, y0=y0, y1=y1, refine_x0=refine_x0, refine_x1=refine_x1,
+        h_contact=h_contact, h_far=h_far, grading=grading,
+    )  # fmt: skip
+    check_less("x0", x0, "x1", x1)
+    check_less("y0", y0, "y1", y1)
+    check_less_equal("x0", x0, "refine_x0", refine_x0)
+    check_less("refine_x0", refine_x0, "refine_x1", refine_x1)
+    check_less_equal("refine_x1", refine_x1, "x1", x1)
+    check_positive(h_contact=h_contact, h_far=h_far, grading=grading)
+    check_less_equal("h_contact", h_contact, "h_far", h_far)
+
+    model.occ.addRectangle(x0, y0, 0.0, x1 - x0, y1 - y0)
+    model.occ.synchronize()
+    add_physical_groups(
+        model,
+        RectangleCells.DOMAIN,
+        {
+            RectangleFacets.BOTTOM: (1, y0),
+            RectangleFacets.RIGHT: (0, x1),
+            RectangleFacets.TOP: (1, y1),
+            RectangleFacets.LEFT: (0, x0),
+        },
+    )
+
+    # Distance to the segment [a, b] x {y1}: (|x - a| + |x - b| - (b - a)) / 2 is the distance
+    # of x to [a, b] along the x axis.
+    a, b, c = (matheval_number(v) for v in (refine_x0, refine_x1, y1))
+    along = f"(Fabs(x-{a})+Fabs(x-{b})-({b}-{a}))/2"
+    distance = f"Sqrt(({along})^2+(y-{c})^2)"
+    set_graded_size(
+        model,
+        distance,
+        size_min=h_contact,
+        size_max=h_far,
+        dist_min=0.5 * (refine_x1 - refine_x0),
+        grading=grading,
+    )
+    import gmsh
+
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    model.mesh.generate(2)
