@@ -32,8 +32,15 @@ class ContactSurface:
     h: object
 
     def position(self, w=None):
+        """Current position in the obstacle's frame, x + u - offset. For the linearised
+        (``vertical``) obstacles only the vertical displacement moves the point: their gap is
+        the small-deformation Signorini gap height(x_t) - (x_d + u_d) of Hertz and Westergaard."""
         x = ufl.SpatialCoordinate(self.u.function_space.mesh)
-        return x + (self.u if w is None else w) - self.offset
+        w = self.u if w is None else w
+        if self.obstacle.vertical:
+            d = ufl.shape(x)[0]
+            w = ufl.as_vector([0.0] * (d - 1) + [w[d - 1]])
+        return x + w - self.offset
 
     def gap(self, w=None):
         """g(u) = phi(x + u - offset), > 0 when apart."""

@@ -6,7 +6,9 @@ x + u minus the obstacle's rigid displacement) has the gap ``g = phi(y)`` (> 0 o
 contact normal ``n = -grad phi(y)``, the outward normal of the body where it touches.
 
 Two profiles follow Hertz's and Westergaard's own linearised model instead of the true distance:
-``Paraboloid`` and ``Sinusoid`` measure the gap vertically and press vertically (n = e_d). The
+``Paraboloid`` and ``Sinusoid`` (and ``HalfSpace``) are ``vertical``: the gap is measured
+vertically above the reference point, moved by the vertical displacement only, and the pressure
+acts vertically (n = e_d): the small-deformation Signorini problem. The
 true circle/sphere is ``Ball``; at a/R = 0.1 its pressure peak is about 1 % below Hertz.
 
 ``height(t)`` is the obstacle's lower surface above the tangential coordinates t (+inf where

@@ -1,1 +1,23 @@
-"""contactfx.scenes"""
+"""The scene registry: named contact problems with their parameters and references."""
+
+from __future__ import annotations
+
+from contactfx.scenes.bar import Bar1D
+from contactfx.scenes.base import METHODS, Numerics, RunResult, Scene
+from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
+from contactfx.scenes.hertz import Hertz2D, Hertz3D
+from contactfx.scenes.westergaard import Westergaard
+
+__all__ = ["SCENES", "get_scene", "Scene", "Numerics", "RunResult", "METHODS"]
+
+SCENES: dict[str, type[Scene]] = {
+    cls.name: cls for cls in (Hertz2D, Hertz3D, Westergaard, FlatPunch2D, FlatPunch3D, Bar1D)
+}
+
+
+def get_scene(name: str) -> type[Scene]:
+    try:
+        return SCENES[name]
+    except KeyError:
+        known = ", ".join(SCENES)
+        raise ValueError(f"unknown scene '{name}' (known: {known})") from None

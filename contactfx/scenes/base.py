@@ -138,6 +138,11 @@ class Scene:
     def h_contact(self) -> float:
         return self.p.h_contact
 
+    def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
+        """Scene-specific pointwise scores (local maxima over this rank's surface nodes x with
+        nodal pressure p); reduced with MAX over ranks."""
+        return {}
+
     def initial_guess(self, u, t: float) -> None:
         """Set a starting state before the first load step (default: zero)."""
 
@@ -306,6 +311,7 @@ class _Run:
             "xdmf": None if xdmf_path is None else str(xdmf_path),
         }
         data["reference"] = post.reference_errors(summary)
+        data["scores"] = post.scores(summary["force"])
         data["errors"] = post.field_errors()
         solver.destroy()
         if self.out is not None:
@@ -466,6 +472,14 @@ class _PostProcessor:
         self.pressure.interpolate(self.pk)
         return force
 
+    def scores(self, force: float) -> dict[str, float]:
+        m = self.mass1.getArray()
+        on = m > 0.0
+        x = _compat.dof_coordinates(self.Q1)[: len(m)][on]
+        p = self.pressure.x.array[: len(m)][on]
+        local = self.scene.pressure_scores(x, p, force)
+        return {k: self.mesh.comm.allreduce(v, op=MPI.MAX) for k, v in local.items()}
+
     def fields(self, u) -> list:
         self.vm.interpolate(self.vm_expr)
         return [u, self.vm, self.pressure, self.gap, self.status]
@@ -473,6 +487,9 @@ class _PostProcessor:
     def reference_errors(self, summary: dict) -> dict[str, float]:
         ref = self.scene.reference(summary["force"])
         out: dict[str, float] = {}
+        if "force" in ref:
+            out["force"] = ref["force"]
+            out["force_rel_error"] = abs(summary["force"] - ref["force"]) / abs(ref["force"])
         for key in ("a", "p0"):
             if key in ref:
                 computed = summary[key]

@@ -1,0 +1,84 @@
+"""1D bar against a rigid wall with Nitsche contact: the exact discrete solution.
+
+Bar (0, L), E A = E, u(0) = 0, body force f, wall at x = L + g0 (u(L) <= g0). With the
+Chouly-Hild parameter gamma0' = 1 / gamma0 and N P1 elements of size h, the Nitsche solution
+penetrates by pen = gamma0' f h^2 / (2 E (1 - theta gamma0')) and its multiplier differs from
+lambda = f L / 2 - E g0 / L by 0 (theta = 1), -E pen / L (0), -2 E pen / L (-1)
+(BENCHMARKS.md section 8; Chouly & Hild 2013, doi:10.1137/12088344X).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+
+import dolfinx
+from contactfx import _compat
+from contactfx.contact.obstacles import HalfSpace, Obstacle
+from contactfx.mechanics.elasticity import Elastic
+from contactfx.scenes._common import fix
+from contactfx.scenes.base import Scene, param, validate
+
+__all__ = ["Bar1D", "bar_nitsche_exact"]
+
+LEFT, RIGHT = 1, 2
+
+
+def bar_nitsche_exact(*, E, L, f, g0, n, theta, gamma0) -> dict[str, float]:
+    """Exact discrete penetration and multiplier of the P1 Nitsche bar."""
+    h = L / n
+    g_ch = 1.0 / gamma0
+    pen = g_ch * f * h**2 / (2.0 * E * (1.0 - theta * g_ch))
+    lam = f * L / 2.0 - E * g0 / L
+    shift = {1: 0.0, 0: -E * pen / L, -1: -2.0 * E * pen / L}[theta]
+    return {"penetration": pen, "multiplier": lam + shift, "multiplier_exact": lam}
+
+
+@dataclass(frozen=True)
+class Bar1DParams:
+    length: float = param(1.0, "bar length L", positive=True)
+    E: float = param(1.0, "Young's modulus times cross-section", positive=True)
+    body_force: float = param(1.0, "body force f per unit length", positive=True)
+    gap: float = param(0.3, "initial gap g0 between the bar end and the wall", positive=True)
+    cells: int = param(8, "number of elements N", positive=True)
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+
+class Bar1D(Scene):
+    name = "bar1d"
+    summary = "1D bar pushed by a body force against a rigid wall (exact discrete Nitsche)"
+    Params = Bar1DParams
+    contact_tag = RIGHT
+
+    def material(self) -> Elastic:
+        return Elastic(self.p.E, 0.0)
+
+    def h_contact(self) -> float:
+        return self.p.length / self.p.cells
+
+    def build_mesh(self, comm):
+        mesh = _compat.create_interval(comm, self.p.cells, self.p.length)
+        L = self.p.length
+        left = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], 0.0))
+        right = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], L))
+        indices = np.concatenate([left, right]).astype(np.int32)
+        values = np.concatenate([np.full(len(left), LEFT), np.full(len(right), RIGHT)])
+        order = np.argsort(indices)
+        tags = dolfinx.mesh.meshtags(mesh, 0, indices[order], values[order].astype(np.int32))
+        return mesh, tags
+
+    def obstacle(self) -> Obstacle:
+        return HalfSpace(0.0)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return np.array([self.p.length + self.p.gap])
+
+    def dirichlet(self, V, facet_tags):
+        return [fix(V, facet_tags, LEFT)]
+
+    def load(self, v, ds, t):
+        return t * self.p.body_force * v[0] * ufl.dx

@@ -1,0 +1,122 @@
+"""Flat rigid punch with rounded edges pressed into an elastic block (frictionless).
+
+2D (plane strain, half-width a): p(x) = P / (pi sqrt(a^2 - x^2)); the pressure is singular at
+the edge, so the score is the normalised interior pressure pi sqrt(a^2 - x^2) p_h / P on
+|x| <= 0.8 a. 3D (circular punch of radius a, quarter model): stiffness P = 2 a E* delta
+(Johnson 1985, doi:10.1017/CBO9781139171731, sections 2.8 and 3.8; BENCHMARKS.md section 2).
+The edge radius regularises the corner; the contact extends beyond a by O(edge radius).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from contactfx.contact.obstacles import FlatPunch, Obstacle
+from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
+from contactfx.scenes._common import fix, fix_component, gmsh_mesh
+from contactfx.scenes.base import Scene, param, validate
+
+__all__ = ["FlatPunch2D", "FlatPunch3D"]
+
+
+@dataclass(frozen=True)
+class FlatPunch2DParams:
+    punch_half_width: float = param(0.05, "punch half-width a", positive=True)
+    edge_radius: float = param(0.002, "radius of the rounded punch edges", positive=True)
+    depth: float = param(1e-4, "indentation depth", positive=True)
+    half_width: float = param(1.0, "block half-width", positive=True)
+    height: float = param(1.0, "block height", positive=True)
+    E: float = param(1000.0, "Young's modulus", positive=True)
+    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
+    h_contact: float = param(2.5e-3, "element size under the punch", positive=True)
+    h_far: float = param(0.1, "element size far from the punch", positive=True)
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+
+class FlatPunch2D(Scene):
+    name = "punch2d"
+    summary = "flat punch with rounded edges on a plane-strain block; normalised pressure"
+    Params = FlatPunch2DParams
+    contact_tag = RectangleFacets.TOP
+
+    def build_mesh(self, comm):
+        p = self.p
+        w = 1.2 * p.punch_half_width
+        return gmsh_mesh(
+            comm, rectangle, 2, self.name,
+            x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
+            refine_x0=-w, refine_x1=w, h_contact=p.h_contact, h_far=p.h_far,
+        )  # fmt: skip
+
+    def obstacle(self) -> Obstacle:
+        return FlatPunch(self.p.punch_half_width, self.p.edge_radius)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return np.array([0.0, -t * self.p.depth])
+
+    def dirichlet(self, V, facet_tags):
+        return [fix(V, facet_tags, RectangleFacets.BOTTOM)]
+
+    def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
+        """max |pi sqrt(a^2 - x^2) p_h / P - 1| over surface nodes with |x| <= 0.8 a."""
+        a = self.p.punch_half_width
+        inner = np.abs(x[:, 0]) <= 0.8 * a
+        ratio = np.pi * np.sqrt(a**2 - x[inner, 0] ** 2) * p[inner] / force
+        return {"normalised_pressure_error": float(np.max(np.abs(ratio - 1.0), initial=0.0))}
+
+
+@dataclass(frozen=True)
+class FlatPunch3DParams:
+    punch_radius: float = param(0.05, "punch radius a", positive=True)
+    edge_radius: float = param(0.002, "radius of the rounded punch edge", positive=True)
+    depth: float = param(1e-4, "indentation depth delta", positive=True)
+    size: float = param(1.0, "edge of the quarter block", positive=True)
+    height: float = param(1.0, "block height", positive=True)
+    E: float = param(1000.0, "Young's modulus", positive=True)
+    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
+    h_contact: float = param(0.006, "element size under the punch", positive=True)
+    h_far: float = param(0.3, "element size far from the punch", positive=True)
+
+    def __post_init__(self) -> None:
+        validate(self)
+
+
+class FlatPunch3D(Scene):
+    name = "punch3d"
+    summary = "circular flat punch on a block (quarter model); stiffness P = 2 a E* delta"
+    Params = FlatPunch3DParams
+    contact_tag = BoxFacets.ZMAX
+    symmetry = 4.0
+
+    def build_mesh(self, comm):
+        p = self.p
+        return gmsh_mesh(
+            comm, box, 3, self.name,
+            x0=0.0, x1=p.size, y0=0.0, y1=p.size, z0=-p.height, z1=0.0,
+            refine_center=(0.0, 0.0), refine_radius=1.2 * p.punch_radius,
+            h_contact=p.h_contact, h_far=p.h_far,
+        )  # fmt: skip
+
+    def obstacle(self) -> Obstacle:
+        return FlatPunch(self.p.punch_radius, self.p.edge_radius)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return np.array([0.0, 0.0, -t * self.p.depth])
+
+    def dirichlet(self, V, facet_tags):
+        return [
+            fix(V, facet_tags, BoxFacets.ZMIN),
+            fix_component(V, facet_tags, BoxFacets.XMIN, 0),
+            fix_component(V, facet_tags, BoxFacets.YMIN, 1),
+        ]
+
+    def contact_size(self, measure: float) -> float:
+        return float(np.sqrt(measure / np.pi))
+
+    def reference(self, force: float) -> dict[str, float]:
+        p = self.p
+        return {"force": 2.0 * p.punch_radius * self.material().E_star * p.depth}

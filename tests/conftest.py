@@ -1,0 +1,50 @@
+"""Shared test helpers: MPI awareness and running the command line as a subprocess."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+from mpi4py import MPI
+
+
+def pytest_collection_modifyitems(config, items):
+    if MPI.COMM_WORLD.size == 1:
+        return
+    skip = pytest.mark.skip(reason="launches subprocesses; covered by the serial session")
+    for item in items:
+        if "serial_only" in item.keywords:
+            item.add_marker(skip)
+
+
+def clean_env() -> dict[str, str]:
+    """Environment for child processes: no MPI singleton state of the test process."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
+    env.update(
+        OMPI_ALLOW_RUN_AS_ROOT="1",
+        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+        OMPI_MCA_rmaps_base_oversubscribe="1",
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+    )
+    return env
+
+
+def contactfx_cmd(*args: str, ranks: int = 1) -> list[str]:
+    cmd = [sys.executable, "-m", "contactfx", *args]
+    if ranks > 1:
+        cmd = ["mpirun", "-n", str(ranks), *cmd]
+    return cmd
+
+
+def run_cli(*args: str, ranks: int = 1, timeout: float = 300, cwd=None):
+    return subprocess.run(
+        contactfx_cmd(*args, ranks=ranks),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=clean_env(),
+        cwd=cwd,
+    )

@@ -1,0 +1,62 @@
+"""Hertz line contact (2D) and sphere contact (3D) against the closed form at the computed force
+(BENCHMARKS.md section 1)."""
+
+import pytest
+
+from contactfx.scenes import Numerics
+from contactfx.scenes.hertz import Hertz2D, Hertz2DParams, Hertz3D, Hertz3DParams
+
+# Default 2D scene: R = 1, depth 1.5e-3 gives a = 0.026 (a/R < 0.03, block 1 x 1, L/a = 38),
+# h = 3e-3 in the contact zone: about 9 elements across a.
+COARSE = Hertz2DParams()
+FINE = Hertz2DParams(h_contact=1.5e-3, refine_half_width=0.04)
+
+METHODS = [
+    Numerics(method="nitsche", theta=1),
+    Numerics(method="nitsche", theta=0),
+    Numerics(method="nitsche", theta=-1),
+    Numerics(method="penalty"),
+]
+
+
+def _ids(num):
+    return f"{num.method}-theta{num.theta}" if num.method == "nitsche" else num.method
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+@pytest.mark.parametrize("num", METHODS, ids=_ids)
+def test_hertz2d_coarse(num, degree):
+    num = Numerics(**{**num.__dict__, "degree": degree})
+    ref = Hertz2D(COARSE).run(num, verbose=False)["reference"]
+    # the contact edge is resolved to the element containing it: |a_h - a| <= h / 2
+    assert ref["a_error_over_h"] <= 0.5
+    # about 10 elements across a: a few percent on the peak (BENCHMARKS.md section 1)
+    assert ref["p0_rel_error"] < 0.03
+
+
+@pytest.mark.parametrize("num", METHODS[:1] + METHODS[3:], ids=_ids)
+def test_hertz2d_fine(num):
+    ref = Hertz2D(FINE).run(num, verbose=False)["reference"]
+    # about 18 elements across a: 1 % on the peak pressure
+    assert ref["a_error_over_h"] <= 0.5
+    assert ref["p0_rel_error"] < 0.01
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_nitsche_and_vi_agree(degree):
+    nit = Hertz2D(COARSE).run(Numerics(method="nitsche", degree=degree), verbose=False)
+    vi = Hertz2D(COARSE).run(Numerics(method="vi", degree=degree), verbose=False)
+    # independent enforcement (bounds at the nodes vs Nitsche at quadrature points), same mesh:
+    # they agree to the discretisation error of either (a few tenths of a percent in force,
+    # the contact edge to one element, the peak to 1.5 %)
+    assert vi["force"] == pytest.approx(nit["force"], rel=5e-3)
+    assert abs(vi["contact_half_width"] - nit["contact_half_width"]) <= COARSE.h_contact
+    assert vi["peak_pressure"] == pytest.approx(nit["peak_pressure"], rel=1.5e-2)
+
+
+def test_hertz3d():
+    result = Hertz3D(Hertz3DParams(h_contact=0.015)).run(Numerics(), verbose=False)
+    ref = result["reference"]
+    # quarter model, about 7 tetrahedra across a = 0.1: 5 % (BENCHMARKS.md section 1)
+    assert ref["a_rel_error"] < 0.05
+    assert ref["p0_rel_error"] < 0.05

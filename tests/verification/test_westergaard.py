@@ -1,0 +1,34 @@
+"""Westergaard's wavy surface (BENCHMARKS.md section 3): partial contact half-width and the
+optimal convergence rates of the smooth full-contact solution."""
+
+import numpy as np
+import pytest
+
+from contactfx.scenes import Numerics
+from contactfx.scenes.westergaard import Westergaard, WestergaardParams
+
+
+def test_partial_contact_half_width():
+    params = WestergaardParams(mean_pressure_ratio=0.5)
+    result = Westergaard(params).run(Numerics(steps=2), verbose=False)
+    ref = result["reference"]
+    assert ref["a"] == pytest.approx(0.25, rel=1e-12)  # sin^2(pi a / lambda) = 1 / 2
+    # within one element of the exact a / lambda = 0.25
+    assert abs(result["contact_half_width"] - 0.25) <= params.h_contact
+
+
+@pytest.mark.parametrize("method", ["nitsche", "penalty"])
+def test_full_contact_rates(method):
+    errors = {"L2": [], "H1": []}
+    sizes = [1 / 8, 1 / 16, 1 / 32]
+    for h in sizes:
+        params = WestergaardParams(mean_pressure_ratio=1.5, h_contact=h, h_far=h)
+        num = Numerics(method=method, penalty=1e4, steps=1)
+        result = Westergaard(params).run(num, verbose=False)
+        for key in errors:
+            errors[key].append(result["errors"][f"displacement_{key}"])
+    rates = {k: np.polyfit(np.log(sizes), np.log(v), 1)[0] for k, v in errors.items()}
+    # P1 on a smooth solution: H1 error O(h), L2 error O(h^2); 0.15 leaves room for the
+    # pre-asymptotic first mesh (8 elements per half wavelength)
+    assert rates["H1"] == pytest.approx(1.0, abs=0.15)
+    assert rates["L2"] == pytest.approx(2.0, abs=0.15)
