@@ -17,6 +17,7 @@ __all__ = [
     "DOLFINX_VERSION",
     "function_space",
     "petsc_vec",
+    "element_degree",
     "model_to_mesh",
     "create_interval",
     "expression",
@@ -45,6 +46,12 @@ def function_space(mesh, family: str, degree: int, shape: tuple[int, ...] | None
     if shape:
         return dolfinx.fem.VectorFunctionSpace(mesh, (family, degree), dim=shape[0])
     return dolfinx.fem.FunctionSpace(mesh, (family, degree))
+
+
+def element_degree(space) -> int:
+    """Polynomial degree of a function space's element."""
+    degree = space.ufl_element().degree
+    return degree() if callable(degree) else degree
 
 
 def petsc_vec(u: dolfinx.fem.Function) -> PETSc.Vec:

@@ -36,8 +36,7 @@ class ResultsWriter:
             self._file = None
 
     def _output_function(self, f: dolfinx.fem.Function) -> dolfinx.fem.Function:
-        element = f.function_space.ufl_element()
-        if element.degree() <= 1:
+        if _compat.element_degree(f.function_space) <= 1:
             return f
         if f.name not in self._out:
             shape = f.ufl_shape

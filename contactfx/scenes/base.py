@@ -59,7 +59,7 @@ class Numerics:
     method: str = param("nitsche", "enforcement method", choices=METHODS)
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
     gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
-    penalty: float = param(1000.0, "penalty parameter, kappa = penalty E / h", positive=True)
+    penalty: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True)
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
@@ -350,7 +350,8 @@ class _VIBounds:
         self.dofs = np.asarray(dofs[0])  # indices into V's local (unrolled) dofs
         coords = _compat.dof_coordinates(Vd)[np.asarray(dofs[1])]
         self.coords = coords[:, :gdim]
-        x = _compat.petsc_vec(dolfinx.fem.Function(V))
+        self._template = dolfinx.fem.Function(V)  # owns the memory the bounds are copied from
+        x = _compat.petsc_vec(self._template)
         self.lower = x.copy()
         self.upper = x.copy()
         self.lower.set(PETSc.NINFINITY)
