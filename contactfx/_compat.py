@@ -6,12 +6,11 @@ No other module of contactfx checks a version; they call the functions below.
 
 from __future__ import annotations
 
+import dolfinx
+import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from petsc4py import PETSc
-
-import dolfinx
-import dolfinx.fem.petsc
 
 __all__ = [
     "DOLFINX_VERSION",

@@ -90,7 +90,8 @@ def _build(scene_cls, ns: argparse.Namespace):
     from contactfx.scenes import Numerics
 
     values = vars(ns)
-    params = scene_cls.Params(**{f.name: values[f.name] for f in dataclasses.fields(scene_cls.Params)})
+    fields = dataclasses.fields(scene_cls.Params)
+    params = scene_cls.Params(**{f.name: values[f.name] for f in fields})
     numerics = Numerics(**{f.name: values[f.name] for f in dataclasses.fields(Numerics)})
     return scene_cls(params), numerics
 
@@ -128,7 +129,7 @@ def _table(data: dict) -> str:
                      f"{ref['force_rel_error']:.2%})"))  # fmt: skip
     if "a" in ref:
         rows.append(
-            ("contact half-width a (Hertz-type ref)",
+            ("contact half-width a (ref)",
              f"{ref['a_computed']:.6g} vs {ref['a']:.6g}  (rel. error {ref['a_rel_error']:.2%},"
              f" {ref['a_error_over_h']:.2f} h)")
         )  # fmt: skip

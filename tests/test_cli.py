@@ -84,3 +84,12 @@ def test_module_entry_point_westergaard():
     res = run_cli("run", "westergaard", "--mean-pressure-ratio", "0.5", "--quiet")
     assert res.returncode == 0, res.stderr
     assert "0.25" in res.stdout  # a / lambda = 0.25 (asserted precisely in verification)
+
+
+def test_bench_smoke(tmp_path):
+    res = run_cli("bench", "hertz2d", "--levels", "1", "--out", str(tmp_path), *[],
+                  timeout=300)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert "contact_over_linear" in res.stdout
+    rows = (tmp_path / "bench.csv").read_text().splitlines()
+    assert rows[0].startswith("level,method,h,dofs") and len(rows) == 2

@@ -6,9 +6,9 @@ import json
 import platform
 from pathlib import Path
 
+import dolfinx
 from petsc4py import PETSc
 
-import dolfinx
 import contactfx
 
 __all__ = ["versions", "write_json"]

@@ -6,7 +6,6 @@ import functools
 
 import numpy as np
 
-import dolfinx
 from contactfx import _compat
 from contactfx.meshes import build
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import dolfinx
 import numpy as np
 import ufl
 
-import dolfinx
 from contactfx import _compat
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.mechanics.elasticity import Elastic

@@ -98,7 +98,8 @@ class Westergaard(Scene):
         r = self.p.mean_pressure_ratio
         lam = self.p.wavelength
         if r >= 1.0:
-            return {"a": 0.5 * lam, "p0": self.p_mean + self.p_star, "force": 0.5 * lam * self.p_mean}
+            force = 0.5 * lam * self.p_mean
+            return {"a": 0.5 * lam, "p0": self.p_mean + self.p_star, "force": force}
         a = lam / np.pi * np.arcsin(np.sqrt(r))
         return {"a": a, "p0": 2.0 * self.p_star * np.sqrt(r), "force": 0.5 * lam * self.p_mean}
 

@@ -21,10 +21,10 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+import dolfinx
 import numpy as np
 from petsc4py import PETSc
 
-import dolfinx
 from contactfx import _compat
 
 __all__ = ["ConvergenceError", "SolveStats", "ContactSNES", "DEFAULT_OPTIONS", "GAMG_OPTIONS"]
@@ -112,7 +112,7 @@ def rigid_body_modes(V) -> PETSc.NullSpace:
         arrays[3][:, 0], arrays[3][:, 1] = -x[:, 1], x[:, 0]
         arrays[4][:, 0], arrays[4][:, 2] = x[:, 2], -x[:, 0]
         arrays[5][:, 2], arrays[5][:, 1] = x[:, 1], -x[:, 2]
-    for vec, arr in zip(vecs, arrays):
+    for vec, arr in zip(vecs, arrays, strict=True):
         vec.array[:] = arr.ravel()
     dolfinx.la.orthonormalize(vecs)
     return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)

@@ -18,6 +18,8 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 import ufl
+from mpi4py import MPI
+
 from contactfx.meshes import (
     BoxCells,
     BoxFacets,
@@ -29,7 +31,6 @@ from contactfx.meshes import (
     build,
     rectangle,
 )
-from mpi4py import MPI
 
 RECTANGLE = dict(
     x0=-2.0,
