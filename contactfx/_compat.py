@@ -25,12 +25,11 @@ __all__ = [
     "create_vector",
     "assemble_vector",
     "write_function",
-    "num_owned_vertices",
     "dof_coordinates",
     "bc_dofs",
     "locate_dofs_topological",
     "dirichletbc",
-    "cell_name",
+    "cell_diameter",
 ]
 
 DOLFINX_VERSION: tuple[int, int] = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
@@ -111,10 +110,6 @@ def write_function(xdmf, u: dolfinx.fem.Function, t: float) -> None:
     xdmf.write_function(u, t)
 
 
-def num_owned_vertices(mesh) -> int:
-    return mesh.topology.index_map(0).size_local
-
-
 def dof_coordinates(space) -> np.ndarray:
     """Coordinates (num_dofs_local + ghosts, 3) of the (scalar) space's dofs."""
     return space.tabulate_dof_coordinates()
@@ -134,10 +129,6 @@ def bc_dofs(bc) -> np.ndarray:
     """Local indices (owned and ghost) of the dofs a Dirichlet condition fixes."""
     dofs, _ = bc.dof_indices()
     return dofs
-
-
-def cell_name(mesh) -> str:
-    return mesh.topology.cell_type.name
 
 
 def cell_diameter(mesh):

@@ -102,12 +102,9 @@ def model_to_mesh(
 
     The only dolfinx call of :mod:`contactfx.meshes`. Collective on ``comm``.
     """
-    # dolfinx 0.5 needs the submodule import; dolfinx >= 0.10 returns a NamedTuple whose first
-    # three fields are these, earlier versions a 3-tuple.
-    from dolfinx.io import gmshio
+    from contactfx import _compat  # dolfinx is imported only when a mesh is built
 
-    result = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
-    return result[0], result[1], result[2]
+    return _compat.model_to_mesh(model, comm, rank, gdim)
 
 
 @contextlib.contextmanager
