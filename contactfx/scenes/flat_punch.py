@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from contactfx.contact.obstacles import FlatPunch, Obstacle
-from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
-from contactfx.scenes._common import fix, fix_component, gmsh_mesh
+from contactfx.meshes import RectangleFacets, rectangle
+from contactfx.scenes._common import fix, gmsh_mesh
 from contactfx.scenes.base import Scene, param, validate
+from contactfx.scenes.hertz import QuarterBlock
 
 __all__ = ["FlatPunch2D", "FlatPunch3D"]
 
@@ -85,37 +86,16 @@ class FlatPunch3DParams:
         validate(self)
 
 
-class FlatPunch3D(Scene):
+class FlatPunch3D(QuarterBlock):
     name = "punch3d"
     summary = "circular flat punch on a block (quarter model); stiffness P = 2 a E* delta"
     Params = FlatPunch3DParams
-    contact_tag = BoxFacets.ZMAX
-    symmetry = 4.0
 
-    def build_mesh(self, comm):
-        p = self.p
-        return gmsh_mesh(
-            comm, box, 3, self.name,
-            x0=0.0, x1=p.size, y0=0.0, y1=p.size, z0=-p.height, z1=0.0,
-            refine_center=(0.0, 0.0), refine_radius=1.2 * p.punch_radius,
-            h_contact=p.h_contact, h_far=p.h_far,
-        )  # fmt: skip
+    def refine_radius(self) -> float:
+        return 1.2 * self.p.punch_radius
 
     def obstacle(self) -> Obstacle:
         return FlatPunch(self.p.punch_radius, self.p.edge_radius)
-
-    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
-        return np.array([0.0, 0.0, -t * self.p.depth])
-
-    def dirichlet(self, V, facet_tags):
-        return [
-            fix(V, facet_tags, BoxFacets.ZMIN),
-            fix_component(V, facet_tags, BoxFacets.XMIN, 0),
-            fix_component(V, facet_tags, BoxFacets.YMIN, 1),
-        ]
-
-    def contact_size(self, measure: float) -> float:
-        return float(np.sqrt(measure / np.pi))
 
     def reference(self, force: float) -> dict[str, float]:
         p = self.p

@@ -21,7 +21,7 @@ from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
 from contactfx.scenes.base import Scene, param, validate
 
-__all__ = ["Hertz2D", "Hertz3D", "hertz_2d", "hertz_3d"]
+__all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "hertz_2d", "hertz_3d"]
 
 
 def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
@@ -100,24 +100,24 @@ class Hertz3DParams:
         validate(self)
 
 
-class Hertz3D(Scene):
-    name = "hertz3d"
-    summary = "rigid sphere pressed into a block (quarter model); reference Hertz a and p0"
-    Params = Hertz3DParams
+class QuarterBlock(Scene):
+    """A block [0, size]^2 x [-height, 0] with the symmetry planes x = 0 and y = 0 (quarter
+    model of an axisymmetric indentation), clamped at the bottom, contact on the top."""
+
     contact_tag = BoxFacets.ZMAX
     symmetry = 4.0
+
+    def refine_radius(self) -> float:
+        raise NotImplementedError
 
     def build_mesh(self, comm):
         p = self.p
         return gmsh_mesh(
             comm, box, 3, self.name,
             x0=0.0, x1=p.size, y0=0.0, y1=p.size, z0=-p.height, z1=0.0,
-            refine_center=(0.0, 0.0), refine_radius=p.refine_radius,
+            refine_center=(0.0, 0.0), refine_radius=self.refine_radius(),
             h_contact=p.h_contact, h_far=p.h_far,
         )  # fmt: skip
-
-    def obstacle(self) -> Obstacle:
-        return _indenter(self.p.profile, self.p.radius)
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
         return np.array([0.0, 0.0, -t * self.p.depth])
@@ -131,6 +131,18 @@ class Hertz3D(Scene):
 
     def contact_size(self, measure: float) -> float:
         return float(np.sqrt(measure / np.pi))
+
+
+class Hertz3D(QuarterBlock):
+    name = "hertz3d"
+    summary = "rigid sphere pressed into a block (quarter model); reference Hertz a and p0"
+    Params = Hertz3DParams
+
+    def refine_radius(self) -> float:
+        return self.p.refine_radius
+
+    def obstacle(self) -> Obstacle:
+        return _indenter(self.p.profile, self.p.radius)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_3d(force, self.p.radius, self.material().E_star)
