@@ -19,7 +19,7 @@ from contactfx import _compat
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.scenes._common import fix
-from contactfx.scenes.base import Scene, param, validate
+from contactfx.scenes.base import Scene, SceneParams, param
 
 __all__ = ["Bar1D", "bar_nitsche_exact"]
 
@@ -37,15 +37,12 @@ def bar_nitsche_exact(*, E, L, f, g0, n, theta, gamma0) -> dict[str, float]:
 
 
 @dataclass(frozen=True)
-class Bar1DParams:
+class Bar1DParams(SceneParams):
     length: float = param(1.0, "bar length L", positive=True)
     E: float = param(1.0, "Young's modulus times cross-section", positive=True)
     body_force: float = param(1.0, "body force f per unit length", positive=True)
     gap: float = param(0.3, "initial gap g0 between the bar end and the wall", positive=True)
     cells: int = param(8, "number of elements N", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class Bar1D(Scene):

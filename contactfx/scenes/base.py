@@ -29,7 +29,7 @@ from contactfx.mechanics.elasticity import Elastic
 from contactfx.solvers.loadstep import StepRecord, run_load_program
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
 
-__all__ = ["param", "Numerics", "Scene", "RunResult", "METHODS"]
+__all__ = ["param", "SceneParams", "Numerics", "Scene", "RunResult", "METHODS"]
 
 METHODS = ("nitsche", "penalty", "vi")
 
@@ -50,6 +50,15 @@ def validate(obj) -> None:
         if choices is not None and value not in choices:
             allowed = ", ".join(str(c) for c in choices)
             raise ValueError(f"--{name} must be one of {allowed}, got {value}")
+
+
+@dataclass(frozen=True)
+class SceneParams:
+    """Base of every scene's parameter dataclass: fields made with :func:`param` are
+    validated on construction."""
+
+    def __post_init__(self) -> None:
+        validate(self)
 
 
 @dataclass(frozen=True)

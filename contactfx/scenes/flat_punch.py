@@ -16,14 +16,14 @@ import numpy as np
 from contactfx.contact.obstacles import FlatPunch, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.scenes._common import fix, gmsh_mesh
-from contactfx.scenes.base import Scene, param, validate
+from contactfx.scenes.base import Scene, SceneParams, param
 from contactfx.scenes.hertz import QuarterBlock
 
 __all__ = ["FlatPunch2D", "FlatPunch3D"]
 
 
 @dataclass(frozen=True)
-class FlatPunch2DParams:
+class FlatPunch2DParams(SceneParams):
     punch_half_width: float = param(0.05, "punch half-width a", positive=True)
     edge_radius: float = param(0.002, "radius of the rounded punch edges", positive=True)
     depth: float = param(1e-4, "indentation depth", positive=True)
@@ -33,9 +33,6 @@ class FlatPunch2DParams:
     nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(2.5e-3, "element size under the punch", positive=True)
     h_far: float = param(0.1, "element size far from the punch", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class FlatPunch2D(Scene):
@@ -71,7 +68,7 @@ class FlatPunch2D(Scene):
 
 
 @dataclass(frozen=True)
-class FlatPunch3DParams:
+class FlatPunch3DParams(SceneParams):
     punch_radius: float = param(0.05, "punch radius a", positive=True)
     edge_radius: float = param(0.002, "radius of the rounded punch edge", positive=True)
     depth: float = param(1e-4, "indentation depth delta", positive=True)
@@ -81,9 +78,6 @@ class FlatPunch3DParams:
     nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(0.006, "element size under the punch", positive=True)
     h_far: float = param(0.3, "element size far from the punch", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class FlatPunch3D(QuarterBlock):

@@ -19,7 +19,7 @@ import numpy as np
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
-from contactfx.scenes.base import Scene, param, validate
+from contactfx.scenes.base import Scene, SceneParams, param
 
 __all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "hertz_2d", "hertz_3d"]
 
@@ -39,7 +39,7 @@ def _indenter(profile: str, radius: float) -> Obstacle:
 
 
 @dataclass(frozen=True)
-class Hertz2DParams:
+class Hertz2DParams(SceneParams):
     radius: float = param(1.0, "indenter radius R", positive=True)
     profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
     depth: float = param(1.5e-3, "indentation depth (ramped over the load steps)", positive=True)
@@ -50,9 +50,6 @@ class Hertz2DParams:
     h_contact: float = param(3e-3, "element size in the contact zone", positive=True)
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
     refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class Hertz2D(Scene):
@@ -84,7 +81,7 @@ class Hertz2D(Scene):
 
 
 @dataclass(frozen=True)
-class Hertz3DParams:
+class Hertz3DParams(SceneParams):
     radius: float = param(1.0, "indenter radius R", positive=True)
     profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
     depth: float = param(0.01, "indentation depth (ramped over the load steps)", positive=True)
@@ -95,9 +92,6 @@ class Hertz3DParams:
     h_contact: float = param(0.02, "element size in the contact zone", positive=True)
     h_far: float = param(0.3, "element size far from the contact zone", positive=True)
     refine_radius: float = param(0.15, "radius of the refined zone", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class QuarterBlock(Scene):

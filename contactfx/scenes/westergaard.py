@@ -26,13 +26,13 @@ import ufl
 from contactfx.contact.obstacles import Obstacle, Sinusoid
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.scenes._common import fix_component, gmsh_mesh
-from contactfx.scenes.base import Scene, param, validate
+from contactfx.scenes.base import Scene, SceneParams, param
 
 __all__ = ["Westergaard"]
 
 
 @dataclass(frozen=True)
-class WestergaardParams:
+class WestergaardParams(SceneParams):
     wavelength: float = param(1.0, "wavelength lambda of the rigid sinusoid", positive=True)
     amplitude: float = param(0.01, "amplitude Delta of the sinusoid", positive=True)
     mean_pressure_ratio: float = param(0.5, "mean pressure p_m / p* (>= 1: full contact)",
@@ -42,9 +42,6 @@ class WestergaardParams:
     nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(1.0 / 64, "element size at the surface", positive=True)
     h_far: float = param(1.0 / 8, "element size at depth", positive=True)
-
-    def __post_init__(self) -> None:
-        validate(self)
 
 
 class Westergaard(Scene):
