@@ -30,6 +30,7 @@ __all__ = [
     "locate_dofs_topological",
     "dirichletbc",
     "cell_diameter",
+    "mixed_space",
 ]
 
 DOLFINX_VERSION: tuple[int, int] = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
@@ -133,3 +134,22 @@ def bc_dofs(bc) -> np.ndarray:
 
 def cell_diameter(mesh):
     return ufl.CellDiameter(mesh)
+
+
+def mixed_space(mesh, degree: int, gdim: int, multiplier_shape: tuple[int, ...]):
+    """[P_degree]^gdim x P1 (scalar, or vector of ``multiplier_shape``): displacement and
+    contact multiplier in one space."""
+    if _NEW:
+        import basix.ufl
+
+        cell = mesh.basix_cell()
+        Ve = basix.ufl.element("Lagrange", cell, degree, shape=(gdim,))
+        Qe = basix.ufl.element("Lagrange", cell, 1, shape=multiplier_shape or None)
+        return dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element([Ve, Qe]))
+    cell = mesh.ufl_cell()
+    Ve = ufl.VectorElement("Lagrange", cell, degree, dim=gdim)
+    if multiplier_shape:
+        Qe = ufl.VectorElement("Lagrange", cell, 1, dim=multiplier_shape[0])
+    else:
+        Qe = ufl.FiniteElement("Lagrange", cell, 1)
+    return dolfinx.fem.FunctionSpace(mesh, ufl.MixedElement([Ve, Qe]))

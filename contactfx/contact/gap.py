@@ -1,4 +1,5 @@
-"""Contact kinematics against a rigid obstacle: gap, normal and normal stress on a surface."""
+"""Contact kinematics against a rigid obstacle: gap, normal, slip increment and the normal and
+tangential stress on a surface."""
 
 from __future__ import annotations
 
@@ -7,19 +8,33 @@ from dataclasses import dataclass
 
 import ufl
 
+from contactfx.contact.laws import Friction
 from contactfx.contact.obstacles import Obstacle
 
-__all__ = ["ContactSurface"]
+__all__ = ["ContactSurface", "tangential"]
+
+
+def tangential(w, n):
+    """Tangential part (I - n n) w of the vector w."""
+    return w - ufl.dot(w, n) * n
 
 
 @dataclass(frozen=True)
 class ContactSurface:
     """Everything a method needs to write its terms on one contact boundary.
 
-    u: displacement (dolfinx Function); v: test function; ds: measure restricted to the
-    candidate contact facets; obstacle and its rigid displacement ``offset`` (a dolfinx
-    Constant vector, part of the load program); sigma: the stress function w -> sigma(w);
-    E: Young's modulus used to scale the method parameters; h: local mesh size (UFL).
+    u: displacement (a dolfinx Function or a UFL component of a mixed one); v: its test
+    function; ds: measure restricted to the candidate contact facets; obstacle and its rigid
+    displacement ``offset`` (a dolfinx Constant vector, part of the load program); sigma: the
+    stress function w -> sigma(w); E: Young's modulus used to scale the method parameters;
+    h: local mesh size (UFL).
+
+    Friction (only when ``friction`` is not None): ``u_prev`` and ``offset_prev`` are the
+    displacement and the obstacle offset of the last converged load step; the slip increment
+    is measured from them. ``ds_nodal`` is the same boundary with the vertex (trapezoidal)
+    quadrature rule, for laws collocated at the nodes (semi-smooth Newton multipliers).
+    ``multiplier`` (and ``multiplier_test``): the augmented Lagrangian multiplier, when the
+    method has one.
     """
 
     u: object
@@ -30,12 +45,22 @@ class ContactSurface:
     sigma: Callable
     E: float
     h: object
+    friction: Friction | None = None
+    u_prev: object = None
+    offset_prev: object = None
+    ds_nodal: ufl.Measure | None = None
+    multiplier: object = None
+    multiplier_test: object = None
+
+    @property
+    def mesh(self):
+        return self.ds.ufl_domain()
 
     def position(self, w=None):
         """Current position in the obstacle's frame, x + u - offset. For the linearised
         (``vertical``) obstacles only the vertical displacement moves the point: their gap is
         the small-deformation Signorini gap height(x_t) - (x_d + u_d) of Hertz and Westergaard."""
-        x = ufl.SpatialCoordinate(self.u.function_space.mesh)
+        x = ufl.SpatialCoordinate(self.mesh)
         w = self.u if w is None else w
         if self.obstacle.vertical:
             d = ufl.shape(x)[0]
@@ -53,3 +78,14 @@ class ContactSurface:
     def sigma_n(self, w, n):
         """Normal stress n . sigma(w) n (< 0 in compression)."""
         return ufl.dot(n, ufl.dot(self.sigma(w), n))
+
+    def sigma_t(self, w, n):
+        """Tangential traction (I - n n) sigma(w) n."""
+        return tangential(ufl.dot(self.sigma(w), n), n)
+
+    def slip_increment(self, n):
+        """Tangential displacement of the body relative to the obstacle since the last
+        converged step: (I - n n) ((u - u_prev) - (offset - offset_prev))."""
+        if self.u_prev is None:
+            raise ValueError("the slip increment needs the previous state (friction only)")
+        return tangential((self.u - self.u_prev) - (self.offset - self.offset_prev), n)

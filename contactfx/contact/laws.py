@@ -1,15 +1,31 @@
-"""Pointwise contact laws as UFL expressions.
+"""Pointwise contact and friction laws as UFL expressions.
 
-Conventions (ARCHITECTURE.md): gap g >= 0 when apart, pressure p >= 0 in compression, g p = 0.
-The Signorini conditions are equivalent, for any r > 0, to p = [p - r g]_+ (Alart & Curnier
-1991, doi:10.1016/0045-7825(91)90022-X), which is the form every method here discretises.
+Conventions (ARCHITECTURE.md): gap g >= 0 when apart, pressure p >= 0 in compression, g p = 0;
+the tangential traction t_T on the body satisfies |t_T| <= s (s = mu p for Coulomb, a given
+threshold for Tresca), and it opposes the slip where |t_T| = s.
+
+The Signorini conditions are equivalent, for any r > 0, to p = [p - r g]_+, and the friction
+conditions to t_T = proj_{B(0, s)}(t_T - r du_T) with du_T the slip increment (Alart & Curnier
+1991, doi:10.1016/0045-7825(91)90022-X): the forms every method here discretises.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import ufl
 
-__all__ = ["positive_part", "active"]
+__all__ = [
+    "positive_part",
+    "active",
+    "ball_projection",
+    "norm",
+    "fischer_burmeister",
+    "Friction",
+    "Tresca",
+    "Coulomb",
+    "friction_law",
+]
 
 
 def positive_part(x):
@@ -20,3 +36,73 @@ def positive_part(x):
 def active(x):
     """Indicator 1 where x > 0, else 0."""
     return ufl.conditional(ufl.gt(x, 0.0), 1.0, 0.0)
+
+
+def norm(x, scale: float):
+    """|x|, regularised by 1e-12 ``scale`` so that it and its derivative stay finite at 0."""
+    return ufl.sqrt(ufl.dot(x, x) + (1e-12 * scale) ** 2)
+
+
+def ball_projection(x, s, scale: float):
+    """Projection of the vector x onto the ball of radius s >= 0: x where |x| <= s, else
+    s x / |x|. ``scale`` is a typical magnitude of x (regularises |x| at 0)."""
+    nx = norm(x, scale)
+    return ufl.conditional(ufl.le(nx, s), x, s / nx * x)
+
+
+def fischer_burmeister(a, b, scale: float):
+    """phi(a, b) = a + b - sqrt(a^2 + b^2): zero exactly when a >= 0, b >= 0 and a b = 0
+    (Fischer 1992, doi:10.1080/02331939208843795). Regularised at (0, 0) by 1e-12 scale."""
+    return a + b - ufl.sqrt(a**2 + b**2 + (1e-12 * scale) ** 2)
+
+
+@dataclass(frozen=True)
+class Friction:
+    """A friction law: ``bound(p)`` is the radius of the admissible tangential tractions."""
+
+    name = "none"
+
+    def bound(self, p):
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Tresca(Friction):
+    """Tresca friction with a given threshold (stress units), acting where the surfaces are in
+    contact (p > 0): |t_T| <= threshold there."""
+
+    threshold: float
+    name = "tresca"
+
+    def __post_init__(self) -> None:
+        if not self.threshold >= 0.0:
+            raise ValueError(f"Tresca threshold must be >= 0, got {self.threshold}")
+
+    def bound(self, p):
+        return self.threshold * active(p)
+
+
+@dataclass(frozen=True)
+class Coulomb(Friction):
+    """Coulomb friction |t_T| <= mu p."""
+
+    mu: float
+    name = "coulomb"
+
+    def __post_init__(self) -> None:
+        if not self.mu >= 0.0:
+            raise ValueError(f"friction coefficient mu must be >= 0, got {self.mu}")
+
+    def bound(self, p):
+        return self.mu * positive_part(p)
+
+
+def friction_law(name: str, mu: float = 0.0, threshold: float = 0.0) -> Friction | None:
+    """'none' -> None (no friction terms are built), 'tresca', 'coulomb'."""
+    if name == "none":
+        return None
+    if name == "tresca":
+        return Tresca(threshold)
+    if name == "coulomb":
+        return Coulomb(mu)
+    raise ValueError(f"unknown friction law '{name}' (known: none, tresca, coulomb)")

@@ -1,15 +1,24 @@
-"""Nitsche's method for frictionless contact with a rigid obstacle.
+"""Nitsche's method for contact with a rigid obstacle, frictionless or with Tresca / Coulomb
+friction.
 
-With P(u) = [-sigma_n(u) - gamma_N g(u)]_+ the Nitsche contact pressure, the residual is
+With the Nitsche pressure and tangential traction
 
-    R(u; v) = a(u, v) - L(v) - theta / gamma_N int sigma_n(u) sigma_n(v)
-              + 1 / gamma_N int P(u) (gamma_N v.n - theta sigma_n(v))
+    P_n(u) = [-sigma_n(u) - gamma_N g(u)]_+,
+    P_T(u) = proj_{B(0, s(P_n))}(sigma_T(u) - gamma_N du_T(u))
 
-(Chouly, Hild & Renard 2015, doi:10.1090/S0025-5718-2014-02913-X), theta = 1 symmetric,
-0 incomplete, -1 skew-symmetric. Here gamma_N = gamma0 E / h with gamma0 dimensionless and
-large = strong. The papers write gamma = gamma0' h / E (small = strong): gamma0' = 1 / gamma0.
-GetFEM 5.4 uses gamma0_GetFEM / h with gamma0_GetFEM = gamma0 E; asimov-contact gamma_a / h
-with gamma_a = gamma0 E.
+(du_T the slip increment since the last load step, s the friction bound: mu P_n for Coulomb,
+the threshold for Tresca) and the traction on the body t(u) = -P_n n + P_T, the residual is
+
+    R(u; v) = a(u, v) - L(v) - theta / gamma_N int sigma(u) n . sigma(v) n
+              - 1 / gamma_N int t(u) . (gamma_N v - theta sigma(v) n)
+
+(Chouly, Hild & Renard 2015, doi:10.1090/S0025-5718-2014-02913-X, frictionless; Chouly 2014,
+doi:10.1016/j.jmaa.2013.10.046, Tresca; Chouly, Hild, Lleras & Renard 2022,
+doi:10.1016/j.cam.2022.114557, Coulomb). theta = 1 symmetric, 0 incomplete, -1 skew.
+Without friction only the normal terms are built. Here gamma_N = gamma0 E / h with gamma0
+dimensionless and large = strong. The papers write gamma = gamma0' h / E (small = strong):
+gamma0' = 1 / gamma0. GetFEM 5.4 uses gamma0_GetFEM / h with gamma0_GetFEM = gamma0 E;
+asimov-contact gamma_a / h with gamma_a = gamma0 E.
 """
 
 from __future__ import annotations
@@ -19,7 +28,7 @@ from dataclasses import dataclass
 import ufl
 
 from contactfx.contact.gap import ContactSurface
-from contactfx.contact.laws import positive_part
+from contactfx.contact.laws import active, ball_projection, norm, positive_part
 
 __all__ = ["Nitsche"]
 
@@ -31,6 +40,7 @@ class Nitsche:
     theta: float = 1.0
     gamma0: float = 10.0
     name = "nitsche"
+    mixed = False
 
     def __post_init__(self) -> None:
         if self.theta not in (1, 0, -1):
@@ -45,6 +55,18 @@ class Nitsche:
         n = s.normal()
         return positive_part(-s.sigma_n(s.u, n) - self.gamma(s) * s.gap())
 
+    def _trial_t(self, s: ContactSurface):
+        n = s.normal()
+        return s.sigma_t(s.u, n) - self.gamma(s) * s.slip_increment(n)
+
+    def tangential_traction(self, s: ContactSurface):
+        return ball_projection(self._trial_t(s), s.friction.bound(self.pressure(s)), s.E)
+
+    def slip_indicator(self, s: ContactSurface):
+        """1 where the friction bound is reached (slip), else 0."""
+        p = self.pressure(s)
+        return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))
+
     def residual(self, s: ContactSurface):
         n = s.normal()
         gamma = self.gamma(s)
@@ -54,4 +76,11 @@ class Nitsche:
         form = p * (ufl.dot(s.v, n) - self.theta / gamma * sn_v) * s.ds
         if self.theta != 0:
             form -= self.theta / gamma * sn_u * sn_v * s.ds
+        if s.friction is not None:
+            st_v = s.sigma_t(s.v, n)
+            t_T = self.tangential_traction(s)
+            # t_T is tangential: t_T . v = t_T . (I - n n) v
+            form -= ufl.dot(t_T, s.v - self.theta / gamma * st_v) * s.ds
+            if self.theta != 0:
+                form -= self.theta / gamma * ufl.dot(s.sigma_t(s.u, n), st_v) * s.ds
         return form

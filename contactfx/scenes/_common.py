@@ -23,11 +23,9 @@ def _facets(facet_tags, tag: int) -> np.ndarray:
 
 
 def fix(V, facet_tags, tag: int):
-    """u = 0 on the facets tagged ``tag``."""
-    mesh = V.mesh
-    dofs = _compat.locate_dofs_topological(V, mesh.topology.dim - 1, _facets(facet_tags, tag))
-    zero = np.zeros(mesh.geometry.dim, dtype=np.float64)
-    return _compat.dirichletbc(zero, dofs, V)
+    """u = 0 on the facets tagged ``tag`` (one condition per component, so that V may be the
+    displacement part of a mixed space)."""
+    return [fix_component(V, facet_tags, tag, i) for i in range(V.mesh.geometry.dim)]
 
 
 def fix_component(V, facet_tags, tag: int, component: int):

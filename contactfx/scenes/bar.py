@@ -75,7 +75,7 @@ class Bar1D(Scene):
         return np.array([self.p.length + self.p.gap])
 
     def dirichlet(self, V, facet_tags):
-        return [fix(V, facet_tags, LEFT)]
+        return fix(V, facet_tags, LEFT)
 
     def load(self, v, ds, t):
         return t * self.p.body_force * v[0] * ufl.dx

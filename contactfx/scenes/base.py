@@ -18,8 +18,12 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.contact.augmented_lagrangian import (
+    AugmentedLagrangianSSN,
+    AugmentedLagrangianUzawa,
+)
 from contactfx.contact.gap import ContactSurface
-from contactfx.contact.laws import active
+from contactfx.contact.laws import active, friction_law, norm, positive_part
 from contactfx.contact.nitsche import Nitsche
 from contactfx.contact.obstacles import Obstacle
 from contactfx.contact.penalty import Penalty
@@ -28,15 +32,25 @@ from contactfx.io.xdmf import ResultsWriter
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.solvers.loadstep import StepRecord, run_load_program
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
+from contactfx.solvers.uzawa import Uzawa
 
 __all__ = ["param", "SceneParams", "Numerics", "Scene", "RunResult", "METHODS"]
 
-METHODS = ("nitsche", "penalty", "vi")
+METHODS = ("nitsche", "penalty", "vi", "al-uzawa", "al-ssn")
+FRICTION_LAWS = ("none", "tresca", "coulomb")
 
 
-def param(default: Any, help: str, *, positive: bool = False, choices: tuple | None = None):
+def param(
+    default: Any,
+    help: str,
+    *,
+    positive: bool = False,
+    nonnegative: bool = False,
+    choices: tuple | None = None,
+):
     """A scene / numerics parameter with its help text and validation rule."""
-    return field(default=default, metadata={"help": help, "positive": positive, "choices": choices})
+    meta = {"help": help, "positive": positive, "nonnegative": nonnegative, "choices": choices}
+    return field(default=default, metadata=meta)
 
 
 def validate(obj) -> None:
@@ -46,6 +60,8 @@ def validate(obj) -> None:
         name = f.name.replace("_", "-")
         if f.metadata.get("positive") and not value > 0:
             raise ValueError(f"--{name} must be > 0, got {value}")
+        if f.metadata.get("nonnegative") and not value >= 0:
+            raise ValueError(f"--{name} must be >= 0, got {value}")
         choices = f.metadata.get("choices")
         if choices is not None and value not in choices:
             allowed = ", ".join(str(c) for c in choices)
@@ -63,25 +79,55 @@ class SceneParams:
 
 @dataclass(frozen=True)
 class Numerics:
-    """How the contact problem is discretised and solved (shared by all scenes)."""
+    """How the contact problem is discretised and solved, and the friction law (shared by all
+    scenes)."""
 
     method: str = param("nitsche", "enforcement method", choices=METHODS)
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
     gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
     penalty: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True)
+    r0: float = param(10.0, "augmented Lagrangian augmentation, r = r0 E / h", positive=True)
+    ncp: str = param("min", "al-ssn complementarity function: min (Alart-Curnier) or fb "
+                     "(Fischer-Burmeister)", choices=("min", "fb"))  # fmt: skip
+    al_tol: float = param(1e-8, "al-uzawa stop: max nodal multiplier change / max multiplier",
+                          positive=True)  # fmt: skip
+    al_max_it: int = param(100, "al-uzawa maximal outer iterations", positive=True)
+    friction: str = param("none", "friction law", choices=FRICTION_LAWS)
+    mu: float = param(0.0, "Coulomb friction coefficient", nonnegative=True)
+    threshold: float = param(0.0, "Tresca friction threshold (stress)", nonnegative=True)
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
 
     def __post_init__(self) -> None:
         validate(self)
+        if self.friction != "none" and self.method == "vi":
+            raise ValueError(
+                f"friction law '{self.friction}' is not supported by method 'vi' (bound "
+                "constraints are frictionless); use nitsche, penalty, al-uzawa or al-ssn"
+            )
+        if self.mu > 0.0 and self.friction != "coulomb":
+            raise ValueError(f"--mu needs --friction coulomb (got --friction {self.friction})")
+        if self.threshold > 0.0 and self.friction != "tresca":
+            raise ValueError(
+                f"--threshold needs --friction tresca (got --friction {self.friction})"
+            )
+        if self.method == "al-ssn" and self.solver != "lu":
+            raise ValueError("method al-ssn is a saddle-point system: use --solver lu")
 
     def method_object(self):
         if self.method == "nitsche":
             return Nitsche(theta=self.theta, gamma0=self.gamma0)
         if self.method == "penalty":
             return Penalty(kappa0=self.penalty)
+        if self.method == "al-uzawa":
+            return AugmentedLagrangianUzawa(r0=self.r0)
+        if self.method == "al-ssn":
+            return AugmentedLagrangianSSN(r0=self.r0, ncp=self.ncp)
         return None
+
+    def friction_law(self):
+        return friction_law(self.friction, mu=self.mu, threshold=self.threshold)
 
 
 @dataclass
@@ -155,6 +201,14 @@ class Scene:
     def initial_guess(self, u, t: float) -> None:
         """Set a starting state before the first load step (default: zero)."""
 
+    #: multiplicity of the modelled part for each tangential force component
+    tangential_symmetry: ClassVar[tuple] = (1.0, 1.0, 1.0)
+
+    def friction_scores(self, x, p, t, status, summary) -> dict[str, float]:
+        """Scene-specific friction scores from the contact nodes' coordinates x, pressure p,
+        tangential traction t and status (0 open, 1 stick, 2 slip); reduced with MAX."""
+        return {}
+
     # -- driver ------------------------------------------------------------------------
     def run(
         self,
@@ -185,6 +239,8 @@ class _Run:
         scene, num, comm = self.scene, self.num, self.comm
         material = scene.material()
         obstacle = scene.obstacle()
+        method = num.method_object()
+        friction = num.friction_law()
         if self.out is not None:
             _prepare_output(self.out, comm)
 
@@ -192,24 +248,68 @@ class _Run:
         mesh, facet_tags = scene.build_mesh(comm)
         self.timings["mesh"] = time.perf_counter() - t0
         gdim = mesh.geometry.dim
+        fdim = mesh.topology.dim - 1
+        contact_facets = facet_tags.indices[facet_tags.values == scene.contact_tag]
 
-        V = _compat.function_space(mesh, "Lagrange", num.degree, (gdim,))
-        u = dolfinx.fem.Function(V, name="displacement")
-        du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        # unknowns: the displacement, or (displacement, multiplier) for al-ssn
+        mixed = method is not None and method.mixed
+        mult_shape = (gdim,) if friction is not None else ()
+        lam = lam_test = None
+        if mixed:
+            W = _compat.mixed_space(mesh, num.degree, gdim, mult_shape)
+            V = W.sub(0)
+            V_out, out_map = V.collapse()
+            state = dolfinx.fem.Function(W, name="state")
+            displacement = dolfinx.fem.Function(V_out, name="displacement")
+            trial, test = ufl.TrialFunction(W), ufl.TestFunction(W)
+            u, lam = ufl.split(state)
+            du, v = ufl.split(trial)[0], ufl.split(test)[0]
+            lam_test = ufl.split(test)[1]
+        else:
+            V = _compat.function_space(mesh, "Lagrange", num.degree, (gdim,))
+            state = displacement = u = dolfinx.fem.Function(V, name="displacement")
+            trial, test = ufl.TrialFunction(V), ufl.TestFunction(V)
+            du, v = trial, test
         bcs = scene.dirichlet(V, facet_tags)
+        if mixed:
+            bcs += _multiplier_bc(W, fdim, contact_facets, mult_shape)
+
         qdeg = 2 * num.degree + 2
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
         dsc = ds(scene.contact_tag, metadata={"quadrature_degree": qdeg})
         dsc_fine = ds(scene.contact_tag, metadata={"quadrature_degree": 12})
+        ds_nodal = ds(scene.contact_tag, metadata=_vertex_rule(fdim)) if mixed else None
         offset = dolfinx.fem.Constant(mesh, np.zeros(gdim))
         tload = dolfinx.fem.Constant(mesh, 0.0)
         h = _compat.cell_diameter(mesh)
-        surface = ContactSurface(u, v, dsc, obstacle, offset, material.sigma, material.E, h)
-        method = num.method_object()
+
+        prev = offset_prev = None  # last converged state, for the slip increment
+        if friction is not None:
+            prev = dolfinx.fem.Function(state.function_space)
+            offset_prev = dolfinx.fem.Constant(mesh, np.zeros(gdim))
+        multiplier = None
+        if method is not None and method.name == "al-uzawa":
+            shape = mult_shape if mult_shape else None
+            multiplier = dolfinx.fem.Function(
+                _compat.function_space(mesh, "Lagrange", 1, shape), name="multiplier"
+            )
+            lam = multiplier
+        surface = ContactSurface(
+            u, v, dsc, obstacle, offset, material.sigma, material.E, h,
+            friction=friction,
+            u_prev=None if prev is None else (ufl.split(prev)[0] if mixed else prev),
+            offset_prev=offset_prev, ds_nodal=ds_nodal, multiplier=lam, multiplier_test=lam_test,
+        )  # fmt: skip
 
         t0 = time.perf_counter()
-        eps = ufl.sym(ufl.grad(v))
-        a_form = dolfinx.fem.form(ufl.inner(material.sigma(du), eps) * ufl.dx)
+        a_ufl = ufl.inner(material.sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx
+        if mixed:  # a zero coupling of every component in every cell: the Jacobian's pattern
+            zero = dolfinx.fem.Constant(mesh, 0.0)
+            n_comp = ufl.shape(trial)[0]
+            a_ufl += zero * sum(trial[i] for i in range(n_comp)) * sum(
+                test[i] for i in range(n_comp)
+            ) * ufl.dx
+        a_form = dolfinx.fem.form(a_ufl)
         L = scene.load(v, ds, tload)
         if L is None:
             L = ufl.inner(dolfinx.fem.Constant(mesh, np.zeros(gdim)), v) * ufl.dx
@@ -218,8 +318,11 @@ class _Run:
         if method is not None:
             Fc_ufl = method.residual(surface)
             F_c = dolfinx.fem.form(Fc_ufl)
-            J_c = dolfinx.fem.form(ufl.derivative(Fc_ufl, u, du))
-        post = _PostProcessor(scene, num, surface, method, dsc, dsc_fine, material)
+            J_c = dolfinx.fem.form(ufl.derivative(Fc_ufl, state, trial))
+        post = _PostProcessor(mesh, scene, num, surface, method, dsc, dsc_fine, material)
+        update = None
+        if multiplier is not None:
+            update = _compat.expression(method.update(surface), multiplier.function_space)
         self.timings["compile"] = time.perf_counter() - t0
 
         options = dict(GAMG_OPTIONS) if num.solver == "gamg" else {}
@@ -227,7 +330,7 @@ class _Run:
             options["snes_type"] = "vinewtonrsls"
         prefix = f"contactfx_{scene.name.replace('-', '_')}_"
         solver = ContactSNES(
-            u,
+            state,
             stiffness=a_form,
             load=L_form,
             contact_residual=F_c,
@@ -238,6 +341,11 @@ class _Run:
             user_options=self.petsc_options,
             near_nullspace=num.solver == "gamg",
         )
+        if multiplier is not None:
+            mask = _boundary_mask(multiplier.function_space, fdim, contact_facets)
+            solver = Uzawa(
+                solver, multiplier, update, mask, tol=num.al_tol, max_it=num.al_max_it
+            )
         bounds = _VIBounds(V, facet_tags, scene, obstacle) if num.method == "vi" else None
 
         def apply_load(t: float) -> None:
@@ -247,34 +355,53 @@ class _Run:
                 bounds.update(offset.value)
                 solver.set_bounds(bounds.lower, bounds.upper)
 
-        scene.initial_guess(u, 1.0 / num.steps)
+        scene.initial_guess(state.sub(0) if mixed else state, 1.0 / num.steps)
         steps_log: list[dict] = []
         xdmf_path = None if self.out is None else self.out / f"{scene.name}.xdmf"
+        last: dict[str, Any] = {}
 
         def on_step(rec: StepRecord) -> None:
             summary = post.evaluate(solver)
+            last.clear()
+            last.update(summary)
+            if friction is not None:
+                post.accumulate_slip()
             entry = {
                 "step": rec.step,
                 "load": rec.load,
                 "newton": rec.stats.newton,
                 "ksp": rec.stats.ksp,
+                "outer": rec.stats.outer,
                 "cutbacks": rec.cutbacks,
                 "reason": rec.stats.reason,
                 "force": summary["force"],
                 "contact_half_width": summary["a"],
             }
+            if friction is not None:
+                entry["tangential_force"] = summary["tangential_force"]
+                entry["stick_size"] = summary["stick_size"]
             steps_log.append(entry)
             if writer is not None:
                 t_out = time.perf_counter()
-                writer.write(rec.load, post.fields(u))
+                if mixed:
+                    displacement.x.array[:] = state.x.array[out_map]
+                writer.write(rec.load, post.fields(displacement))
                 self.timings["output"] = self.timings.get("output", 0.0) + (
                     time.perf_counter() - t_out
                 )
+            if friction is not None:  # this step is the history of the next one
+                prev.x.array[:] = state.x.array
+                offset_prev.value[:] = offset.value
+            outer = f"  outer {rec.stats.outer:3d}" if multiplier is not None else ""
+            tangential = ""
+            if friction is not None:
+                tangential = f"  Q {summary['tangential_force'][0]:.6g}"
             _say(
                 comm,
                 self.verbose,
-                f"  step {rec.step:3d}  load {rec.load:6.3f}  newton {rec.stats.newton:3d}  "
-                f"ksp {rec.stats.ksp:4d}  force {summary['force']:.6g}  a {summary['a']:.6g}",
+                f"  step {rec.step:3d}  load {rec.load:6.3f}  newton {rec.stats.newton:3d}{outer}"
+                f"  ksp {rec.stats.ksp:4d}  force {summary['force']:.6g}  a {summary['a']:.6g}"
+                f"{tangential}",
             )
 
         writer = None
@@ -295,8 +422,10 @@ class _Run:
             if bounds is not None:
                 bounds.destroy()
 
-        summary = post.evaluate(solver)
+        summary = last
         dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        if mixed:
+            dofs = state.function_space.dofmap.index_map.size_global
         data: dict[str, Any] = {
             "status": "completed",
             "scene": scene.name,
@@ -311,6 +440,7 @@ class _Run:
             "h_contact": scene.h_contact(),
             "newton_iterations": sum(r.stats.newton for r in records),
             "ksp_iterations": sum(r.stats.ksp for r in records),
+            "outer_iterations": sum(r.stats.outer for r in records),
             "steps": steps_log,
             "timings": dict(self.timings),
             "force": summary["force"],
@@ -319,13 +449,60 @@ class _Run:
             "max_penetration": summary["penetration"],
             "xdmf": None if xdmf_path is None else str(xdmf_path),
         }
+        if friction is not None:
+            for key in ("tangential_force", "stick_size", "slip_fraction", "friction_excess"):
+                data[key] = summary[key]
         data["reference"] = post.reference_errors(summary)
-        data["scores"] = post.scores(summary["force"])
+        data["scores"] = post.scores(summary)
         data["errors"] = post.field_errors()
         solver.destroy()
         if self.out is not None:
             write_json(self.out / "run.json", data, comm)
         return RunResult(data)
+
+
+def _vertex_rule(fdim: int) -> dict:
+    """Quadrature at the facet's vertices (trapezoidal rule): nodal collocation of the
+    multiplier equations, exact nodal complementarity."""
+    if fdim == 0:
+        points, weights = ((),), (1.0,)
+    elif fdim == 1:
+        points, weights = ((0.0,), (1.0,)), (0.5, 0.5)
+    else:
+        points, weights = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), (1.0 / 6.0,) * 3
+    return {
+        "quadrature_rule": "custom",
+        "quadrature_degree": 1,
+        "quadrature_points": points,
+        "quadrature_weights": weights,
+    }
+
+
+def _boundary_mask(Q, fdim: int, facets: np.ndarray) -> np.ndarray:
+    """Bool per local (owned + ghost) dof block of Q: on one of the facets on any rank."""
+    marker = dolfinx.fem.Function(Q)
+    dofs = _compat.locate_dofs_topological(Q, fdim, facets)
+    bs = Q.dofmap.index_map_bs
+    marker.x.array.reshape(-1, bs)[dofs] = 1.0
+    vec = _compat.petsc_vec(marker)
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    return marker.x.array.reshape(-1, bs)[:, 0] > 0.0
+
+
+def _multiplier_bc(W, fdim: int, facets: np.ndarray, shape: tuple):
+    """The multiplier is zero away from the contact boundary: its other dofs are fixed."""
+    Wl = W.sub(1)
+    Q, q_to_w = Wl.collapse()
+    on = _boundary_mask(Q, fdim, facets)
+    bs = Q.dofmap.index_map_bs
+    q_to_w = np.asarray(q_to_w).reshape(-1, bs)
+    if not shape:
+        return [_compat.dirichletbc(np.float64(0.0), q_to_w[~on, 0].astype(np.int32), Wl)]
+    return [
+        _compat.dirichletbc(np.float64(0.0), q_to_w[~on, i].astype(np.int32), Wl.sub(i))
+        for i in range(bs)
+    ]
 
 
 def _prepare_output(out: Path, comm) -> None:
@@ -383,15 +560,18 @@ class _VIBounds:
 
 
 class _PostProcessor:
-    """Contact force, pressure, contact size, penetration and field errors, compiled once."""
+    """Contact force, pressure, contact size, penetration, friction quantities and field
+    errors, compiled once."""
 
-    def __init__(self, scene, num, surface: ContactSurface, method, dsc, dsc_fine, material):
+    def __init__(self, mesh, scene, num, surface: ContactSurface, method, dsc, dsc_fine,
+                 material):  # fmt: skip
         self.scene, self.num, self.surface, self.method = scene, num, surface, method
-        mesh = surface.u.function_space.mesh
         self.mesh = mesh
         gdim = mesh.geometry.dim
         self.gdim = gdim
         u = surface.u
+        friction = surface.friction
+        self.friction = friction
         Q1 = _compat.function_space(mesh, "Lagrange", 1)
         self.Q1 = Q1
         q = ufl.TestFunction(Q1)
@@ -408,13 +588,31 @@ class _PostProcessor:
             p = method.pressure(surface)
             self.force_form = dolfinx.fem.form(p * n[gdim - 1] * dsc)
             self.p_form = dolfinx.fem.form(p * q * dsc)
-            self.measure_form = dolfinx.fem.form(active(p) * dsc_fine)
+            closed = getattr(method, "contact_indicator", method.pressure)(surface)
+            self.measure_form = dolfinx.fem.form(active(closed) * dsc_fine)
         else:
             Qk = _compat.function_space(mesh, "Lagrange", num.degree)
             self.Qk = Qk
             self.massk = _assemble_vec(dolfinx.fem.form(ufl.TestFunction(Qk) * dsc))
             self.pk = dolfinx.fem.Function(Qk)
             self.measure_form = dolfinx.fem.form(self.status * dsc)
+        if friction is not None:
+            V1 = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
+            qv = ufl.TestFunction(V1)
+            t_T = method.tangential_traction(surface)
+            bound = friction.bound(p)
+            slipping = method.slip_indicator(surface)
+            self.traction = dolfinx.fem.Function(V1, name="tangential_traction")
+            self.slip = dolfinx.fem.Function(V1, name="slip")
+            self._increment = dolfinx.fem.Function(V1)
+            self._slipping = dolfinx.fem.Function(Q1)
+            self.increment_expr = _compat.expression(surface.slip_increment(n), V1)
+            self.t_form = dolfinx.fem.form(ufl.dot(t_T, qv) * dsc)
+            self.slip_form = dolfinx.fem.form(slipping * q * dsc)
+            self.tforce_forms = [dolfinx.fem.form(t_T[i] * dsc) for i in range(gdim)]
+            self.excess_form = dolfinx.fem.form(positive_part(norm(t_T, material.E) - bound) * dsc)
+            self.bound_form = dolfinx.fem.form(bound * dsc)
+            self.stick_form = dolfinx.fem.form(active(p) * (1.0 - slipping) * dsc_fine)
         self.exact = scene.exact_displacement(ufl.SpatialCoordinate(mesh))
         if self.exact is not None:
             e = u - self.exact
@@ -431,36 +629,67 @@ class _PostProcessor:
     def _sum(self, form) -> float:
         return self.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
 
-    def evaluate(self, solver: ContactSNES) -> dict[str, float]:
-        pv = _compat.petsc_vec(self.pressure)
+    def _lumped(self, form, target, mass: np.ndarray) -> None:
+        """target = (int f q ds) / (int q ds) at the contact boundary's nodes, 0 elsewhere."""
+        b = _assemble_vec(form)
+        bs = target.function_space.dofmap.index_map_bs
+        vec = _compat.petsc_vec(target)
+        arr = vec.getArray().reshape(-1, bs)
+        on = mass > 0.0
+        arr[:] = 0.0
+        arr[on] = b.getArray().reshape(-1, bs)[on] / mass[on, None]
+        b.destroy()
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def evaluate(self, solver) -> dict[str, Any]:
         m = self.mass1.getArray()
         on_surface = m > 0.0
         if self.method is not None:
             force = self._sum(self.force_form)
-            b = _assemble_vec(self.p_form)
-            arr = pv.getArray()
-            arr[:] = 0.0
-            arr[on_surface] = b.getArray()[on_surface] / m[on_surface]
-            b.destroy()
+            self._lumped(self.p_form, self.pressure, m)
         else:
             force = self._vi_pressure(solver)
-        pv.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         p_local = self.pressure.x.array
         p_max = self.mesh.comm.allreduce(float(p_local.max(initial=0.0)), op=MPI.MAX)
         st = self.status.x.array
-        st[:] = (p_local > 1e-10 * max(p_max, 1e-300)).astype(float)
+        st[:] = (p_local > 1e-10 * max(p_max, 1e-300)).astype(float)  # 0 open, 1 closed (stick)
         self.gap.interpolate(self.gap_expr)
         gap_surface = self.gap.x.array[: len(m)][on_surface]
         penetration = self.mesh.comm.allreduce(
             float(max(-gap_surface.min(initial=0.0), 0.0)), op=MPI.MAX
         )
         measure = self._sum(self.measure_form) * self.scene.symmetry
-        return {
+        out: dict[str, Any] = {
             "force": force * self.scene.symmetry,
             "a": self.scene.contact_size(measure),
             "p0": p_max,
             "penetration": penetration,
         }
+        if self.friction is not None:
+            self._lumped(self.t_form, self.traction, m)
+            self._lumped(self.slip_form, self._slipping, m)
+            st[:] += (st > 0.0) & (self._slipping.x.array > 0.5)  # 2 where slipping
+            bound = self._sum(self.bound_form)
+            excess = self._sum(self.excess_form)
+            stick = self._sum(self.stick_form) * self.scene.symmetry
+            out["tangential_force"] = [
+                self._sum(f) * self.scene.tangential_symmetry[i]
+                for i, f in enumerate(self.tforce_forms)
+            ]
+            out["stick_size"] = self.scene.contact_size(stick)
+            out["slip_fraction"] = 1.0 - stick / measure if measure > 0.0 else 0.0
+            out["friction_excess"] = excess / bound if bound > 0.0 else excess
+        return out
+
+    def accumulate_slip(self) -> None:
+        """slip += tangential slip increment of this step, on the contact boundary's nodes."""
+        self._increment.interpolate(self.increment_expr)
+        m = self.mass1.getArray()
+        vec = _compat.petsc_vec(self.slip)
+        arr = vec.getArray().reshape(-1, self.gdim)
+        inc = self._increment.x.array[: arr.size].reshape(-1, self.gdim)
+        arr[m > 0.0] += inc[m > 0.0]
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     def _vi_pressure(self, solver: ContactSNES) -> float:
         """Nodal contact pressure from the reaction K u - b at the constrained dofs."""
@@ -482,17 +711,24 @@ class _PostProcessor:
         self.pressure.interpolate(self.pk)
         return force
 
-    def scores(self, force: float) -> dict[str, float]:
+    def scores(self, summary: dict) -> dict[str, float]:
         m = self.mass1.getArray()
         on = m > 0.0
         x = _compat.dof_coordinates(self.Q1)[: len(m)][on]
         p = self.pressure.x.array[: len(m)][on]
-        local = self.scene.pressure_scores(x, p, force)
+        local = self.scene.pressure_scores(x, p, summary["force"])
+        if self.friction is not None:
+            t = self.traction.x.array[: len(m) * self.gdim].reshape(-1, self.gdim)[on]
+            status = self.status.x.array[: len(m)][on]
+            local.update(self.scene.friction_scores(x, p, t, status, summary))
         return {k: self.mesh.comm.allreduce(v, op=MPI.MAX) for k, v in local.items()}
 
     def fields(self, u) -> list:
         self.vm.interpolate(self.vm_expr)
-        return [u, self.vm, self.pressure, self.gap, self.status]
+        out = [u, self.vm, self.pressure, self.gap, self.status]
+        if self.friction is not None:
+            out += [self.traction, self.slip]
+        return out
 
     def reference_errors(self, summary: dict) -> dict[str, float]:
         ref = self.scene.reference(summary["force"])

@@ -57,7 +57,7 @@ class FlatPunch2D(Scene):
         return np.array([0.0, -t * self.p.depth])
 
     def dirichlet(self, V, facet_tags):
-        return [fix(V, facet_tags, RectangleFacets.BOTTOM)]
+        return fix(V, facet_tags, RectangleFacets.BOTTOM)
 
     def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
         """max |pi sqrt(a^2 - x^2) p_h / P - 1| over surface nodes with |x| <= 0.8 a."""

@@ -74,7 +74,7 @@ class Hertz2D(Scene):
         return np.array([0.0, -t * self.p.depth])
 
     def dirichlet(self, V, facet_tags):
-        return [fix(V, facet_tags, RectangleFacets.BOTTOM)]
+        return fix(V, facet_tags, RectangleFacets.BOTTOM)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.p.radius, self.material().E_star)
@@ -118,7 +118,7 @@ class QuarterBlock(Scene):
 
     def dirichlet(self, V, facet_tags):
         return [
-            fix(V, facet_tags, BoxFacets.ZMIN),
+            *fix(V, facet_tags, BoxFacets.ZMIN),
             fix_component(V, facet_tags, BoxFacets.XMIN, 0),
             fix_component(V, facet_tags, BoxFacets.YMIN, 1),
         ]

@@ -85,6 +85,7 @@ class SolveStats:
     assembly: float = 0.0
     solve: float = 0.0
     reason: str = ""
+    outer: int = 1  # augmented Lagrangian (Uzawa) outer iterations
 
 
 @dataclass

@@ -1,0 +1,155 @@
+"""Augmented Lagrangian enforcement: Uzawa (outer multiplier loop) and monolithic semi-smooth
+Newton on displacement and multiplier.
+
+The multiplier lambda is the contact traction on the body: a scalar pressure lambda_n >= 0
+without friction, a vector t = -lambda_n n + lambda_T with friction. With the augmentation
+r = r0 E / h, the augmented pressure and tangential traction are
+
+    p = [lambda_n - r g(u)]_+,    T = proj_{B(0, s(p))}(lambda_T - r du_T(u))
+
+(Alart & Curnier 1991, doi:10.1016/0045-7825(91)90022-X; Simo & Laursen 1992,
+doi:10.1016/0045-7949(92)90540-G). The Signorini and friction laws hold exactly when
+lambda_n = p and lambda_T = T.
+
+* ``AugmentedLagrangianUzawa``: for fixed lambda solve a(u, v) - L(v) + int (p v.n - T.v) = 0
+  by Newton, then set lambda <- (p, T) at the nodes; repeat until the nodal multiplier stops
+  changing. The converged state satisfies the laws at the nodes exactly (no O(1/r)
+  penetration), whatever r; r only sets the speed of the outer loop.
+* ``AugmentedLagrangianSSN``: lambda is a P1 field of a mixed space, solved together with u.
+  u-equation a(u, v) - L(v) - int t(lambda) . v = 0; the multiplier equations are the
+  complementarity functions collocated at the nodes (trapezoidal / vertex quadrature):
+  C_n = lambda_n - p (``min``, Alart-Curnier: = min(lambda_n, r g)) or the Fischer-Burmeister
+  function of (lambda_n, r g) (``fb``), and C_T = lambda_T - T (Alart-Curnier) with friction.
+  The multiplier's dofs away from the contact boundary are fixed to zero (a trace space on
+  dolfinx versions without mixed-dimensional assembly; Hueeber & Wohlmuth 2005,
+  doi:10.1016/j.cma.2004.09.012 for the semi-smooth Newton view of these equations).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+from contactfx.contact.gap import ContactSurface, tangential
+from contactfx.contact.laws import (
+    active,
+    ball_projection,
+    fischer_burmeister,
+    norm,
+    positive_part,
+)
+
+__all__ = ["AugmentedLagrangianUzawa", "AugmentedLagrangianSSN", "split_multiplier"]
+
+
+def split_multiplier(lam, n):
+    """(lambda_n, lambda_T) of a scalar pressure or a traction vector t = -lambda_n n + lambda_T
+    (lambda_T is None for a scalar multiplier)."""
+    if ufl.shape(lam) == ():
+        return lam, None
+    return -ufl.dot(lam, n), tangential(lam, n)
+
+
+@dataclass(frozen=True)
+class _AugmentedBase:
+    r0: float = 10.0
+
+    def __post_init__(self) -> None:
+        if not self.r0 > 0.0:
+            raise ValueError(f"augmentation r0 must be > 0, got {self.r0}")
+
+    def r(self, s: ContactSurface):
+        return self.r0 * s.E / s.h
+
+    def _augmented(self, s: ContactSurface, lam):
+        """(p, T trial, T) from the multiplier lam; T and its trial are None without friction."""
+        n = s.normal()
+        lam_n, lam_t = split_multiplier(lam, n)
+        p = positive_part(lam_n - self.r(s) * s.gap())
+        if s.friction is None:
+            return p, None, None
+        trial = lam_t - self.r(s) * s.slip_increment(n)
+        return p, trial, ball_projection(trial, s.friction.bound(p), s.E)
+
+    def _slip(self, s: ContactSurface, lam):
+        p, trial, _ = self._augmented(s, lam)
+        return active(p) * active(norm(trial, s.E) - s.friction.bound(p))
+
+
+@dataclass(frozen=True)
+class AugmentedLagrangianUzawa(_AugmentedBase):
+    """r0 > 0 (r = r0 E / h). ``s.multiplier`` is the nodal multiplier Function (scalar P1
+    without friction, vector P1 with); the outer loop is :class:`contactfx.solvers.uzawa.Uzawa`."""
+
+    name = "al-uzawa"
+    mixed = False
+
+    def pressure(self, s: ContactSurface):
+        return self._augmented(s, s.multiplier)[0]
+
+    def tangential_traction(self, s: ContactSurface):
+        return self._augmented(s, s.multiplier)[2]
+
+    def slip_indicator(self, s: ContactSurface):
+        return self._slip(s, s.multiplier)
+
+    def update(self, s: ContactSurface):
+        """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
+        p, _, t_T = self._augmented(s, s.multiplier)
+        if t_T is None:
+            return p
+        return -p * s.normal() + t_T
+
+    def residual(self, s: ContactSurface):
+        p, _, t_T = self._augmented(s, s.multiplier)
+        form = p * ufl.dot(s.v, s.normal()) * s.ds
+        if t_T is not None:
+            form -= ufl.dot(t_T, s.v) * s.ds
+        return form
+
+
+@dataclass(frozen=True)
+class AugmentedLagrangianSSN(_AugmentedBase):
+    """r0 > 0; ncp 'min' (Alart-Curnier) or 'fb' (Fischer-Burmeister) for the normal law.
+    ``s.multiplier`` / ``s.multiplier_test`` are the multiplier component of the mixed unknown
+    and its test function; ``s.ds_nodal`` is the vertex-quadrature contact measure."""
+
+    ncp: str = "min"
+    name = "al-ssn"
+    mixed = True
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.ncp not in ("min", "fb"):
+            raise ValueError(f"ncp must be 'min' or 'fb', got {self.ncp}")
+
+    def pressure(self, s: ContactSurface):
+        return split_multiplier(s.multiplier, s.normal())[0]
+
+    def tangential_traction(self, s: ContactSurface):
+        return split_multiplier(s.multiplier, s.normal())[1]
+
+    def contact_indicator(self, s: ContactSurface):
+        """[lambda_n - r g]_+: > 0 exactly where the surfaces are closed (between the nodes
+        too; lambda_n itself only vanishes up to the solver tolerance where open)."""
+        return self._augmented(s, s.multiplier)[0]
+
+    def slip_indicator(self, s: ContactSurface):
+        return self._slip(s, s.multiplier)
+
+    def residual(self, s: ContactSurface):
+        n = s.normal()
+        lam, mu = s.multiplier, s.multiplier_test
+        lam_n, lam_t = split_multiplier(lam, n)
+        r = self.r(s)
+        p, _, t_T = self._augmented(s, lam)
+        if self.ncp == "min":
+            c_n = lam_n - p
+        else:
+            c_n = fischer_burmeister(lam_n, r * s.gap(), s.E)
+        if lam_t is None:  # scalar pressure multiplier
+            return lam * ufl.dot(s.v, n) * s.ds + c_n / r * mu * s.ds_nodal
+        # traction multiplier t = lam: -int t . v, and C(lam, u) = -c_n n + (lam_T - T) = 0
+        c = -c_n * n + lam_t - t_T
+        return -ufl.dot(lam, s.v) * s.ds + ufl.dot(c, mu) / r * s.ds_nodal

@@ -1,0 +1,82 @@
+"""Uzawa's outer loop for the augmented Lagrangian: Newton solves for fixed multipliers, then
+the nodal multiplier update, until the update stops changing the multiplier."""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+
+from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats
+
+__all__ = ["Uzawa"]
+
+
+class Uzawa:
+    """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
+
+    ``update`` is a compiled expression of the multiplier's next value, interpolated into the
+    multiplier's space; ``mask`` (bool per local dof of that space) selects the contact
+    boundary's nodes, elsewhere the multiplier is kept at zero. The loop stops when
+    max |lambda_{k+1} - lambda_k| <= tol max |lambda_{k+1}| over the contact nodes: the nodal
+    constraint violation and complementarity residual are then below tol max |lambda| / r.
+    On failure (inner divergence or ``max_it`` outer iterations) the multiplier of the last
+    converged load step is restored and ``ConvergenceError`` raised, so load cut-back works.
+    """
+
+    def __init__(self, inner: ContactSNES, multiplier, update, mask: np.ndarray, *, tol: float,
+                 max_it: int) -> None:  # fmt: skip
+        self.inner = inner
+        self.u = inner.u
+        self.timer = inner.timer
+        self.K, self.b = inner.K, inner.b
+        self.multiplier = multiplier
+        self.update = update
+        self.mask = mask
+        self.tol = tol
+        self.max_it = max_it
+        self._next = multiplier.copy()
+        self.comm = inner.comm
+
+    def assemble_load(self) -> None:
+        self.inner.assemble_load()
+
+    def _max(self, values: np.ndarray) -> float:
+        local = float(np.max(np.abs(values), initial=0.0))
+        return self.comm.allreduce(local, op=MPI.MAX)
+
+    def solve(self) -> SolveStats:
+        lam = self.multiplier.x.array
+        saved = lam.copy()
+        total = SolveStats()
+        imap = self.multiplier.function_space.dofmap.index_map
+        bs = self.multiplier.function_space.dofmap.index_map_bs
+        mask = np.repeat(self.mask, bs) if bs > 1 else self.mask.copy()
+        mask[imap.size_local * bs :] = False  # owned dofs decide; ghosts follow
+        for k in range(1, self.max_it + 1):
+            try:
+                stats = self.inner.solve()
+            except ConvergenceError as err:
+                lam[:] = saved
+                raise ConvergenceError(f"{err.reason} (Uzawa iteration {k})") from None
+            total.newton += stats.newton
+            total.ksp += stats.ksp
+            total.assembly += stats.assembly
+            total.solve += stats.solve
+            total.reason = stats.reason
+            self._next.interpolate(self.update)
+            new = np.where(mask, self._next.x.array, 0.0)
+            change = self._max((new - lam)[mask])
+            size = self._max(new[mask])
+            lam[:] = new
+            self.multiplier.x.scatter_forward()
+            if change <= self.tol * size or size == 0.0 and change == 0.0:
+                total.outer = k
+                return total
+        lam[:] = saved
+        raise ConvergenceError(
+            f"augmented Lagrangian (Uzawa) not converged in {self.max_it} iterations "
+            f"(multiplier change {change:.3e}, tolerance {self.tol:.1e} x {size:.3e})"
+        )
+
+    def destroy(self) -> None:
+        self.inner.destroy()
