@@ -142,6 +142,16 @@ def _table(data: dict) -> str:
         )  # fmt: skip
     else:
         rows.append(("peak pressure", f"{data['peak_pressure']:.6g}"))
+    if "tangential_force" in data:
+        q = data["tangential_force"][0]
+        rows.append(("tangential force Q / bound", f"{q:.6g} / {data['friction_bound']:.6g}"))
+        stick = f"{data['stick_size']:.6g}  (slip fraction {data['slip_fraction']:.1%})"
+        if "c" in ref:
+            stick += f", Cattaneo-Mindlin {ref['c']:.6g}"
+        rows.append(("stick zone half-width / radius", stick))
+        rows.append(("max friction excess", f"{data['friction_excess']:.2e}"))
+    if data.get("outer_iterations", 0) > len(data["steps"]):
+        rows.append(("Uzawa outer iterations", str(data["outer_iterations"])))
     for key, value in data.get("scores", {}).items():
         rows.append((key.replace("_", " "), f"{value:.4g}"))
     for key, value in data.get("errors", {}).items():

@@ -38,6 +38,19 @@ BAD = [
     (["run", "hertz2d", "--degree", "3"], "--degree must be one of 1, 2"),
     (["run", "hertz2d", "--out", "/proc/contactfx"], "is not writable"),
     (["frobnicate"], "unknown command 'frobnicate'"),
+    (["run", "sliding-block", "--mu", "-0.1"], "--mu must be >= 0"),
+    (
+        ["run", "sliding-block", "--friction", "tresca", "--mu", "0", "--threshold", "-1"],
+        "--threshold must be >= 0",
+    ),
+    (
+        ["run", "hertz2d", "--method", "vi", "--friction", "coulomb", "--mu", "0.3"],
+        "friction law 'coulomb' is not supported by method 'vi'",
+    ),
+    (["run", "hertz2d", "--mu", "0.3"], "--mu needs --friction coulomb"),
+    (["run", "sliding-block", "--method", "penalty"], "not supported by method 'penalty'"),
+    (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
+    (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),
 ]
 
 

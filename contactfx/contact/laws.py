@@ -65,6 +65,11 @@ class Friction:
     def bound(self, p):
         raise NotImplementedError
 
+    def bound_where(self, p, closed):
+        """The bound for the pressure p where ``closed`` > 0 marks the contact set (they
+        differ only for multiplier methods, whose pressure is not exactly 0 where open)."""
+        return self.bound(p)
+
 
 @dataclass(frozen=True)
 class Tresca(Friction):
@@ -80,6 +85,9 @@ class Tresca(Friction):
 
     def bound(self, p):
         return self.threshold * active(p)
+
+    def bound_where(self, p, closed):
+        return self.threshold * active(closed)
 
 
 @dataclass(frozen=True)

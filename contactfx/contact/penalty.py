@@ -1,10 +1,10 @@
-"""Penalty method for contact with a rigid obstacle, frictionless or with friction.
+"""Penalty method for frictionless contact with a rigid obstacle.
 
-p = kappa [-g(u)]_+ and t_T = proj_{B(0, s(p))}(-kappa du_T) with kappa = kappa0 E / h and
-du_T the slip increment; the residual adds int (p v.n - t_T . v) ds (Kikuchi & Oden 1988,
-doi:10.1137/1.9781611970845). The penetration and the elastic stick slip are
-O(p h / (kappa0 E)): the method is not consistent, the error falls as kappa0 grows (and the
-conditioning worsens).
+p = kappa [-g(u)]_+ with kappa = kappa0 E / h; the residual adds int p v.n ds (Kikuchi & Oden
+1988, doi:10.1137/1.9781611970845). The penetration is O(p h / (kappa0 E)): the method is not
+consistent, the error falls as kappa0 grows (and the conditioning worsens). Friction is not
+offered: a penalised stick needs the tangential traction of the last step as history
+(t_T = proj(t_T_prev - kappa du_T)), which this module does not store.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import ufl
 
 from contactfx.contact.gap import ContactSurface
-from contactfx.contact.laws import active, ball_projection, norm, positive_part
+from contactfx.contact.laws import positive_part
 
 __all__ = ["Penalty"]
 
@@ -37,18 +37,5 @@ class Penalty:
     def pressure(self, s: ContactSurface):
         return self.kappa(s) * positive_part(-s.gap())
 
-    def _trial_t(self, s: ContactSurface):
-        return -self.kappa(s) * s.slip_increment(s.normal())
-
-    def tangential_traction(self, s: ContactSurface):
-        return ball_projection(self._trial_t(s), s.friction.bound(self.pressure(s)), s.E)
-
-    def slip_indicator(self, s: ContactSurface):
-        p = self.pressure(s)
-        return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))
-
     def residual(self, s: ContactSurface):
-        form = self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds
-        if s.friction is not None:
-            form -= ufl.dot(self.tangential_traction(s), s.v) * s.ds
-        return form
+        return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

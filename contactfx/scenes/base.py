@@ -23,7 +23,7 @@ from contactfx.contact.augmented_lagrangian import (
     AugmentedLagrangianUzawa,
 )
 from contactfx.contact.gap import ContactSurface
-from contactfx.contact.laws import active, friction_law, norm, positive_part
+from contactfx.contact.laws import active, friction_law, positive_part
 from contactfx.contact.nitsche import Nitsche
 from contactfx.contact.obstacles import Obstacle
 from contactfx.contact.penalty import Penalty
@@ -105,6 +105,12 @@ class Numerics:
             raise ValueError(
                 f"friction law '{self.friction}' is not supported by method 'vi' (bound "
                 "constraints are frictionless); use nitsche, penalty, al-uzawa or al-ssn"
+            )
+        if self.friction != "none" and self.method == "penalty":
+            raise ValueError(
+                f"friction law '{self.friction}' is not supported by method 'penalty' (its "
+                "stick traction needs the tangential traction history); use nitsche, al-uzawa "
+                "or al-ssn"
             )
         if self.mu > 0.0 and self.friction != "coulomb":
             raise ValueError(f"--mu needs --friction coulomb (got --friction {self.friction})")
@@ -204,9 +210,19 @@ class Scene:
     #: multiplicity of the modelled part for each tangential force component
     tangential_symmetry: ClassVar[tuple] = (1.0, 1.0, 1.0)
 
-    def friction_scores(self, x, p, t, status, summary) -> dict[str, float]:
+    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
+        """Closed-form friction quantities (e.g. the stick size) at the computed forces."""
+        return {}
+
+    @classmethod
+    def default_numerics(cls, **overrides) -> Numerics:
+        """The scene's default numerics (what the command line starts from), overridden."""
+        return Numerics(**{**cls.numerics_defaults, **overrides})
+
+    def friction_scores(self, x, p, t, bound, status) -> dict[str, float]:
         """Scene-specific friction scores from the contact nodes' coordinates x, pressure p,
-        tangential traction t and status (0 open, 1 stick, 2 slip); reduced with MAX."""
+        tangential traction t, friction bound and status (0 open, 1 stick, 2 slip); local
+        maxima, reduced with MAX over ranks."""
         return {}
 
     # -- driver ------------------------------------------------------------------------
@@ -306,9 +322,12 @@ class _Run:
         if mixed:  # a zero coupling of every component in every cell: the Jacobian's pattern
             zero = dolfinx.fem.Constant(mesh, 0.0)
             n_comp = ufl.shape(trial)[0]
-            a_ufl += zero * sum(trial[i] for i in range(n_comp)) * sum(
-                test[i] for i in range(n_comp)
-            ) * ufl.dx
+            a_ufl += (
+                zero
+                * sum(trial[i] for i in range(n_comp))
+                * sum(test[i] for i in range(n_comp))
+                * ufl.dx
+            )
         a_form = dolfinx.fem.form(a_ufl)
         L = scene.load(v, ds, tload)
         if L is None:
@@ -343,9 +362,7 @@ class _Run:
         )
         if multiplier is not None:
             mask = _boundary_mask(multiplier.function_space, fdim, contact_facets)
-            solver = Uzawa(
-                solver, multiplier, update, mask, tol=num.al_tol, max_it=num.al_max_it
-            )
+            solver = Uzawa(solver, multiplier, update, mask, tol=num.al_tol, max_it=num.al_max_it)
         bounds = _VIBounds(V, facet_tags, scene, obstacle) if num.method == "vi" else None
 
         def apply_load(t: float) -> None:
@@ -450,9 +467,12 @@ class _Run:
             "xdmf": None if xdmf_path is None else str(xdmf_path),
         }
         if friction is not None:
-            for key in ("tangential_force", "stick_size", "slip_fraction", "friction_excess"):
+            for key in ("tangential_force", "friction_bound", "stick_size", "slip_fraction",
+                        "friction_excess"):  # fmt: skip
                 data[key] = summary[key]
         data["reference"] = post.reference_errors(summary)
+        if friction is not None:
+            data["reference"].update(scene.friction_reference(summary, friction))
         data["scores"] = post.scores(summary)
         data["errors"] = post.field_errors()
         solver.destroy()
@@ -600,7 +620,9 @@ class _PostProcessor:
             V1 = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
             qv = ufl.TestFunction(V1)
             t_T = method.tangential_traction(surface)
-            bound = friction.bound(p)
+            # the bound plus a zero that keeps the forms' arguments when mu = 0 or the
+            # threshold is 0 (UFL would simplify the bound away)
+            bound = friction.bound_where(p, closed) + dolfinx.fem.Constant(mesh, 0.0)
             slipping = method.slip_indicator(surface)
             self.traction = dolfinx.fem.Function(V1, name="tangential_traction")
             self.slip = dolfinx.fem.Function(V1, name="slip")
@@ -610,9 +632,12 @@ class _PostProcessor:
             self.t_form = dolfinx.fem.form(ufl.dot(t_T, qv) * dsc)
             self.slip_form = dolfinx.fem.form(slipping * q * dsc)
             self.tforce_forms = [dolfinx.fem.form(t_T[i] * dsc) for i in range(gdim)]
-            self.excess_form = dolfinx.fem.form(positive_part(norm(t_T, material.E) - bound) * dsc)
+            t_abs = ufl.sqrt(ufl.dot(t_T, t_T))
+            self.excess_form = dolfinx.fem.form(positive_part(t_abs - bound) * dsc)
             self.bound_form = dolfinx.fem.form(bound * dsc)
-            self.stick_form = dolfinx.fem.form(active(p) * (1.0 - slipping) * dsc_fine)
+            self.bound_nodal_form = dolfinx.fem.form(bound * q * dsc)
+            self._bound = dolfinx.fem.Function(Q1)
+            self.stick_form = dolfinx.fem.form(active(closed) * (1.0 - slipping) * dsc_fine)
         self.exact = scene.exact_displacement(ufl.SpatialCoordinate(mesh))
         if self.exact is not None:
             e = u - self.exact
@@ -679,6 +704,7 @@ class _PostProcessor:
             out["stick_size"] = self.scene.contact_size(stick)
             out["slip_fraction"] = 1.0 - stick / measure if measure > 0.0 else 0.0
             out["friction_excess"] = excess / bound if bound > 0.0 else excess
+            out["friction_bound"] = bound * self.scene.tangential_symmetry[0]
         return out
 
     def accumulate_slip(self) -> None:
@@ -720,7 +746,9 @@ class _PostProcessor:
         if self.friction is not None:
             t = self.traction.x.array[: len(m) * self.gdim].reshape(-1, self.gdim)[on]
             status = self.status.x.array[: len(m)][on]
-            local.update(self.scene.friction_scores(x, p, t, status, summary))
+            self._lumped(self.bound_nodal_form, self._bound, m)
+            bound = self._bound.x.array[: len(m)][on]
+            local.update(self.scene.friction_scores(x, p, t, bound, status))
         return {k: self.mesh.comm.allreduce(v, op=MPI.MAX) for k, v in local.items()}
 
     def fields(self, u) -> list:

@@ -34,6 +34,30 @@ def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
     return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
 
 
+def _indent_then_shift(t: float, depth: float, shift: float, gdim: int) -> np.ndarray:
+    """Indentation over the load factor t (all of it, or its first half when the indenter is
+    then shifted tangentially along x over the second half)."""
+    offset = np.zeros(gdim)
+    if shift > 0.0:
+        offset[0] = shift * max(0.0, 2.0 * t - 1.0)
+        t = min(2.0 * t, 1.0)
+    offset[gdim - 1] = -t * depth
+    return offset
+
+
+def _cattaneo_mindlin(summary: dict, a: float, exponent: float) -> dict[str, float]:
+    """Stick size c = a (1 - Q / (mu P))^exponent (2D: 1/2, 3D: 1/3) at the computed normal
+    force P and tangential force Q (Johnson 1985, section 7.1; approximate on a rigid-elastic
+    pair, Dundurs beta != 0). With Q the x component and the bound mu P = friction_bound."""
+    bound = summary.get("friction_bound", 0.0)
+    if bound <= 0.0:
+        return {}
+    ratio = abs(summary["tangential_force"][0]) / bound
+    c = a * max(0.0, 1.0 - ratio) ** exponent
+    return {"Q_over_bound": ratio, "c": c, "c_computed": summary["stick_size"],
+            "c_over_a_computed": summary["stick_size"] / a, "c_over_a": c / a}  # fmt: skip
+
+
 def _indenter(profile: str, radius: float) -> Obstacle:
     return Ball(radius) if profile == "circle" else Paraboloid(radius)
 
@@ -50,6 +74,8 @@ class Hertz2DParams(SceneParams):
     h_contact: float = param(3e-3, "element size in the contact zone", positive=True)
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
     refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
+    shift: float = param(0.0, "tangential displacement of the indenter after the indentation "
+                         "(needs friction)", nonnegative=True)  # fmt: skip
 
 
 class Hertz2D(Scene):
@@ -71,13 +97,17 @@ class Hertz2D(Scene):
         return _indenter(self.p.profile, self.p.radius)
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
-        return np.array([0.0, -t * self.p.depth])
+        return _indent_then_shift(t, self.p.depth, self.p.shift, gdim)
 
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, RectangleFacets.BOTTOM)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.p.radius, self.material().E_star)
+
+    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
+        ref = hertz_2d(summary["force"], self.p.radius, self.material().E_star)
+        return _cattaneo_mindlin(summary, ref["a"], exponent=0.5)
 
 
 @dataclass(frozen=True)
@@ -92,14 +122,25 @@ class Hertz3DParams(SceneParams):
     h_contact: float = param(0.02, "element size in the contact zone", positive=True)
     h_far: float = param(0.3, "element size far from the contact zone", positive=True)
     refine_radius: float = param(0.15, "radius of the refined zone", positive=True)
+    shift: float = param(0.0, "tangential displacement (x) of the indenter after the "
+                         "indentation (needs friction; half model)", nonnegative=True)  # fmt: skip
 
 
 class QuarterBlock(Scene):
     """A block [0, size]^2 x [-height, 0] with the symmetry planes x = 0 and y = 0 (quarter
-    model of an axisymmetric indentation), clamped at the bottom, contact on the top."""
+    model of an axisymmetric indentation), clamped at the bottom, contact on the top. With a
+    tangential shift along x the plane x = 0 is no symmetry plane: then the half model
+    [-size, size] x [0, size] x [-height, 0]."""
 
     contact_tag = BoxFacets.ZMAX
-    symmetry = 4.0
+
+    def __init__(self, params) -> None:
+        super().__init__(params)
+        self.shift = getattr(params, "shift", 0.0)
+        self.half = self.shift > 0.0
+        self.symmetry = 2.0 if self.half else 4.0
+        # the half model's mirror image doubles F_x and cancels F_y
+        self.tangential_symmetry = (2.0, 0.0, 2.0)
 
     def refine_radius(self) -> float:
         raise NotImplementedError
@@ -108,20 +149,20 @@ class QuarterBlock(Scene):
         p = self.p
         return gmsh_mesh(
             comm, box, 3, self.name,
-            x0=0.0, x1=p.size, y0=0.0, y1=p.size, z0=-p.height, z1=0.0,
+            x0=-p.size if self.half else 0.0, x1=p.size, y0=0.0, y1=p.size,
+            z0=-p.height, z1=0.0,
             refine_center=(0.0, 0.0), refine_radius=self.refine_radius(),
             h_contact=p.h_contact, h_far=p.h_far,
         )  # fmt: skip
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
-        return np.array([0.0, 0.0, -t * self.p.depth])
+        return _indent_then_shift(t, self.p.depth, self.shift, gdim)
 
     def dirichlet(self, V, facet_tags):
-        return [
-            *fix(V, facet_tags, BoxFacets.ZMIN),
-            fix_component(V, facet_tags, BoxFacets.XMIN, 0),
-            fix_component(V, facet_tags, BoxFacets.YMIN, 1),
-        ]
+        bcs = [*fix(V, facet_tags, BoxFacets.ZMIN), fix_component(V, facet_tags, BoxFacets.YMIN, 1)]
+        if not self.half:
+            bcs.append(fix_component(V, facet_tags, BoxFacets.XMIN, 0))
+        return bcs
 
     def contact_size(self, measure: float) -> float:
         return float(np.sqrt(measure / np.pi))
@@ -140,3 +181,7 @@ class Hertz3D(QuarterBlock):
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_3d(force, self.p.radius, self.material().E_star)
+
+    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
+        ref = hertz_3d(summary["force"], self.p.radius, self.material().E_star)
+        return _cattaneo_mindlin(summary, ref["a"], exponent=1.0 / 3.0)

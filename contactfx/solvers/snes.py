@@ -233,7 +233,10 @@ class ContactSNES:
         self._sync(x)
         a0 = self.timer.assembly
         t0 = time.perf_counter()
-        self.snes.solve(None, x)
+        try:
+            self.snes.solve(None, x)
+        except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash
+            raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
         self._sync(x)
         wall = time.perf_counter() - t0
         reason = self.snes.getConvergedReason()

@@ -60,3 +60,22 @@ def test_hertz3d():
     # quarter model, about 7 tetrahedra across a = 0.1: 5 % (BENCHMARKS.md section 1)
     assert ref["a_rel_error"] < 0.05
     assert ref["p0_rel_error"] < 0.05
+
+
+@pytest.mark.parametrize(
+    "num",
+    [Numerics(method="al-uzawa"), Numerics(method="al-ssn"), Numerics(method="al-ssn", ncp="fb")],
+    ids=["al-uzawa", "al-ssn-min", "al-ssn-fb"],
+)
+def test_augmented_lagrangian_hertz2d(num):
+    res = Hertz2D(COARSE).run(num, verbose=False)
+    nit = Hertz2D(COARSE).run(Numerics(method="nitsche"), verbose=False)
+    ref = res["reference"]
+    # the same discretisation bounds as Nitsche (a within h/2, p0 within 3 %)
+    assert ref["a_error_over_h"] <= 0.5
+    assert ref["p0_rel_error"] < 0.03
+    # and the same force as Nitsche on this mesh to its discretisation error
+    assert res["force"] == pytest.approx(nit["force"], rel=5e-3)
+    # the constraint holds at the nodes to solver tolerance, not O(1/r): nodal penetration
+    # below 1e-9 of the indentation depth
+    assert res["max_penetration"] < 1e-9 * COARSE.depth

@@ -10,6 +10,7 @@ from mpi4py import MPI
 
 from contactfx.scenes import Numerics
 from contactfx.scenes.hertz import Hertz2D, Hertz2DParams, Hertz3D, Hertz3DParams
+from contactfx.scenes.sliding_block import SlidingBlock, SlidingBlockParams
 
 
 @pytest.mark.parametrize(
@@ -31,3 +32,26 @@ def test_serial_and_parallel_agree(scene, num):
     for key in ("force", "contact_half_width", "peak_pressure"):
         assert parallel[key] == pytest.approx(serial[key], rel=1e-8), key
     assert abs(parallel["newton_iterations"] - serial["newton_iterations"]) <= 1
+
+
+@pytest.mark.parametrize(
+    "scene, num",
+    [
+        (Hertz2D(Hertz2DParams()), Numerics(method="al-uzawa")),
+        (Hertz2D(Hertz2DParams()), Numerics(method="al-ssn", ncp="fb")),
+        (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="nitsche")),
+        (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="al-ssn")),
+    ],
+    ids=["hertz2d-al-uzawa", "hertz2d-al-ssn-fb", "sliding-nitsche", "sliding-al-ssn"],
+)
+def test_serial_and_parallel_agree_al_and_friction(scene, num):
+    serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
+    parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
+    # Newton (and Uzawa, tolerance 1e-8 on the multiplier) converged: contact quantities
+    # agree to the solver tolerance
+    for key in ("force", "contact_half_width", "peak_pressure"):
+        assert parallel[key] == pytest.approx(serial[key], rel=1e-7), key
+    if "tangential_force" in serial.data:
+        assert parallel["tangential_force"][0] == pytest.approx(
+            serial["tangential_force"][0], rel=1e-7, abs=1e-9 * serial["force"]
+        )
