@@ -265,6 +265,11 @@ class _Run:
         self.timings["mesh"] = time.perf_counter() - t0
         gdim = mesh.geometry.dim
         fdim = mesh.topology.dim - 1
+        if num.method == "al-uzawa" and fdim == 0:
+            raise ValueError(
+                "method al-uzawa needs a 2D or 3D mesh (its nodal multiplier update cannot be "
+                "compiled on intervals); use al-ssn for 1D scenes"
+            )
         contact_facets = facet_tags.indices[facet_tags.values == scene.contact_tag]
 
         # unknowns: the displacement, or (displacement, multiplier) for al-ssn
