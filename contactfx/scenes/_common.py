@@ -25,6 +25,10 @@ def _facets(facet_tags, tag: int) -> np.ndarray:
 def fix(V, facet_tags, tag: int):
     """u = 0 on the facets tagged ``tag`` (one condition per component, so that V may be the
     displacement part of a mixed space)."""
+    if V.num_sub_spaces == 0:  # a one-component space (1D on dolfinx 0.9) has no sub-spaces
+        mesh = V.mesh
+        dofs = _compat.locate_dofs_topological(V, mesh.topology.dim - 1, _facets(facet_tags, tag))
+        return [_compat.dirichletbc(np.zeros(mesh.geometry.dim), dofs, V)]
     return [fix_component(V, facet_tags, tag, i) for i in range(V.mesh.geometry.dim)]
 
 
