@@ -28,7 +28,6 @@ class Uzawa:
         self.inner = inner
         self.u = inner.u
         self.timer = inner.timer
-        self.K, self.b = inner.K, inner.b
         self.multiplier = multiplier
         self.update = update
         self.mask = mask
