@@ -19,7 +19,7 @@ export OMPI_MCA_btl_tcp_if_include := lo
 export OPENBLAS_NUM_THREADS := 1
 export OMP_NUM_THREADS := 1
 
-.PHONY: install demo test lint clean
+.PHONY: install demo test lint clean results
 
 install:
 	bash scripts/install.sh
@@ -30,6 +30,15 @@ demo: install
 test: install
 	$(PY) -m pytest -q tests
 	mpirun -n $(NP) $(PY) -m mpi4py -m pytest -q -m "not serial_only" tests
+
+# The committed results page docs/results.md (about 30 min on 2 cores): error against run time
+# for every case and method, and the robustness matrix.
+BENCH_METHODS := nitsche,nitsche@1+nodal,penalty,al-uzawa,al-ssn,vi
+results: install
+	mpirun -n $(NP) $(VENV)/bin/contactfx bench --scene all --method $(BENCH_METHODS) \
+		--degree 1,2 --levels 3 --out docs/results/bench
+	$(VENV)/bin/contactfx stress --out docs/results/stress
+	$(PY) -m contactfx.validation.report docs/results docs/results.md
 
 lint: install
 	@test -x $(VENV)/bin/ruff || $(PY) -m pip install -q --disable-pip-version-check ruff

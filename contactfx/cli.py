@@ -1,4 +1,4 @@
-"""Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench SCENE``.
+"""Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench | stress``.
 
 PETSc options after ``--`` reach PETSc: they initialise petsc4py before dolfinx is imported and
 are copied under the solver's options prefix, so ``-- -snes_monitor -ksp_type gmres`` works.
@@ -213,7 +213,8 @@ def _write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
 def _usage() -> str:
     return (
         "usage: contactfx {list | run SCENE [options] [-- PETSc options] | "
-        "bench SCENE [--levels N] [--method M,...]}"
+        "bench [--scene CASES] [--method M,...] [--levels N] [--degree 1,2] [--out DIR] | "
+        "stress [--quick] [--axis AXES] [--out DIR]}"
     )
 
 
@@ -242,6 +243,10 @@ def main(argv: list[str] | None = None) -> int:
             from contactfx.validation.bench import bench_main
 
             return bench_main(rest, petsc_options, comm)
+        if command == "stress":
+            from contactfx.validation.stress import stress_main
+
+            return stress_main(rest, petsc_options, comm)
         raise ValueError(f"unknown command '{command}' ({_usage()})")
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2, message printed)
         return int(exc.code or 0)

@@ -95,6 +95,9 @@ class Numerics:
     friction: str = param("none", "friction law", choices=FRICTION_LAWS)
     mu: float = param(0.0, "Coulomb friction coefficient", nonnegative=True)
     threshold: float = param(0.0, "Tresca friction threshold (stress)", nonnegative=True)
+    quadrature: str = param("gauss", "contact integrals of nitsche / penalty: gauss (degree "
+                            "2k + 2) or nodal (at the vertices, P1 only)",
+                            choices=("gauss", "nodal"))  # fmt: skip
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
@@ -117,6 +120,12 @@ class Numerics:
         if self.threshold > 0.0 and self.friction != "tresca":
             raise ValueError(
                 f"--threshold needs --friction tresca (got --friction {self.friction})"
+            )
+        if self.quadrature == "nodal" and (self.degree != 1 or self.method not in
+                                           ("nitsche", "penalty")):  # fmt: skip
+            raise ValueError(
+                "--quadrature nodal needs --degree 1 and method nitsche or penalty (the "
+                "augmented Lagrangian methods already collocate the contact law at the nodes)"
             )
         if self.method == "al-ssn" and self.solver != "lu":
             raise ValueError("method al-ssn is a saddle-point system: use --solver lu")
@@ -194,6 +203,11 @@ class Scene:
 
     def exact_displacement(self, x):
         """UFL expression of the exact displacement, or None."""
+        return None
+
+    def exact_pressure(self, x, ref: dict):
+        """UFL expression of the closed-form contact pressure on the contact boundary, or None.
+        ``ref`` maps the keys of :meth:`reference` (at the computed force) to UFL constants."""
         return None
 
     def h_contact(self) -> float:
@@ -297,7 +311,10 @@ class _Run:
 
         qdeg = 2 * num.degree + 2
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-        dsc = ds(scene.contact_tag, metadata={"quadrature_degree": qdeg})
+        # nodal: the contact law at the P1 nodes only (trapezoidal rule), so a curved obstacle
+        # does not over-constrain the piecewise linear surface when gamma0 / penalty is large
+        rule = _vertex_rule(fdim) if num.quadrature == "nodal" else {"quadrature_degree": qdeg}
+        dsc = ds(scene.contact_tag, metadata=rule)
         dsc_fine = ds(scene.contact_tag, metadata={"quadrature_degree": 12})
         ds_nodal = ds(scene.contact_tag, metadata=_vertex_rule(fdim)) if mixed else None
         offset = dolfinx.fem.Constant(mesh, np.zeros(gdim))
@@ -469,6 +486,7 @@ class _Run:
             "contact_half_width": summary["a"],
             "peak_pressure": summary["p0"],
             "max_penetration": summary["penetration"],
+            "complementarity": summary["complementarity"],
             "xdmf": None if xdmf_path is None else str(xdmf_path),
         }
         if friction is not None:
@@ -479,7 +497,7 @@ class _Run:
         if friction is not None:
             data["reference"].update(scene.friction_reference(summary, friction))
         data["scores"] = post.scores(summary)
-        data["errors"] = post.field_errors()
+        data["errors"] = post.field_errors(summary)
         solver.destroy()
         if self.out is not None:
             write_json(self.out / "run.json", data, comm)
@@ -591,7 +609,7 @@ class _PostProcessor:
     def __init__(self, mesh, scene, num, surface: ContactSurface, method, dsc, dsc_fine,
                  material):  # fmt: skip
         self.scene, self.num, self.surface, self.method = scene, num, surface, method
-        self.mesh = mesh
+        self.mesh, self.dsc_fine = mesh, dsc_fine
         gdim = mesh.geometry.dim
         self.gdim = gdim
         u = surface.u
@@ -689,11 +707,16 @@ class _PostProcessor:
             float(max(-gap_surface.min(initial=0.0), 0.0)), op=MPI.MAX
         )
         measure = self._sum(self.measure_form) * self.scene.symmetry
+        p_surface = p_local[: len(m)][on_surface]
+        complementarity = self.mesh.comm.allreduce(
+            float(np.max(np.abs(gap_surface * p_surface), initial=0.0)), op=MPI.MAX
+        )
         out: dict[str, Any] = {
             "force": force * self.scene.symmetry,
             "a": self.scene.contact_size(measure),
             "p0": p_max,
             "penetration": penetration,
+            "complementarity": complementarity,
         }
         if self.friction is not None:
             self._lumped(self.t_form, self.traction, m)
@@ -781,16 +804,34 @@ class _PostProcessor:
             out.setdefault(key, value)
         return out
 
-    def field_errors(self) -> dict[str, float]:
+    def field_errors(self, summary: dict) -> dict[str, float]:
+        out = self._pressure_error(summary)
         if self.exact is None:
-            return {}
-        out = {}
+            return out
         for key in ("L2", "H1"):
             err = np.sqrt(self._sum(self.err_forms[key]))
             norm = np.sqrt(self._sum(self.norm_forms[key]))
             out[f"displacement_{key}"] = err
             out[f"displacement_{key}_rel"] = err / norm
         return out
+
+    def _pressure_error(self, summary: dict) -> dict[str, float]:
+        """Relative L2(contact boundary) error of the pressure against the closed form at the
+        computed force: the method's pressure at quadrature points (the lumped nodal pressure
+        for vi and nodal quadrature), integrated with a degree-12 rule."""
+        ref = self.scene.reference(summary["force"])
+        consts = {k: dolfinx.fem.Constant(self.mesh, float(v)) for k, v in ref.items()}
+        exact = self.scene.exact_pressure(ufl.SpatialCoordinate(self.mesh), consts)
+        if exact is None:
+            return {}
+        if self.method is not None and self.num.quadrature == "gauss":
+            p_h = self.method.pressure(self.surface)
+        else:  # the nodal pressure (vi, nodal quadrature): piecewise linear between nodes
+            p_h = self.pressure
+        dsf = self.dsc_fine
+        err = np.sqrt(self._sum(dolfinx.fem.form((p_h - exact) ** 2 * dsf)))
+        norm = np.sqrt(self._sum(dolfinx.fem.form(exact**2 * dsf)))
+        return {"pressure_L2": err, "pressure_L2_rel": err / norm}
 
 
 def _assemble_vec(form) -> PETSc.Vec:

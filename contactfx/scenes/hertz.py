@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import ufl
 
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
@@ -32,6 +33,11 @@ def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
 def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
     a = (3.0 * force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
     return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
+
+
+def _elliptic(p0, s2):
+    """Hertz pressure p0 sqrt(1 - s^2), zero outside the contact (s^2 = (x / a)^2)."""
+    return p0 * ufl.sqrt(ufl.max_value(1.0 - s2, 0.0))
 
 
 def _indent_then_shift(t: float, depth: float, shift: float, gdim: int) -> np.ndarray:
@@ -76,6 +82,13 @@ class Hertz2DParams(SceneParams):
     refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
     shift: float = param(0.0, "tangential displacement of the indenter after the indentation "
                          "(needs friction)", nonnegative=True)  # fmt: skip
+    gap0: float = param(0.0, "initial clearance of the indenter at load 0 (< 0: interference; "
+                        "the final position is still -depth)")  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.gap0 != 0.0 and self.shift > 0.0:
+            raise ValueError("--gap0 and --shift cannot be combined")
 
 
 class Hertz2D(Scene):
@@ -97,13 +110,20 @@ class Hertz2D(Scene):
         return _indenter(self.p.profile, self.p.radius)
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
-        return _indent_then_shift(t, self.p.depth, self.p.shift, gdim)
+        offset = _indent_then_shift(t, self.p.depth, self.p.shift, gdim)
+        offset[gdim - 1] += (1.0 - t) * self.p.gap0
+        return offset
 
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, RectangleFacets.BOTTOM)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.p.radius, self.material().E_star)
+
+    def exact_pressure(self, x, ref: dict):
+        if self.p.shift > 0.0:  # the pressure under a sliding indenter moves with it
+            return None
+        return _elliptic(ref["p0"], x[0] ** 2 / ref["a"] ** 2)
 
     def friction_reference(self, summary: dict, friction) -> dict[str, float]:
         ref = hertz_2d(summary["force"], self.p.radius, self.material().E_star)
@@ -181,6 +201,11 @@ class Hertz3D(QuarterBlock):
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_3d(force, self.p.radius, self.material().E_star)
+
+    def exact_pressure(self, x, ref: dict):
+        if self.half:
+            return None
+        return _elliptic(ref["p0"], (x[0] ** 2 + x[1] ** 2) / ref["a"] ** 2)
 
     def friction_reference(self, summary: dict, friction) -> dict[str, float]:
         ref = hertz_3d(summary["force"], self.p.radius, self.material().E_star)

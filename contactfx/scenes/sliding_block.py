@@ -89,6 +89,15 @@ class SlidingBlock(Scene):
     def reference(self, force: float) -> dict[str, float]:
         return {"force": self.p.pressure * self.p.width}
 
+    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
+        """After the drag the whole face slides (the shift exceeds the stick displacement):
+        Coulomb's gross slip Q = mu P."""
+        if friction.name != "coulomb" or friction.mu == 0.0 or self.p.shift == 0.0:
+            return {}
+        q_ref = friction.mu * summary["force"]
+        q = abs(summary["tangential_force"][0])
+        return {"Q": q_ref, "Q_rel_error": abs(q - q_ref) / q_ref}
+
     def friction_scores(self, x, p, t, bound, status) -> dict[str, float]:
         """Where the face slides, |t_T| = bound exactly: the largest deviation relative to p."""
         slipping = status > 1.5

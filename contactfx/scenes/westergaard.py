@@ -100,6 +100,13 @@ class Westergaard(Scene):
         a = lam / np.pi * np.arcsin(np.sqrt(r))
         return {"a": a, "p0": 2.0 * self.p_star * np.sqrt(r), "force": 0.5 * lam * self.p_mean}
 
+    def exact_pressure(self, x, ref: dict):
+        k = np.pi / self.p.wavelength
+        if self.p.mean_pressure_ratio >= 1.0:
+            return self.p_mean + self.p_star * ufl.cos(2.0 * k * x[0])
+        s2 = ufl.sin(k * ref["a"]) ** 2 - ufl.sin(k * x[0]) ** 2
+        return 2.0 * self.p_star * ufl.cos(k * x[0]) * ufl.sqrt(ufl.max_value(s2, 0.0))
+
     def exact_displacement(self, x):
         if self.p.mean_pressure_ratio < 1.0:
             return None

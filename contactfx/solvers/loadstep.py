@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from petsc4py import PETSc
 
 from contactfx import _compat
-from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats
+from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats, TimeLimitExceeded
 
 __all__ = ["StepRecord", "run_load_program"]
 
@@ -61,6 +61,9 @@ def run_load_program(
             solver.assemble_load()
             try:
                 stats = solver.solve()
+            except TimeLimitExceeded:
+                previous.copy(x)
+                raise TimeLimitExceeded(f" at load factor {t:.6g}") from None
             except ConvergenceError as err:
                 cutbacks += 1
                 if cutbacks > max_cutbacks:

@@ -17,17 +17,20 @@ user are copied under the prefix as well).
 
 from __future__ import annotations
 
+import contextlib
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import dolfinx
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["ConvergenceError", "SolveStats", "ContactSNES", "DEFAULT_OPTIONS", "GAMG_OPTIONS"]
+__all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "ContactSNES", "time_limit",
+           "DEFAULT_OPTIONS", "GAMG_OPTIONS"]  # fmt: skip
 
 
 class ConvergenceError(RuntimeError):
@@ -39,6 +42,31 @@ class ConvergenceError(RuntimeError):
         self.load = load
         where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
         super().__init__(f"nonlinear solve diverged{where}: {reason}")
+
+
+class TimeLimitExceeded(ConvergenceError):
+    """The solve ran past the deadline set by :func:`time_limit` (not retried by cut-back)."""
+
+    def __init__(self, where: str = "") -> None:
+        RuntimeError.__init__(self, f"time limit exceeded{where}")
+        self.reason, self.step, self.load = "time limit", None, None
+
+
+_DEADLINE: list[float] = []  # perf_counter deadlines, innermost last
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float | None):
+    """Solves started inside stop with :class:`TimeLimitExceeded` once ``seconds`` of wall
+    time have passed (checked collectively at every residual evaluation: no rank hangs)."""
+    if seconds is None:
+        yield
+        return
+    _DEADLINE.append(time.perf_counter() + seconds)
+    try:
+        yield
+    finally:
+        _DEADLINE.pop()
 
 
 #: Newton with a backtracking line search, MUMPS LU.
@@ -206,6 +234,9 @@ class ContactSNES:
 
     def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
         t0 = time.perf_counter()
+        if _DEADLINE and self.comm.allreduce(t0 > _DEADLINE[-1], op=MPI.LOR):
+            self._late = True
+            raise TimeLimitExceeded()
         self._sync(x)
         self.K.mult(x, F)
         F.axpy(-1.0, self.b)
@@ -233,9 +264,12 @@ class ContactSNES:
         self._sync(x)
         a0 = self.timer.assembly
         t0 = time.perf_counter()
+        self._late = False
         try:
             self.snes.solve(None, x)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash
+            if self._late:
+                raise TimeLimitExceeded() from None
             raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
         self._sync(x)
         wall = time.perf_counter() - t0

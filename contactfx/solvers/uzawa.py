@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats
+from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats, TimeLimitExceeded
 
 __all__ = ["Uzawa"]
 
@@ -56,6 +56,8 @@ class Uzawa:
                 stats = self.inner.solve()
             except ConvergenceError as err:
                 lam[:] = saved
+                if isinstance(err, TimeLimitExceeded):
+                    raise
                 raise ConvergenceError(f"{err.reason} (Uzawa iteration {k})") from None
             total.newton += stats.newton
             total.ksp += stats.ksp

@@ -1,16 +1,27 @@
-"""``contactfx bench SCENE --levels N``: refinement study with timings and a linear yardstick.
+"""``contactfx bench``: error against run time over mesh refinement, every method variant.
 
-Per level: dofs, Newton and KSP iterations, time per phase, errors in a and p0, and the time of
-one linear-elastic assemble + solve on the same mesh with the same linear solver. Under
-``mpirun -n 2`` each level also runs on one rank (rank 0 alone) to give the parallel speed-up,
-next to the machine's ceiling measured by a trivially parallel NumPy loop.
+For each benchmark case (a scene with a closed-form reference, see ``CASES``), each method
+variant (``nitsche`` = theta 1, 0, -1; ``penalty`` = three penalty parameters; ``al-uzawa``,
+``al-ssn``, ``vi``), each Lagrange degree and each refinement level (every mesh size of the
+scene halves per level) one run records dofs, Newton / KSP iterations, the wall time split into
+mesh, compile, assembly and solve, and the errors against the closed form: force, contact
+half-width a, peak pressure p0, the pressure in L2 on the contact boundary, the displacement in
+L2 and H1 where an exact field exists, the flat punch's normalised pressure on |x| <= 0.8 a, and
+the sliding block's gross-slip force Q = mu P.
+
+Outputs (``--out``): ``bench.csv``, ``bench.md`` (tables and observed rates) and PNG plots per
+case and error measure: error against solve wall time (assembly + solve: the just-in-time
+compilation is cached between runs, so it is reported but not plotted) and error against h
+with the least-squares rate. Runs under mpirun; rank 0 writes.
+
+Optional yardsticks (issue-2 targets): ``--linear`` times one linear-elastic solve on the same
+mesh; ``--speedup`` reruns every case on rank 0 alone under mpirun.
 """
 
 from __future__ import annotations
 
-import argparse
-import csv
 import dataclasses
+import math
 import time
 from pathlib import Path
 
@@ -19,7 +30,157 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-__all__ = ["bench_main", "linear_elastic_time", "parallel_ceiling"]
+__all__ = ["CASES", "MEASURES", "bench_main", "expand_methods", "linear_elastic_time",
+           "observed_rates", "parallel_ceiling"]  # fmt: skip
+
+
+@dataclasses.dataclass(frozen=True)
+class BenchCase:
+    """A scene with a reference, its parameter overrides, and the coarsening of level 0
+    relative to the scene's default mesh (level k has mesh sizes default * coarsen / 2^k)."""
+
+    scene: str
+    params: dict
+    coarsen: float
+    summary: str
+    #: at most this many levels with P2 (3D P2 grows fast)
+    p2_levels: int = 99
+
+
+CASES: dict[str, BenchCase] = {
+    "hertz2d": BenchCase("hertz2d", {}, 2.0, "Hertz cylinder, plane strain"),
+    "hertz3d": BenchCase("hertz3d", {}, 2.0, "Hertz sphere, quarter model", p2_levels=2),
+    "westergaard-partial": BenchCase(
+        "westergaard", {"mean_pressure_ratio": 0.5}, 2.0, "Westergaard, partial contact p_m = p*/2"
+    ),
+    "westergaard-full": BenchCase(
+        "westergaard",
+        {"mean_pressure_ratio": 1.5, "h_contact": 1 / 8, "h_far": 1 / 8},
+        1.0,
+        "Westergaard, full contact p_m = 1.5 p*, uniform mesh, exact displacement",
+    ),  # fmt: skip
+    "punch2d": BenchCase("punch2d", {}, 2.0, "flat rigid punch, plane strain"),
+    "sliding-block": BenchCase("sliding-block", {}, 2.0, "Coulomb block dragged to gross slip"),
+}
+
+#: error measures: column, label, where in run.json
+MEASURES: dict[str, tuple[str, tuple[str, str]]] = {
+    "err_force": ("force", ("reference", "force_rel_error")),
+    "err_a": ("half-width a", ("reference", "a_rel_error")),
+    "err_p0": ("peak pressure p0", ("reference", "p0_rel_error")),
+    "err_p_L2": ("pressure, L2 on contact", ("errors", "pressure_L2_rel")),
+    "err_u_L2": ("displacement, L2", ("errors", "displacement_L2_rel")),
+    "err_u_H1": ("displacement, H1 semi-norm", ("errors", "displacement_H1_rel")),
+    "err_punch": ("punch pressure on |x| <= 0.8 a", ("scores", "normalised_pressure_error")),
+    "err_Q": ("gross-slip force Q = mu P", ("reference", "Q_rel_error")),
+}
+
+PENALTIES = (10.0, 100.0, 1000.0)
+
+
+def expand_methods(spec: str) -> list[tuple[str, dict]]:
+    """'nitsche,penalty@100,al-ssn' -> [(label, Numerics overrides), ...]. ``nitsche`` expands
+    to theta = 1, 0, -1 and ``penalty`` to three parameters; ``name@value`` picks one (theta
+    for nitsche, the penalty factor for penalty, r0 for the augmented Lagrangian); a
+    ``+nodal`` suffix integrates the contact terms at the nodes (``--quadrature nodal``)."""
+    from contactfx.scenes import METHODS
+
+    out: list[tuple[str, dict]] = []
+    for token in filter(None, (t.strip() for t in spec.split(","))):
+        token, nodal = token.removesuffix("+nodal"), token.endswith("+nodal")
+        if nodal and not token.startswith(("nitsche", "penalty")):
+            raise ValueError(f"--method {token}+nodal: nodal quadrature is for nitsche / penalty")
+        first = len(out)
+        name, _, value = token.partition("@")
+        if name not in METHODS:
+            raise ValueError(f"unknown method '{name}' in --method (known: {', '.join(METHODS)})")
+        try:
+            number = float(value) if value else None
+        except ValueError:
+            raise ValueError(f"--method {token}: '{value}' is not a number") from None
+        if name == "nitsche":
+            thetas = (1, 0, -1) if number is None else (int(number),)
+            out += [(f"nitsche({t})", {"method": name, "theta": t}) for t in thetas]
+        elif name == "penalty":
+            values = PENALTIES if number is None else (number,)
+            out += [(f"penalty({k:g})", {"method": name, "penalty": k}) for k in values]
+        elif name.startswith("al-") and number is not None:
+            out.append((f"{name}({number:g})", {"method": name, "r0": number}))
+        else:
+            out.append((name, {"method": name}))
+        if nodal:
+            out[first:] = [(f"{label} nodal", {**o, "quadrature": "nodal"})
+                           for label, o in out[first:]]  # fmt: skip
+    if not out:
+        raise ValueError("--method: no method given")
+    return out
+
+
+def _refined(params, coarsen: float, level: int):
+    """The scene parameters with every mesh size (fields h, h_*) scaled by coarsen / 2^level."""
+    scale = coarsen * 0.5**level
+    sizes = {
+        f.name: getattr(params, f.name) * scale
+        for f in dataclasses.fields(params)
+        if f.name == "h" or f.name.startswith("h_")
+    }
+    if not sizes:
+        raise ValueError(f"scene {type(params).__name__} has no mesh size to refine")
+    return dataclasses.replace(params, **sizes)
+
+
+def _lookup(data: dict, where: tuple[str, str]) -> float:
+    value = data.get(where[0], {}).get(where[1])
+    return float("nan") if value is None else float(value)
+
+
+def run_case(
+    case_name: str, label: str, overrides: dict, degree: int, level: int, comm,
+    petsc_options: dict | None = None, solver: str = "lu",
+) -> tuple[dict, object, object]:  # fmt: skip
+    """One bench row (and the scene and numerics it ran, for the yardsticks)."""
+    from contactfx.scenes import SCENES
+    from contactfx.solvers.snes import ConvergenceError
+
+    case = CASES[case_name]
+    scene_cls = SCENES[case.scene]
+    params = _refined(scene_cls.Params(**case.params), case.coarsen, level)
+    scene = scene_cls(params)
+    row: dict = {"case": case_name, "method": label, "degree": degree, "level": level,
+                 "h": scene.h_contact(), "ranks": comm.size}  # fmt: skip
+    try:
+        num = scene_cls.default_numerics(degree=degree, solver=solver, **overrides)
+    except ValueError as err:  # e.g. friction with penalty: not applicable, not a failure
+        row.update(status="n/a", reason=str(err))
+        return row, scene, None
+    try:
+        data = scene.run(num, comm=comm, petsc_options=petsc_options, verbose=False).data
+    except (ConvergenceError, ValueError) as err:
+        row.update(status="failed", reason=str(err))
+        return row, scene, num
+    t = data["timings"]
+    row.update(
+        status="ok", reason="", dofs=data["dofs"], newton=data["newton_iterations"],
+        ksp=data["ksp_iterations"], outer=data["outer_iterations"],
+        t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
+        t_run=t["assembly"] + t["solve"],
+    )  # fmt: skip
+    for column, (_, where) in MEASURES.items():
+        row[column] = _lookup(data, where)
+    return row, scene, num
+
+
+def observed_rates(rows: list[dict], column: str) -> tuple[float, float]:
+    """Least-squares slope of log(error) against log(h) over the rows, and the rate between
+    the two finest levels (nan when undefined)."""
+    pts = [(r["h"], r[column]) for r in rows if r.get("status") == "ok"]
+    pts = [(h, e) for h, e in pts if np.isfinite(e) and e > 0.0]
+    if len(pts) < 2:
+        return float("nan"), float("nan")
+    h, e = np.log(np.array(pts)).T
+    fit = float(np.polyfit(h, e, 1)[0])
+    last = float((e[-2] - e[-1]) / (h[-2] - h[-1]))
+    return fit, last
 
 
 def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[float, int]:
@@ -90,107 +251,117 @@ def parallel_ceiling(comm, n: int = 3_000_000, repeats: int = 3) -> float:
     return comm.size * alone / together
 
 
-def _parser(scenes) -> argparse.ArgumentParser:
+def _int_list(text: str) -> list[int]:
+    try:
+        return [int(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise ValueError(f"expected comma-separated integers, got '{text}'") from None
+
+
+def _parser():
     from contactfx.cli import _Parser
 
-    p = _Parser(prog="contactfx bench", description="refinement study with timings")
-    p.add_argument("scene", choices=sorted(scenes))
+    p = _Parser(prog="contactfx bench", description="error against run time over refinement")
+    p.add_argument("case", nargs="?", default=None, help="one case (same as --scene)")
+    p.add_argument(
+        "--scene",
+        default=None,
+        help=f"comma-separated cases, or all (default hertz2d): {', '.join(CASES)}",
+    )
+    p.add_argument(
+        "--method",
+        default="nitsche,penalty,al-uzawa,al-ssn,vi",
+        help="comma-separated method variants, e.g. nitsche,nitsche@-1,penalty@100",
+    )
     p.add_argument("--levels", type=int, default=3, help="refinement levels (h halves)")
-    p.add_argument("--method", default="nitsche", help="comma-separated methods")
-    p.add_argument("--theta", type=int, default=1)
-    p.add_argument("--gamma0", type=float, default=10.0)
-    p.add_argument("--degree", type=int, default=1)
+    p.add_argument("--degree", default="1", help="comma-separated Lagrange degrees, e.g. 1,2")
     p.add_argument("--solver", default="lu", choices=("lu", "gamg"))
-    p.add_argument("--out", type=Path, default=None, help="folder for bench.csv")
-    return p
+    p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNGs")
+    p.add_argument(
+        "--linear",
+        action="store_true",
+        help="also time one linear-elastic solve per mesh (contact / linear ratio)",
+    )
+    p.add_argument(
+        "--speedup",
+        action="store_true",
+        help="under mpirun, also run every case on rank 0 alone (parallel speed-up)",
+    )
+    return p  # fmt: skip
 
 
 def bench_main(argv: list[str], petsc_options: dict, comm) -> int:
-    from contactfx.scenes import SCENES, Numerics
-
-    ns = _parser(SCENES).parse_args(argv)
+    ns = _parser().parse_args(argv)
+    if ns.case is not None and ns.scene is not None:
+        raise ValueError("give the case either positionally or with --scene, not both")
+    spec = ns.case or ns.scene or "hertz2d"
+    cases = list(CASES) if spec == "all" else [c.strip() for c in spec.split(",") if c.strip()]
+    for name in cases:
+        if name not in CASES:
+            raise ValueError(f"unknown bench case '{name}' (known: {', '.join(CASES)}, all)")
     if ns.levels < 1:
         raise ValueError(f"--levels must be >= 1, got {ns.levels}")
-    scene_cls = SCENES[ns.scene]
-    base = scene_cls.Params()
-    if not hasattr(base, "h_contact"):
-        raise ValueError(f"scene {ns.scene} has no mesh size to refine")
-    ceiling = parallel_ceiling(comm) if comm.size > 1 else 1.0
-    rows = []
-    for level in range(ns.levels):
-        scale = 0.5**level
-        sizes = {"h_contact": base.h_contact * scale}
-        params = dataclasses.replace(base, **sizes)
-        scene = scene_cls(params)
-        for method in ns.method.split(","):
-            num = Numerics(
-                method=method, theta=ns.theta, gamma0=ns.gamma0, degree=ns.degree,
-                solver=ns.solver, **scene_cls.numerics_defaults,
-            )  # fmt: skip
-            res = scene.run(num, comm=comm, petsc_options=petsc_options, verbose=False).data
-            lin, _ = linear_elastic_time(scene, ns.degree, comm, ns.solver)
-            t = res["timings"]
-            contact = t["assembly"] + t["solve"]
-            row = {
-                "level": level,
-                "method": method,
-                "h": params.h_contact,
-                "dofs": res["dofs"],
-                "ranks": comm.size,
-                "newton": res["newton_iterations"],
-                "ksp": res["ksp_iterations"],
-                "t_mesh": t["mesh"],
-                "t_compile": t["compile"],
-                "t_assembly": t["assembly"],
-                "t_solve": t["solve"],
-                "t_linear": lin,
-                "contact_over_linear": contact / lin,
-                "a_err": res["reference"].get("a_rel_error", np.nan),
-                "p0_err": res["reference"].get("p0_rel_error", np.nan),
-            }
-            if comm.size > 1:
-                serial = None
-                if comm.rank == 0:
-                    serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False).data
-                serial = comm.bcast(serial, root=0)
-                ts = serial["timings"]
-                speedup = (ts["assembly"] + ts["solve"]) / contact
-                row["newton_serial"] = serial["newton_iterations"]
-                row["speedup"] = speedup
-                row["speedup_over_ceiling"] = speedup / ceiling
-            rows.append(row)
-            if comm.rank == 0:
-                print(_format_row(row), flush=True)
+    degrees = _int_list(ns.degree)
+    if not degrees or any(d not in (1, 2) for d in degrees):
+        raise ValueError(f"--degree must list 1 and/or 2, got '{ns.degree}'")
+    variants = expand_methods(ns.method)
+    ceiling = parallel_ceiling(comm) if ns.speedup and comm.size > 1 else 1.0
+    rows: list[dict] = []
+    started = time.perf_counter()
+    for case_name in cases:
+        for label, overrides in variants:
+            for degree in degrees:
+                levels = ns.levels if degree == 1 else min(ns.levels, CASES[case_name].p2_levels)
+                for level in range(levels):
+                    row, scene, num = run_case(case_name, label, overrides, degree, level, comm,
+                                               petsc_options, ns.solver)  # fmt: skip
+                    if row["status"] == "ok" and ns.linear:
+                        lin, _ = linear_elastic_time(scene, degree, comm, ns.solver)
+                        row["t_linear"] = lin
+                        row["contact_over_linear"] = row["t_run"] / lin
+                    if row["status"] == "ok" and ns.speedup and comm.size > 1:
+                        _add_speedup(row, scene, num, comm, ceiling)
+                    rows.append(row)
+                    if comm.rank == 0:
+                        print(_format_row(row), flush=True)
+                    if row["status"] == "n/a":
+                        break  # the same at every level
     if comm.rank == 0:
-        if comm.size > 1:
+        total = time.perf_counter() - started
+        print(f"bench: {len(rows)} runs in {total:.0f} s on {comm.size} rank(s)")
+        if ns.speedup and comm.size > 1:
             print(f"parallel ceiling of this machine with {comm.size} ranks: {ceiling:.2f}x")
         if ns.out is not None:
-            ns.out.mkdir(parents=True, exist_ok=True)
-            with open(ns.out / "bench.csv", "w", newline="") as fh:
-                writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
-                writer.writeheader()
-                writer.writerows(rows)
-            print(f"table: {ns.out / 'bench.csv'}")
+            from contactfx.validation.report import write_bench
+
+            for path in write_bench(rows, ns.out, comm.size, total):
+                print(f"wrote {path}")
+    comm.barrier()
     return 0
 
 
-_HEADER_DONE = False
+def _add_speedup(row: dict, scene, num, comm, ceiling: float) -> None:
+    serial = None
+    if comm.rank == 0:
+        serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False).data
+    serial = comm.bcast(serial, root=0)
+    ts = serial["timings"]
+    row["newton_serial"] = serial["newton_iterations"]
+    row["speedup"] = (ts["assembly"] + ts["solve"]) / row["t_run"]
+    row["speedup_over_ceiling"] = row["speedup"] / ceiling
 
 
 def _format_row(row: dict) -> str:
-    global _HEADER_DONE
-    cols = [
-        ("level", "{:>5d}"), ("method", "{:>8s}"), ("dofs", "{:>8d}"), ("newton", "{:>6d}"),
-        ("ksp", "{:>5d}"), ("t_mesh", "{:>7.2f}"), ("t_compile", "{:>9.2f}"),
-        ("t_assembly", "{:>10.2f}"), ("t_solve", "{:>7.2f}"), ("t_linear", "{:>8.2f}"),
-        ("contact_over_linear", "{:>19.2f}"), ("a_err", "{:>7.2%}"), ("p0_err", "{:>7.2%}"),
-    ]  # fmt: skip
+    head = f"{row['case']:>19s} {row['method']:>14s} P{row['degree']} L{row['level']}"
+    if row["status"] != "ok":
+        return f"{head}  {row['status'].upper()}: {row['reason']}"
+    errors = "  ".join(f"{col[4:]} {row[col]:.2e}" for col in MEASURES if math.isfinite(row[col]))
+    extra = ""
+    if "contact_over_linear" in row:
+        extra += f"  contact/linear {row['contact_over_linear']:.2f}"
     if "speedup" in row:
-        cols += [("newton_serial", "{:>13d}"), ("speedup", "{:>7.2f}"),
-                 ("speedup_over_ceiling", "{:>20.2f}")]  # fmt: skip
-    line = " ".join(fmt.format(row[k]) for k, fmt in cols)
-    if not _HEADER_DONE:
-        _HEADER_DONE = True
-        header = " ".join(f"{k:>{len(fmt.format(row[k]))}s}" for k, fmt in cols)
-        return header + "\n" + line
-    return line
+        extra += f"  speed-up {row['speedup']:.2f} ({row['speedup_over_ceiling']:.2f} of ceiling)"
+    return (
+        f"{head} dofs {row['dofs']:>7d} newton {row['newton']:>3d} ksp {row['ksp']:>4d} "
+        f"time {row['t_run']:7.2f} s  {errors}{extra}"
+    )

@@ -1,0 +1,286 @@
+"""Tables and plots of ``contactfx bench`` and ``contactfx stress`` (rank 0 only).
+
+CSV for machines, Markdown for the results page, PNG for the eye. Plots use matplotlib's Agg
+backend (no display needed).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import platform
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["machine", "write_bench", "write_csv", "markdown_table"]
+
+
+#: errors below this are round-off (the measure is exact by construction)
+ROUNDOFF = 1e-10
+
+
+def machine(ranks: int) -> str:
+    """One line naming the machine, the versions and the date."""
+    from contactfx.io.provenance import versions
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    v = versions()
+    distro = ""
+    try:
+        for line in Path("/etc/os-release").read_text().splitlines():
+            if line.startswith("PRETTY_NAME="):
+                distro = line.split("=", 1)[1].strip('"')
+    except OSError:
+        pass
+    return (
+        f"{cpu}, {os.cpu_count()} cores, {ranks} MPI rank(s); {distro}; contactfx "
+        f"{v['contactfx']}, dolfinx {v['dolfinx']}, PETSc {v['petsc']}, Python {v['python']}; "
+        f"{time.strftime('%Y-%m-%d')}"
+    )
+
+
+def write_csv(rows: list[dict], path: Path) -> Path:
+    fields: list[str] = []
+    for r in rows:
+        fields += [k for k in r if k not in fields]
+    with open(path, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=fields, restval="")
+        writer.writeheader()
+        writer.writerows(rows)
+    return path
+
+
+def _cell(value) -> str:
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return ""
+        return f"{value:.3g}" if abs(value) >= 1e-3 or value == 0.0 else f"{value:.2e}"
+    return str(value)
+
+
+def markdown_table(rows: list[dict], columns: list[tuple[str, str]]) -> str:
+    """Rows as a Markdown table with the (key, heading) columns."""
+    lines = ["| " + " | ".join(h for _, h in columns) + " |",
+             "|" + "---|" * len(columns)]  # fmt: skip
+    for r in rows:
+        lines.append("| " + " | ".join(_cell(r.get(k, "")) for k, _ in columns) + " |")
+    return "\n".join(lines)
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _series(rows: list[dict]) -> dict[tuple[str, int], list[dict]]:
+    out: dict[tuple[str, int], list[dict]] = defaultdict(list)
+    for r in rows:
+        if r["status"] == "ok":
+            out[(r["method"], r["degree"])].append(r)
+    return out
+
+
+def _has(rows: list[dict], column: str, floor: float = 0.0) -> bool:
+    """Some successful row has an error above ``floor`` in the column."""
+    return any(r.get("status") == "ok" and math.isfinite(r.get(column, math.nan)) and
+               r[column] > floor for r in rows)  # fmt: skip
+
+
+def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
+    """bench.csv, bench.md and the plots; returns the paths written."""
+    from contactfx.validation.bench import CASES, MEASURES, observed_rates
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [write_csv(rows, out / "bench.csv")]
+    plt = _plt()
+    md = [
+        "# contactfx bench: error against run time",
+        "",
+        f"Machine: {machine(ranks)}. {len(rows)} runs, {total:.0f} s in all.",
+        "",
+        "Errors are relative to the closed form at the computed force. Time is the wall time "
+        "of assembly + solve (mesh generation and the cached form compilation are in "
+        "bench.csv). Rates: least-squares slope of log(error) against log(h) over the levels "
+        "(last pair in brackets).",
+    ]
+    for case_name in dict.fromkeys(r["case"] for r in rows):
+        case_rows = [r for r in rows if r["case"] == case_name]
+        measures = [m for m in MEASURES if _has(case_rows, m)]
+        # exact by construction (e.g. the force under force control): tabulated, not plotted
+        plotted = [m for m in measures if _has(case_rows, m, ROUNDOFF)]
+        md += ["", f"## {case_name}: {CASES[case_name].summary}", ""]
+        cols = [("method", "method"), ("degree", "P"), ("level", "level"), ("h", "h"),
+                ("dofs", "dofs"), ("newton", "Newton"), ("ksp", "KSP"),
+                ("t_mesh", "t mesh"), ("t_compile", "t compile"), ("t_assembly", "t assembly"),
+                ("t_solve", "t solve")]  # fmt: skip
+        cols += [(m, MEASURES[m][0]) for m in measures]
+        cols += [(k, k.replace("_", " ")) for k in ("contact_over_linear", "speedup")
+                 if any(k in r for r in case_rows)]  # fmt: skip
+        cols.append(("status", "status"))
+        md.append(markdown_table(case_rows, cols))
+        bad = [r for r in case_rows if r["status"] != "ok"]
+        if bad:
+            md += [""] + [f"- {r['method']} P{r['degree']} level {r['level']}: {r['status']}"
+                          f" ({r['reason']})" for r in bad]  # fmt: skip
+        series = _series(case_rows)
+        if not measures:
+            continue
+        rate_rows = []
+        for (label, degree), srs in series.items():
+            rr = {"method": label, "degree": degree}
+            for m in plotted:
+                fit, last = observed_rates(srs, m)
+                rr[m] = "" if math.isnan(fit) else f"{fit:.2f} ({last:.2f})"
+            rate_rows.append(rr)
+        if any(len(s) > 1 for s in series.values()):
+            md += ["", "Observed rates:", ""]
+            md.append(markdown_table(rate_rows, [("method", "method"), ("degree", "P")] +
+                                     [(m, MEASURES[m][0]) for m in plotted]))  # fmt: skip
+        for m in plotted:
+            for kind in ("time", "h"):
+                path = out / f"{case_name}_{m[4:]}_{kind}.png"
+                _plot(plt, series, m, kind, f"{case_name}: {MEASURES[m][0]}", path)
+                written.append(path)
+            md += ["", f"![{case_name} {m} vs time]({case_name}_{m[4:]}_time.png)"
+                   f" ![{case_name} {m} vs h]({case_name}_{m[4:]}_h.png)"]  # fmt: skip
+    path = out / "bench.md"
+    path.write_text("\n".join(md) + "\n")
+    written.append(path)
+    return written
+
+
+def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
+    from contactfx.validation.bench import observed_rates
+
+    fig, ax = plt.subplots(figsize=(6.0, 4.2))
+    for (label, degree), srs in series.items():
+        pts = [(r["t_run"] if kind == "time" else r["h"], r[column]) for r in srs]
+        pts = [(x, e) for x, e in pts if math.isfinite(e) and e > 0.0]
+        if not pts:
+            continue
+        x, e = np.array(pts).T
+        name = f"{label} P{degree}"
+        if kind == "h" and len(pts) > 1:
+            name += f" (rate {observed_rates(srs, column)[0]:.2f})"
+        ax.loglog(x, e, "o-", label=name, markersize=4)
+    ax.set_xlabel("wall time, assembly + solve [s]" if kind == "time" else "h (contact zone)")
+    ax.set_ylabel("relative error")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    if kind == "h":
+        ax.invert_xaxis()
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
+    """stress.csv, stress.md and gamma0.png; returns the paths written."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [write_csv(rows, out / "stress.csv")]
+    failed = [r for r in rows if r["status"] not in ("converged", "n/a")]
+    md = [
+        "# contactfx stress: robustness matrix",
+        "",
+        f"Machine: {machine(ranks)}. {len(rows)} cases, {len(failed)} not converged, "
+        f"{total:.0f} s in all.",
+        "",
+        "penetration / h: largest nodal penetration over the contact element size; "
+        "|g p| / (p0 h): nodal complementarity residual; error: against the closed form at "
+        "the computed force (p L2: pressure in L2 on the contact boundary; punch p: "
+        "pi sqrt(a^2 - x^2) p / P - 1 on |x| <= 0.8 a; Q = mu P: gross-slip force).",
+    ]
+    cols = [("case", "case"), ("method", "method"), ("status", "status"),
+            ("newton", "Newton"), ("cutbacks", "cut-backs"),
+            ("penetration_over_h", "penetration / h"), ("complementarity", "|g p| / (p0 h)"),
+            ("error_measure", "error of"), ("error", "error"), ("p0_error", "p0 error"),
+            ("time", "time [s]"), ("reason", "reason")]  # fmt: skip
+    for axis in dict.fromkeys(r["axis"] for r in rows):
+        md += ["", f"## {axis}", "", markdown_table([r for r in rows if r["axis"] == axis], cols)]
+    if any(r["axis"] == "gamma0" for r in rows):
+        path = out / "gamma0.png"
+        _plot_gamma0(rows, path)
+        written.append(path)
+        md += ["", "![error and Newton iterations against gamma0](gamma0.png)"]
+    path = out / "stress.md"
+    path.write_text("\n".join(md) + "\n")
+    written.append(path)
+    return written
+
+
+def _plot_gamma0(rows: list[dict], path: Path) -> None:
+    """The Nitsche robustness figure: error and Newton iterations against gamma0 per theta
+    (failed solves are drawn as crosses at the top of the iterations panel)."""
+    plt = _plt()
+    fig, (ax_e, ax_n) = plt.subplots(1, 2, figsize=(10.0, 4.0))
+    for theta, marker in ((1, "o"), (0, "s"), (-1, "^")):
+        sel = [r for r in rows if r["axis"] == "gamma0" and f"theta={theta} " in r["case"]]
+        _gamma0_lines(ax_e, ax_n, sel, marker, f"theta = {theta}")
+    nodal = [r for r in rows if r["axis"] == "gamma0, nodal quadrature"]
+    _gamma0_lines(ax_e, ax_n, nodal, "d", "theta = 1, nodal quadrature")
+    ax_e.set_xlabel("gamma0")
+    ax_e.set_ylabel("pressure error, L2 on contact (relative)")
+    ax_n.set_xlabel("gamma0")
+    ax_n.set_ylabel("Newton iterations (x: failed)")
+    for ax in (ax_e, ax_n):
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Nitsche, Hertz 2D: robustness in gamma0")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _gamma0_lines(ax_e, ax_n, sel: list[dict], marker: str, label: str) -> None:
+    g = [float(r["case"].split("g0=")[1].split()[0]) for r in sel]
+    ok = [(gi, r) for gi, r in zip(g, sel, strict=True) if r["status"] == "converged"]
+    bad = [gi for gi, r in zip(g, sel, strict=True) if r["status"] != "converged"]
+    if ok:
+        x = [gi for gi, _ in ok]
+        ax_e.loglog(x, [r["error"] for _, r in ok], marker + "-", label=label)
+        ax_n.semilogx(x, [r["newton"] for _, r in ok], marker + "-", label=label)
+    if bad:
+        ax_n.semilogx(bad, [50] * len(bad), "x", color="k", markersize=8)
+
+
+def write_results_page(folder: Path, page: Path) -> Path:
+    """The results page: the bench and stress Markdown of ``folder`` (bench/, stress/) under
+    one heading, headings demoted one level and image links made relative to the page."""
+    folder, page = Path(folder), Path(page)
+    parts = ["# contactfx results", "",
+             "Made by `make results` (`contactfx bench` and `contactfx stress`); the CSV files "
+             "beside the plots hold every number.", ""]  # fmt: skip
+    for sub in ("bench", "stress"):
+        md = folder / sub / f"{sub}.md"
+        if not md.exists():
+            raise OSError(f"{md} is missing: run contactfx {sub} --out {folder / sub} first")
+        rel = os.path.relpath(folder / sub, page.parent)
+        for line in md.read_text().splitlines():
+            parts.append("#" + line if line.startswith("#") else line.replace("](", f"]({rel}/"))
+        parts.append("")
+    page.write_text("\n".join(parts))
+    return page
+
+
+if __name__ == "__main__":
+    import sys
+
+    print(f"wrote {write_results_page(Path(sys.argv[1]), Path(sys.argv[2]))}")

@@ -1,0 +1,290 @@
+"""``contactfx stress``: the robustness matrix of stiff and extreme cases.
+
+Every case runs with a wall-time limit and becomes one row: converged or failed with the named
+reason, Newton iterations, load cut-backs, the largest penetration (over h), the nodal
+complementarity residual max |g p| (over p_max h), the error against the closed form where one
+exists (which measure is named), and the wall time. A failure is a row, never a crash of the
+command. Axes (see ``cases``): Nitsche gamma0 for theta = 1, 0, -1 (Chouly, Hild & Renard 2015,
+doi:10.1051/m2an/2014046: theta = 1 needs gamma0 large enough, theta = -1 is stable for any
+gamma0), the penalty parameter, Poisson's ratio up to 0.4999 (P1, P2, mixed u-p where
+available), friction mu up to 1, contact onset (zero gap, grazing, clearance, a front crossing
+many element edges), the flat punch's singular edge, one huge load step against many small
+ones, interference (the indenter starts inside the body), and 1 / 2 / 3 ranks.
+
+Outputs (``--out``): stress.csv, stress.md and gamma0.png (error and Newton iterations against
+gamma0, one line per theta).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["StressCase", "cases", "stress_main", "child_env"]
+
+#: the coarse Hertz 2D mesh of the matrix (a is about 4 elements wide per side at depth 1.5e-3)
+_COARSE = {"h_contact": 6e-3, "h_far": 0.2}
+GAMMA0S = (1e-3, 1e-2, 1e-1, 1.0, 10.0, 1e2, 1e3, 1e4)
+
+
+@dataclasses.dataclass(frozen=True)
+class StressCase:
+    """One row of the matrix. ``ranks`` > 0 runs the case as ``mpirun -n ranks`` child
+    process (the parallel axis); 0 runs it in this process on all ranks."""
+
+    id: str
+    axis: str
+    scene: str
+    params: dict
+    numerics: dict
+    quick: bool = False
+    ranks: int = 0
+
+
+def _method_label(num: dict) -> str:
+    m = num.get("method", "nitsche")
+    nodal = " nodal" if num.get("quadrature") == "nodal" else ""
+    if m == "nitsche":
+        return f"nitsche({num.get('theta', 1)}) g0={num.get('gamma0', 10.0):g}{nodal}"
+    if m == "penalty":
+        return f"penalty({num.get('penalty', 10.0):g}){nodal}"
+    return m
+
+
+def cases() -> list[StressCase]:
+    """The whole matrix; ``quick`` marks the fast subset."""
+    from contactfx.scenes import Numerics
+
+    out: list[StressCase] = []
+    hz = dict(_COARSE)
+    for theta in (1, 0, -1):
+        for g in GAMMA0S:
+            out.append(StressCase(f"gamma0 theta={theta} g0={g:g}", "gamma0", "hertz2d", hz,
+                                  {"method": "nitsche", "theta": theta, "gamma0": g},
+                                  quick=g in (1e-3, 10.0, 1e4)))  # fmt: skip
+    for g in GAMMA0S:
+        out.append(StressCase(f"gamma0 theta=1 g0={g:g} nodal", "gamma0, nodal quadrature",
+                              "hertz2d", hz, {"method": "nitsche", "theta": 1, "gamma0": g,
+                                              "quadrature": "nodal"}, quick=g == 1e4))  # fmt: skip
+    for k in (1.0, 10.0, 1e2, 1e3, 1e4):
+        num = {"method": "penalty", "penalty": k}
+        out.append(StressCase(f"penalty {k:g}", "penalty", "hertz2d", hz, num,
+                              quick=k in (10.0, 1e4)))  # fmt: skip
+    mixed = "formulation" in {f.name for f in dataclasses.fields(Numerics)}
+    for nu in (0.3, 0.49, 0.4999):
+        variants = [("P1", {"degree": 1}), ("P2", {"degree": 2})]
+        if mixed:
+            variants.append(("P2/P1 mixed u-p", {"degree": 2, "formulation": "mixed-up"}))
+        for name, extra in variants:
+            out.append(StressCase(f"nu={nu:g} {name}", "Poisson ratio", "hertz2d",
+                                  {**hz, "nu": nu}, {"method": "nitsche", **extra},
+                                  quick=nu == 0.4999 and name != "P2"))  # fmt: skip
+    if "layer_E" in {f.name for f in dataclasses.fields(_scene("hertz2d").Params)}:
+        for ratio in (1.0, 1e3, 1e6, 1e-3, 1e-6):
+            layer = {"layer_thickness": 0.02, "layer_E": 1000.0 / ratio}
+            kind = "soft layer" if ratio > 1 else "stiff layer" if ratio < 1 else "same"
+            out.append(StressCase(f"E/E_layer={ratio:g} ({kind})", "stiffness contrast",
+                                  "hertz2d", {**hz, **layer}, {"method": "nitsche"},
+                                  quick=ratio == 1e6))  # fmt: skip
+    for mu in (0.0, 0.3, 0.6, 1.0):
+        for method in ({"method": "nitsche"}, {"method": "al-ssn"}):
+            out.append(StressCase(f"mu={mu:g} {method['method']}", "friction", "sliding-block",
+                                  {"h": 0.1}, {**method, "friction": "coulomb", "mu": mu},
+                                  quick=mu == 1.0 and method["method"] == "nitsche"))  # fmt: skip
+    onset = [
+        ("zero initial gap, 1 step", {}, {"steps": 1}, True),
+        ("grazing (a ~ h/2)", {"depth": 2e-5}, {"steps": 1}, True),
+        ("clearance 1e-3, 4 steps", {"gap0": 1e-3}, {"steps": 4}, False),
+        ("front crossing edges, 20 steps", {}, {"steps": 20}, False),
+    ]
+    for name, params, num, quick in onset:
+        out.append(StressCase(name, "contact onset", "hertz2d", {**hz, **params},
+                              {"method": "nitsche", **num}, quick=quick))  # fmt: skip
+    for method in ("nitsche", "al-ssn"):
+        out.append(StressCase(f"flat punch edge, {method}", "corners", "punch2d", {},
+                              {"method": method}, quick=method == "nitsche"))  # fmt: skip
+    for method in ({"method": "nitsche"}, {"method": "penalty", "penalty": 100.0},
+                   {"method": "al-ssn"}):  # fmt: skip
+        for steps in (1, 20):
+            out.append(StressCase(f"depth 1.5e-2 in {steps} step(s), {method['method']}",
+                                  "load steps", "hertz2d", {**hz, "depth": 1.5e-2},
+                                  {**method, "steps": steps},
+                                  quick=steps == 1 and method["method"] == "nitsche"))  # fmt: skip
+    for method in ("nitsche", "al-ssn"):
+        out.append(StressCase(f"interference gap0=-3e-3, {method}", "initial penetration",
+                              "hertz2d", {**hz, "gap0": -3e-3}, {"method": method, "steps": 4},
+                              quick=method == "nitsche"))  # fmt: skip
+    for ranks in (1, 2, 3):
+        out.append(StressCase(f"{ranks} rank(s)", "parallel", "hertz2d", hz,
+                              {"method": "nitsche"}, quick=ranks < 3, ranks=ranks))  # fmt: skip
+    return out
+
+
+def _scene(name: str):
+    from contactfx.scenes import SCENES
+
+    return SCENES[name]
+
+
+def _primary_error(data: dict) -> tuple[str, float]:
+    """The case's error against the closed form: pressure in L2 on the contact boundary, else
+    the punch's normalised pressure, else the gross-slip force, else the force."""
+    for name, section, key in (
+        ("p L2", "errors", "pressure_L2_rel"),
+        ("punch p", "scores", "normalised_pressure_error"),
+        ("Q = mu P", "reference", "Q_rel_error"),
+        ("force", "reference", "force_rel_error"),
+    ):
+        value = data.get(section, {}).get(key)
+        if value is not None:
+            return name, float(value)
+    return "", float("nan")
+
+
+def _row(case: StressCase, data: dict | None, error: str, wall: float) -> dict:
+    row = {"axis": case.axis, "case": case.id, "method": _method_label(case.numerics)}
+    if data is None:
+        status = "time limit" if "time limit" in error else "failed"
+        return {**row, "status": status, "reason": error, "time": wall}
+    measure, value = _primary_error(data)
+    h = data["h_contact"]
+    p0 = max(data["peak_pressure"], 1e-300)
+    row.update(
+        status="converged", reason="", newton=data["newton_iterations"],
+        cutbacks=sum(s["cutbacks"] for s in data["steps"]),
+        penetration_over_h=abs(data["max_penetration"]) / h,
+        complementarity=data["complementarity"] / (p0 * h),
+        error_measure=measure, error=value,
+        p0_error=data.get("reference", {}).get("p0_rel_error", float("nan")),
+        force=data["force"], time=wall,
+    )  # fmt: skip
+    return row
+
+
+def run_in_process(case: StressCase, comm, limit: float) -> dict:
+    from contactfx.solvers.snes import ConvergenceError, time_limit
+
+    scene_cls = _scene(case.scene)
+    t0 = time.perf_counter()
+    try:
+        scene = scene_cls(scene_cls.Params(**case.params))
+        num = scene_cls.default_numerics(**case.numerics)
+        with time_limit(limit):
+            data = scene.run(num, comm=comm, verbose=False).data
+    except (ConvergenceError, ValueError) as err:
+        return _row(case, None, str(err), time.perf_counter() - t0)
+    return _row(case, data, "", time.perf_counter() - t0)
+
+
+def child_env() -> dict[str, str]:
+    """Environment for a child mpirun: none of this process's MPI singleton state, root and
+    oversubscription allowed, one thread per rank."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
+    env.update(
+        OMPI_ALLOW_RUN_AS_ROOT="1",
+        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+        OMPI_MCA_rmaps_base_oversubscribe="1",
+        PRTE_MCA_rmaps_default_mapping_policy=":oversubscribe",
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+    )
+    return env
+
+
+def run_child(case: StressCase, limit: float) -> dict:
+    """``mpirun -n ranks contactfx run ...`` with a timeout; the row from its run.json."""
+    args = [f"--{k.replace('_', '-')}={v}" for k, v in {**case.params, **case.numerics}.items()]
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="contactfx-stress-") as tmp:
+        cmd = ["mpirun", "-n", str(case.ranks), sys.executable, "-m", "contactfx", "run",
+               case.scene, *args, "--quiet", "--out", tmp]  # fmt: skip
+        try:
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=limit,
+                                  env=child_env())  # fmt: skip
+        except subprocess.TimeoutExpired:
+            return _row(case, None, "time limit exceeded", time.perf_counter() - t0)
+        except OSError as err:
+            return _row(case, None, f"cannot launch mpirun: {err}", time.perf_counter() - t0)
+        wall = time.perf_counter() - t0
+        lines = (proc.stderr.strip() or proc.stdout.strip() or "no output").splitlines()
+        if proc.returncode != 0:
+            return _row(case, None, lines[-1], wall)
+        data = json.loads((Path(tmp) / "run.json").read_text())
+    return _row(case, data, "", wall)
+
+
+def _parser():
+    from contactfx.cli import _Parser
+
+    p = _Parser(prog="contactfx stress", description="robustness matrix of extreme cases")
+    p.add_argument("--quick", action="store_true", help="the fast subset of the matrix")
+    p.add_argument("--axis", default=None, help="comma-separated axes to run (default all)")
+    p.add_argument("--time-limit", type=float, default=120.0,
+                   help="wall-time limit per case [s] (default 120)")  # fmt: skip
+    p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNG")
+    return p
+
+
+def stress_main(argv: list[str], petsc_options: dict, comm) -> int:
+    ns = _parser().parse_args(argv)
+    if not ns.time_limit > 0:
+        raise ValueError(f"--time-limit must be > 0, got {ns.time_limit}")
+    selected = [c for c in cases() if c.quick or not ns.quick]
+    if ns.axis is not None:
+        axes = [a.strip() for a in ns.axis.split(",")]
+        known = sorted({c.axis for c in cases()})
+        for a in axes:
+            if a not in known:
+                raise ValueError(f"unknown axis '{a}' (known: {', '.join(known)})")
+        selected = [c for c in selected if c.axis in axes]
+    rows: list[dict] = []
+    reference_force = None  # the parallel axis compares with its 1-rank run
+    started = time.perf_counter()
+    for case in selected:
+        if case.ranks == 0:
+            row = run_in_process(case, comm, ns.time_limit)
+        elif comm.size > 1:
+            row = _row(case, None, "", 0.0)
+            row.update(status="n/a", reason="child mpirun runs only from a serial stress run")
+        else:
+            row = run_child(case, ns.time_limit)
+        if case.axis == "parallel" and row["status"] == "converged":
+            if case.ranks == 1:
+                reference_force = row["force"]
+            if reference_force is not None:
+                row["error_measure"] = "force vs 1 rank"
+                row["error"] = abs(row["force"] - reference_force) / reference_force
+        rows.append(row)
+        if comm.rank == 0:
+            print(_format(row), flush=True)
+    if comm.rank == 0:
+        total = time.perf_counter() - started
+        failed = sum(r["status"] not in ("converged", "n/a") for r in rows)
+        print(f"stress: {len(rows)} cases, {failed} not converged, {total:.0f} s")
+        if ns.out is not None:
+            from contactfx.validation.report import write_stress
+
+            for path in write_stress(rows, ns.out, comm.size, total):
+                print(f"wrote {path}")
+    comm.barrier()
+    return 0
+
+
+def _format(row: dict) -> str:
+    head = f"{row['axis']:>19s} | {row['case']:<38s}"
+    if row["status"] != "converged":
+        return f"{head} {row['status'].upper()}: {row['reason']}"
+    err = f"{row['error_measure']} {row['error']:.2e}" if np.isfinite(row["error"]) else ""
+    return (
+        f"{head} newton {row['newton']:3d} cutbacks {row['cutbacks']} pen/h "
+        f"{row['penetration_over_h']:.1e} |gp|/(p0 h) {row['complementarity']:.1e} {err} "
+        f"{row['time']:.1f} s"
+    )
