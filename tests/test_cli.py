@@ -51,6 +51,14 @@ BAD = [
     (["run", "sliding-block", "--method", "penalty"], "not supported by method 'penalty'"),
     (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
     (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),
+    (["run", "hertz2d", "--quadrature", "nodal", "--degree", "2"], "--quadrature nodal needs"),
+    (["bench", "--scene", "nosuch"], "unknown bench case 'nosuch'"),
+    (["bench", "--method", "magic"], "unknown method 'magic'"),
+    (["bench", "--method", "penalty@x"], "'x' is not a number"),
+    (["bench", "--levels", "0"], "--levels must be >= 1"),
+    (["bench", "--degree", "3"], "--degree must list 1 and/or 2"),
+    (["stress", "--axis", "nosuch"], "unknown axis 'nosuch'"),
+    (["stress", "--time-limit", "-1"], "--time-limit must be > 0"),
 ]
 
 
@@ -99,10 +107,11 @@ def test_module_entry_point_westergaard():
     assert "0.25" in res.stdout  # a / lambda = 0.25 (asserted precisely in verification)
 
 
-def test_bench_smoke(tmp_path):
-    res = run_cli("bench", "hertz2d", "--levels", "1", "--out", str(tmp_path), *[],
-                  timeout=300)  # fmt: skip
+def test_bench_command_line(tmp_path):
+    """The bench entry point end to end (positional case, method list, CSV written)."""
+    res = run_cli("bench", "hertz2d", "--method", "nitsche@-1,penalty@100", "--levels", "1",
+                  "--out", str(tmp_path), timeout=300)  # fmt: skip
     assert res.returncode == 0, res.stderr
-    assert "contact_over_linear" in res.stdout
+    assert "nitsche(-1)" in res.stdout and "penalty(100)" in res.stdout
     rows = (tmp_path / "bench.csv").read_text().splitlines()
-    assert rows[0].startswith("level,method,h,dofs") and len(rows) == 2
+    assert rows[0].startswith("case,method,degree,level,h") and len(rows) == 3

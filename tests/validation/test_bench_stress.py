@@ -1,0 +1,120 @@
+"""contactfx bench and contactfx stress: outputs well formed, every method converging on the
+default cases, optimal observed rates on Westergaard full contact, failures as rows.
+
+Run in-process, so also under ``mpirun -n 2`` (rank 0 writes; the folder is rank 0's)."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import pytest
+from mpi4py import MPI
+
+from contactfx.validation.bench import CASES, bench_main, observed_rates, run_case
+from contactfx.validation.stress import stress_main
+
+COMM = MPI.COMM_WORLD
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture
+def shared_dir(tmp_path):
+    return COMM.bcast(tmp_path, root=0)
+
+
+def _read_csv(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+@pytest.mark.parametrize("case", ["hertz2d", "westergaard-partial", "punch2d", "sliding-block"])
+def test_every_method_converges_on_default_case(case):
+    """Each method with the scene's default numerics on the coarsest bench mesh: converged,
+    or not applicable (friction with penalty / vi) - never failed."""
+    for method in ("nitsche", "penalty", "al-uzawa", "al-ssn", "vi"):
+        row, _, _ = run_case(case, method, {"method": method}, 1, 0, COMM)
+        assert row["status"] in ("ok", "n/a"), (case, method, row["reason"])
+        if case == "sliding-block" and method in ("penalty", "vi"):
+            assert row["status"] == "n/a"
+        else:
+            assert row["status"] == "ok"
+            assert row["newton"] > 0 and row["dofs"] > 0
+
+
+def test_bench_outputs_well_formed(shared_dir):
+    argv = ["--scene", "hertz2d,westergaard-full", "--method", "nitsche@1,al-ssn",
+            "--levels", "2", "--out", str(shared_dir)]  # fmt: skip
+    assert bench_main(argv, {}, COMM) == 0
+    if COMM.rank == 0:
+        rows = _read_csv(shared_dir / "bench.csv")
+        assert len(rows) == 2 * 2 * 2  # cases x methods x levels
+        for r in rows:
+            assert r["status"] == "ok"
+            assert int(r["dofs"]) > 0 and int(r["newton"]) > 0
+            times = [float(r[k]) for k in ("t_mesh", "t_compile", "t_assembly", "t_solve")]
+            assert all(t >= 0.0 for t in times)
+            assert 0.0 < float(r["err_p_L2"]) < 1.0
+        md = (shared_dir / "bench.md").read_text()
+        assert "## hertz2d" in md and "## westergaard-full" in md and "Observed rates" in md
+        for name in ("hertz2d_p_L2_time.png", "hertz2d_a_h.png", "westergaard-full_u_H1_h.png"):
+            assert (shared_dir / name).read_bytes().startswith(PNG)
+
+
+def test_westergaard_full_contact_rates():
+    """Full contact: the exact solution is smooth, P1 must converge at O(h^2) in L2 and O(h)
+    in H1. Levels 1/16 .. 1/64 (uniform); the observed rate between the two finest meshes is
+    within 0.15 of optimal (the pre-asymptotic deviation measured is below 0.05)."""
+    for label, overrides in (("nitsche(1)", {"method": "nitsche", "theta": 1}),
+                             ("nitsche(-1)", {"method": "nitsche", "theta": -1}),
+                             ("al-ssn", {"method": "al-ssn"})):  # fmt: skip
+        rows = [run_case("westergaard-full", label, overrides, 1, level, COMM)[0]
+                for level in (1, 2, 3)]  # fmt: skip
+        assert all(r["status"] == "ok" for r in rows), label
+        _, l2 = observed_rates(rows, "err_u_L2")
+        _, h1 = observed_rates(rows, "err_u_H1")
+        assert abs(l2 - 2.0) <= 0.15, (label, l2)
+        assert abs(h1 - 1.0) <= 0.15, (label, h1)
+
+
+def test_stress_quick_rows(shared_dir):
+    argv = ["--quick", "--axis", "gamma0,initial penetration,parallel", "--out", str(shared_dir)]
+    assert stress_main(argv, {}, COMM) == 0
+    if COMM.rank == 0:
+        rows = _read_csv(shared_dir / "stress.csv")
+        assert {r["axis"] for r in rows} == {"gamma0", "initial penetration", "parallel"}
+        by_case = {r["case"]: r for r in rows}
+        # the standard settings converge; symmetric and skew Nitsche at gamma0 = 10 resolve
+        # the penetration to below 1e-3 h (Nitsche's consistency error at this mesh)
+        for theta in (1, 0, -1):
+            r = by_case[f"gamma0 theta={theta} g0=10"]
+            assert r["status"] == "converged"
+            assert float(r["penetration_over_h"]) < 1e-3
+        for r in rows:
+            assert r["status"] in ("converged", "failed", "time limit", "n/a")
+            if r["status"] == "converged":
+                assert math.isfinite(float(r["error"])) and int(r["newton"]) >= 0
+        if COMM.size == 1:  # the parallel axis launches mpirun children from a serial run
+            r = by_case["2 rank(s)"]
+            assert r["status"] == "converged"
+            assert float(r["error"]) < 1e-8  # force on 2 ranks vs 1: solver tolerance
+        assert (shared_dir / "gamma0.png").read_bytes().startswith(PNG)
+        assert "## gamma0" in (shared_dir / "stress.md").read_text()
+
+
+def test_stress_time_limit_is_a_row(shared_dir):
+    """A case over its time limit is a row with its reason; the command still completes."""
+    argv = ["--axis", "load steps", "--time-limit", "0.01", "--out", str(shared_dir)]
+    assert stress_main(argv, {}, COMM) == 0
+    if COMM.rank == 0:
+        rows = _read_csv(shared_dir / "stress.csv")
+        assert len(rows) == 6
+        assert all(r["status"] == "time limit" for r in rows), [r["reason"] for r in rows]
+
+
+def test_bench_cases_have_mesh_sizes():
+    from contactfx.scenes import SCENES
+
+    for name, case in CASES.items():
+        params = SCENES[case.scene].Params(**case.params)
+        assert any(f == "h" or f.startswith("h_") for f in vars(params)), name
