@@ -30,11 +30,15 @@ __all__ = ["Elastic"]
 class Elastic:
     """Isotropic linear-elastic material.
 
-    E: Young's modulus (stress units, > 0); nu: Poisson's ratio in (-1, 0.5).
+    E: Young's modulus (stress units, > 0); nu: Poisson's ratio in (-1, 0.5). modulus: optional
+    field of Young's modulus over the mesh (a UFL expression, e.g. a DG0 Function) that replaces
+    E in the stress of a heterogeneous (layered) body; E stays the reference modulus of the
+    closed forms, and the properties mu, lmbda, E_star, M are its floats.
     """
 
     E: float
     nu: float
+    modulus: object = None
 
     def __post_init__(self) -> None:
         if not self.E > 0.0:
@@ -60,21 +64,28 @@ class Elastic:
         """Oedometric (uniaxial-strain) modulus E (1 - nu) / ((1 + nu)(1 - 2 nu))."""
         return self.E * (1.0 - self.nu) / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
+    def _moduli(self):
+        """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""
+        E = self.E if self.modulus is None else self.modulus
+        nu = self.nu
+        return E, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
     def sigma(self, u, p=None):
         """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
         (p the pressure -lambda div u): 2 mu eps(u) - p I."""
+        E, mu, lmbda = self._moduli()
         eps = ufl.sym(ufl.grad(u))
         identity = ufl.Identity(ufl.shape(eps)[0])
         if p is not None:
-            return 2.0 * self.mu * eps - p * identity
+            return 2.0 * mu * eps - p * identity
         if ufl.shape(eps) == (1, 1):
-            return self.E * eps
-        return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * identity
+            return E * eps
+        return 2.0 * mu * eps + lmbda * ufl.tr(eps) * identity
 
     def pressure_law(self, u, p, q):
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u
         tested with q (mixed u-p formulation; needs lambda > 0)."""
-        return -(ufl.div(u) + p / self.lmbda) * q
+        return -(ufl.div(u) + p / self._moduli()[2]) * q
 
     def von_mises(self, u, p=None):
         """von Mises stress of u, or of the mixed pair (u, p)."""

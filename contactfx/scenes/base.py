@@ -185,6 +185,16 @@ class Scene:
         """Return (mesh, facet_tags)."""
         raise NotImplementedError
 
+    def modulus(self, mesh):
+        """Young's modulus as a field over ``mesh`` (UFL) for a heterogeneous body, or None for
+        the homogeneous ``material().E``."""
+        return None
+
+    def contact_modulus(self) -> float:
+        """Young's modulus of the material at the contact surface: it scales the methods'
+        parameters (gamma_N = gamma0 E / h, kappa, r)."""
+        return self.material().E
+
     contact_tag: ClassVar[int]
 
     def obstacle(self) -> Obstacle:
@@ -285,6 +295,9 @@ class _Run:
         t0 = time.perf_counter()
         mesh, facet_tags = scene.build_mesh(comm)
         self.timings["mesh"] = time.perf_counter() - t0
+        modulus = scene.modulus(mesh)
+        if modulus is not None:
+            material = dataclasses.replace(material, modulus=modulus)
         gdim = mesh.geometry.dim
         fdim = mesh.topology.dim - 1
         if num.method == "al-uzawa" and fdim == 0:
@@ -342,7 +355,8 @@ class _Run:
             )
             lam = multiplier
         surface = ContactSurface(
-            u, v, dsc, obstacle, offset, material.sigma(u, p), material.sigma(v, q), material.E, h,
+            u, v, dsc, obstacle, offset, material.sigma(u, p), material.sigma(v, q),
+            scene.contact_modulus(), h,
             friction=friction,
             u_prev=None if prev is None else (ufl.split(prev)[0] if split else prev),
             offset_prev=offset_prev, ds_nodal=ds_nodal, multiplier=lam, multiplier_test=lam_test,
