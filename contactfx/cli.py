@@ -116,7 +116,8 @@ def _table(data: dict) -> str:
     method = num["method"] + (f" theta={num['theta']}" if num["method"] == "nitsche" else "")
     rows = [
         ("scene", data["scene"]),
-        ("method", f"{method}, P{num['degree']}"),
+        ("method", f"{method}, " + (
+            "P2/P1 mixed u-p" if num["formulation"] == "mixed-up" else f"P{num['degree']}")),
         ("dofs / ranks", f"{data['dofs']} / {data['ranks']}"),
         ("load steps / Newton / KSP", f"{len(data['steps'])} / {data['newton_iterations']} / "
          f"{data['ksp_iterations']}"),

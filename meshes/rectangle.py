@@ -5,7 +5,9 @@ indenter touches an elastic block (Hertz, punch and ironing benchmarks). The ele
 ``h_contact`` within the distance ``(refine_x1 - refine_x0) / 2`` of the zone and grows linearly
 with the distance, by ``grading`` per unit distance, up to ``h_far`` (see
 :func:`contactfx.meshes._build.set_graded_size`). ``h_contact == h_far`` gives a uniform mesh for
-convergence studies. Meshing: OpenCASCADE geometry, Frontal-Delaunay triangulation (gmsh
+convergence studies. Optional horizontal ``interfaces`` y = const cut the rectangle into
+layers (OpenCASCADE boolean fragment): the interface lines are mesh lines, so that no cell crosses
+a material interface. Meshing: OpenCASCADE geometry, Frontal-Delaunay triangulation (gmsh
 ``Mesh.Algorithm`` 6), linear triangles.
 
 Physical groups: the cells are tagged :attr:`RectangleCells.DOMAIN`, the four edges
@@ -60,6 +62,7 @@ def rectangle(
     h_contact: float,
     h_far: float,
     grading: float = 0.3,
+    interfaces: tuple[float, ...] = (),
 ) -> None:
     """Build and mesh the rectangle [x0, x1] x [y0, y1] in ``model`` (a gmsh builder).
 
@@ -71,6 +74,8 @@ def rectangle(
         h_contact: Element size in and near the contact zone (length).
         h_far: Element size far from the contact zone, >= h_contact (length).
         grading: Size increase per unit distance from the contact zone (dimensionless).
+        interfaces: Heights y0 < y < y1 of horizontal lines across the rectangle that the mesh
+            must resolve (material interfaces of a layered block; length).
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -86,8 +91,18 @@ def rectangle(
     check_less_equal("refine_x1", refine_x1, "x1", x1)
     check_positive(h_contact=h_contact, h_far=h_far, grading=grading)
     check_less_equal("h_contact", h_contact, "h_far", h_far)
+    for y in interfaces:
+        check_finite(interface=y)
+        check_less("y0", y0, "interface", y)
+        check_less("interface", y, "y1", y1)
 
-    model.occ.addRectangle(x0, y0, 0.0, x1 - x0, y1 - y0)
+    surface = model.occ.addRectangle(x0, y0, 0.0, x1 - x0, y1 - y0)
+    lines = [
+        (1, model.occ.addLine(model.occ.addPoint(x0, y, 0.0), model.occ.addPoint(x1, y, 0.0)))
+        for y in interfaces
+    ]
+    if lines:
+        model.occ.fragment([(2, surface)], lines)
     model.occ.synchronize()
     add_physical_groups(
         model,

@@ -3,7 +3,6 @@ tangential stress on a surface."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import ufl
@@ -25,9 +24,11 @@ class ContactSurface:
 
     u: displacement (a dolfinx Function or a UFL component of a mixed one); v: its test
     function; ds: measure restricted to the candidate contact facets; obstacle and its rigid
-    displacement ``offset`` (a dolfinx Constant vector, part of the load program); sigma: the
-    stress function w -> sigma(w); E: Young's modulus used to scale the method parameters;
-    h: local mesh size (UFL).
+    displacement ``offset`` (a dolfinx Constant vector, part of the load program); stress: the
+    stress tensor of the state, sigma(u) (or sigma(u, p) = 2 mu eps(u) - p I in the mixed u-p
+    formulation), and stress_test the same expression of the test functions, sigma(v) (or
+    sigma(v, q)), linear in them; E: Young's modulus of the material at the contact surface,
+    used to scale the method parameters; h: local mesh size (UFL).
 
     Friction (only when ``friction`` is not None): ``u_prev`` and ``offset_prev`` are the
     displacement and the obstacle offset of the last converged load step; the slip increment
@@ -42,7 +43,8 @@ class ContactSurface:
     ds: ufl.Measure
     obstacle: Obstacle
     offset: object
-    sigma: Callable
+    stress: object
+    stress_test: object
     E: float
     h: object
     friction: Friction | None = None
@@ -75,13 +77,15 @@ class ContactSurface:
         """n(u) = -grad phi at x + u - offset: outward normal of the body at contact."""
         return self.obstacle.normal(self.position(w))
 
-    def sigma_n(self, w, n):
-        """Normal stress n . sigma(w) n (< 0 in compression)."""
-        return ufl.dot(n, ufl.dot(self.sigma(w), n))
+    @staticmethod
+    def sigma_n(stress, n):
+        """Normal stress n . stress n (< 0 in compression)."""
+        return ufl.dot(n, ufl.dot(stress, n))
 
-    def sigma_t(self, w, n):
-        """Tangential traction (I - n n) sigma(w) n."""
-        return tangential(ufl.dot(self.sigma(w), n), n)
+    @staticmethod
+    def sigma_t(stress, n):
+        """Tangential traction (I - n n) stress n."""
+        return tangential(ufl.dot(stress, n), n)
 
     def slip_increment(self, n):
         """Tangential displacement of the body relative to the obstacle since the last

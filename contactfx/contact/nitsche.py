@@ -15,6 +15,10 @@ the threshold for Tresca) and the traction on the body t(u) = -P_n n + P_T, the 
 (Chouly, Hild & Renard 2015, doi:10.1090/S0025-5718-2014-02913-X, frictionless; Chouly 2014,
 doi:10.1016/j.jmaa.2013.10.046, Tresca; Chouly, Hild, Lleras & Renard 2022,
 doi:10.1016/j.cam.2022.114557, Coulomb). theta = 1 symmetric, 0 incomplete, -1 skew.
+sigma(u) and sigma(v) are the stresses of the state and of the test functions
+(``ContactSurface.stress`` / ``stress_test``): in the mixed u-p formulation sigma(u, p) =
+2 mu eps(u) - p I and sigma(v, q) with the pressure test function q, which keeps the method
+consistent (the exact (u, p) satisfies R = 0 for every theta).
 Without friction only the normal terms are built. Here gamma_N = gamma0 E / h with gamma0
 dimensionless and large = strong. The papers write gamma = gamma0' h / E (small = strong):
 gamma0' = 1 / gamma0. GetFEM 5.4 uses gamma0_GetFEM / h with gamma0_GetFEM = gamma0 E;
@@ -53,11 +57,11 @@ class Nitsche:
 
     def pressure(self, s: ContactSurface):
         n = s.normal()
-        return positive_part(-s.sigma_n(s.u, n) - self.gamma(s) * s.gap())
+        return positive_part(-s.sigma_n(s.stress, n) - self.gamma(s) * s.gap())
 
     def _trial_t(self, s: ContactSurface):
         n = s.normal()
-        return s.sigma_t(s.u, n) - self.gamma(s) * s.slip_increment(n)
+        return s.sigma_t(s.stress, n) - self.gamma(s) * s.slip_increment(n)
 
     def tangential_traction(self, s: ContactSurface):
         return ball_projection(self._trial_t(s), s.friction.bound(self.pressure(s)), s.E)
@@ -70,17 +74,17 @@ class Nitsche:
     def residual(self, s: ContactSurface):
         n = s.normal()
         gamma = self.gamma(s)
-        sn_u = s.sigma_n(s.u, n)
-        sn_v = s.sigma_n(s.v, n)
+        sn_u = s.sigma_n(s.stress, n)
+        sn_v = s.sigma_n(s.stress_test, n)
         p = self.pressure(s)
         form = p * (ufl.dot(s.v, n) - self.theta / gamma * sn_v) * s.ds
         if self.theta != 0:
             form -= self.theta / gamma * sn_u * sn_v * s.ds
         if s.friction is not None:
-            st_v = s.sigma_t(s.v, n)
+            st_v = s.sigma_t(s.stress_test, n)
             t_T = self.tangential_traction(s)
             # t_T is tangential: t_T . v = t_T . (I - n n) v
             form -= ufl.dot(t_T, s.v - self.theta / gamma * st_v) * s.ds
             if self.theta != 0:
-                form -= self.theta / gamma * ufl.dot(s.sigma_t(s.u, n), st_v) * s.ds
+                form -= self.theta / gamma * ufl.dot(s.sigma_t(s.stress, n), st_v) * s.ds
         return form

@@ -3,6 +3,18 @@
 sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I with eps(u) = sym(grad u). In 2D the plane-strain
 state is meant: the in-plane Lame formula is exact and sigma_zz = lambda tr(eps) enters only the
 von Mises stress. In 1D (a bar of unit cross-section) sigma = E eps.
+
+Mixed displacement-pressure (u-p) formulation for near-incompressible materials (nu -> 1/2,
+lambda -> infinity), where the displacement formulation locks: the pressure p = -lambda div u
+is a second unknown, the stress is sigma(u, p) = 2 mu eps(u) - p I (plane strain: sigma_zz =
+-p) and the constitutive law of p is imposed weakly,
+
+    int 2 mu eps(u) : eps(v) - p div v dx - int (div u + p / lambda) q dx = L(v),
+
+a symmetric saddle-point problem whose discrete inf-sup constant does not depend on lambda for
+Taylor-Hood elements (P2 displacement, P1 pressure): Brezzi & Fortin 1991, Mixed and Hybrid
+Finite Element Methods, doi:10.1007/978-1-4612-3172-1; Taylor & Hood 1973,
+doi:10.1016/0045-7930(73)90027-3.
 """
 
 from __future__ import annotations
@@ -18,11 +30,15 @@ __all__ = ["Elastic"]
 class Elastic:
     """Isotropic linear-elastic material.
 
-    E: Young's modulus (stress units, > 0); nu: Poisson's ratio in (-1, 0.5).
+    E: Young's modulus (stress units, > 0); nu: Poisson's ratio in (-1, 0.5). modulus: optional
+    field of Young's modulus over the mesh (a UFL expression, e.g. a DG0 Function) that replaces
+    E in the stress of a heterogeneous (layered) body; E stays the reference modulus of the
+    closed forms, and the properties mu, lmbda, E_star, M are its floats.
     """
 
     E: float
     nu: float
+    modulus: object = None
 
     def __post_init__(self) -> None:
         if not self.E > 0.0:
@@ -48,19 +64,37 @@ class Elastic:
         """Oedometric (uniaxial-strain) modulus E (1 - nu) / ((1 + nu)(1 - 2 nu))."""
         return self.E * (1.0 - self.nu) / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
 
-    def sigma(self, u):
-        eps = ufl.sym(ufl.grad(u))
-        if ufl.shape(eps) == (1, 1):
-            return self.E * eps
-        return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * ufl.Identity(ufl.shape(eps)[0])
+    def _moduli(self):
+        """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""
+        E = self.E if self.modulus is None else self.modulus
+        nu = self.nu
+        return E, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
 
-    def von_mises(self, u):
-        s = self.sigma(u)
+    def sigma(self, u, p=None):
+        """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
+        (p the pressure -lambda div u): 2 mu eps(u) - p I."""
+        E, mu, lmbda = self._moduli()
+        eps = ufl.sym(ufl.grad(u))
+        identity = ufl.Identity(ufl.shape(eps)[0])
+        if p is not None:
+            return 2.0 * mu * eps - p * identity
+        if ufl.shape(eps) == (1, 1):
+            return E * eps
+        return 2.0 * mu * eps + lmbda * ufl.tr(eps) * identity
+
+    def pressure_law(self, u, p, q):
+        """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u
+        tested with q (mixed u-p formulation; needs lambda > 0)."""
+        return -(ufl.div(u) + p / self._moduli()[2]) * q
+
+    def von_mises(self, u, p=None):
+        """von Mises stress of u, or of the mixed pair (u, p)."""
+        s = self.sigma(u, p)
         d = ufl.shape(s)[0]
         if d == 1:
             return abs(s[0, 0])
-        if d == 2:  # plane strain: add sigma_zz = nu (sigma_xx + sigma_yy)
-            szz = self.nu * (s[0, 0] + s[1, 1])
+        if d == 2:  # plane strain: add sigma_zz = nu (sigma_xx + sigma_yy), = -p when mixed
+            szz = self.nu * (s[0, 0] + s[1, 1]) if p is None else -p
             dev = s - (s[0, 0] + s[1, 1] + szz) / 3.0 * ufl.Identity(2)
             j2 = 0.5 * (ufl.inner(dev, dev) + (szz - (s[0, 0] + s[1, 1] + szz) / 3.0) ** 2)
         else:

@@ -38,6 +38,10 @@ __all__ = ["param", "SceneParams", "Numerics", "Scene", "RunResult", "METHODS"]
 
 METHODS = ("nitsche", "penalty", "vi", "al-uzawa", "al-ssn")
 FRICTION_LAWS = ("none", "tresca", "coulomb")
+FORMULATIONS = ("displacement", "mixed-up")
+#: methods the mixed u-p formulation supports (al-ssn has its own mixed (u, lambda) space,
+#: vi bounds the displacement dofs of a displacement-only space)
+MIXED_UP_METHODS = ("nitsche", "penalty", "al-uzawa")
 
 
 def param(
@@ -99,6 +103,9 @@ class Numerics:
                             "2k + 2) or nodal (at the vertices, P1 only)",
                             choices=("gauss", "nodal"))  # fmt: skip
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
+    formulation: str = param("displacement", "bulk unknowns: displacement, or mixed-up "
+                             "(Taylor-Hood P2 displacement / P1 pressure, near-incompressible "
+                             "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
 
@@ -129,6 +136,16 @@ class Numerics:
             )
         if self.method == "al-ssn" and self.solver != "lu":
             raise ValueError("method al-ssn is a saddle-point system: use --solver lu")
+        if self.formulation == "mixed-up":
+            if self.degree != 2:
+                raise ValueError("formulation mixed-up is Taylor-Hood P2/P1: use --degree 2")
+            if self.method not in MIXED_UP_METHODS:
+                raise ValueError(
+                    f"formulation mixed-up does not support method {self.method}; use "
+                    + ", ".join(MIXED_UP_METHODS)
+                )
+            if self.solver != "lu":
+                raise ValueError("formulation mixed-up is a saddle-point system: use --solver lu")
 
     def method_object(self):
         if self.method == "nitsche":
@@ -176,6 +193,16 @@ class Scene:
     def build_mesh(self, comm):
         """Return (mesh, facet_tags)."""
         raise NotImplementedError
+
+    def modulus(self, mesh):
+        """Young's modulus as a field over ``mesh`` (UFL) for a heterogeneous body, or None for
+        the homogeneous ``material().E``."""
+        return None
+
+    def contact_modulus(self) -> float:
+        """Young's modulus of the material at the contact surface: it scales the methods'
+        parameters (gamma_N = gamma0 E / h, kappa, r)."""
+        return self.material().E
 
     contact_tag: ClassVar[int]
 
@@ -271,12 +298,20 @@ class _Run:
         obstacle = scene.obstacle()
         method = num.method_object()
         friction = num.friction_law()
+        up = num.formulation == "mixed-up"
+        if up and not material.lmbda > 0.0:
+            raise ValueError(
+                f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = {material.nu}"
+            )
         if self.out is not None:
             _prepare_output(self.out, comm)
 
         t0 = time.perf_counter()
         mesh, facet_tags = scene.build_mesh(comm)
         self.timings["mesh"] = time.perf_counter() - t0
+        modulus = scene.modulus(mesh)
+        if modulus is not None:
+            material = dataclasses.replace(material, modulus=modulus)
         gdim = mesh.geometry.dim
         fdim = mesh.topology.dim - 1
         if num.method == "al-uzawa" and fdim == 0:
@@ -286,25 +321,29 @@ class _Run:
             )
         contact_facets = facet_tags.indices[facet_tags.values == scene.contact_tag]
 
-        # unknowns: the displacement, or (displacement, multiplier) for al-ssn
+        # unknowns: the displacement, or (displacement, P1 field) with the field the contact
+        # multiplier (al-ssn) or the pressure (mixed u-p formulation)
         mixed = method is not None and method.mixed
+        split = mixed or up
         mult_shape = (gdim,) if friction is not None else ()
-        lam = lam_test = None
-        if mixed:
-            W = _compat.mixed_space(mesh, num.degree, gdim, mult_shape)
+        extra = extra_trial = extra_test = None
+        if split:
+            W = _compat.mixed_space(mesh, num.degree, gdim, mult_shape if mixed else ())
             V = W.sub(0)
             V_out, out_map = V.collapse()
             state = dolfinx.fem.Function(W, name="state")
             displacement = dolfinx.fem.Function(V_out, name="displacement")
             trial, test = ufl.TrialFunction(W), ufl.TestFunction(W)
-            u, lam = ufl.split(state)
-            du, v = ufl.split(trial)[0], ufl.split(test)[0]
-            lam_test = ufl.split(test)[1]
+            u, extra = ufl.split(state)
+            du, extra_trial = ufl.split(trial)
+            v, extra_test = ufl.split(test)
         else:
             V = _compat.function_space(mesh, "Lagrange", num.degree, (gdim,))
             state = displacement = u = dolfinx.fem.Function(V, name="displacement")
             trial, test = ufl.TrialFunction(V), ufl.TestFunction(V)
             du, v = trial, test
+        lam, lam_test = (extra, extra_test) if mixed else (None, None)
+        p, dp, q = (extra, extra_trial, extra_test) if up else (None, None, None)
         bcs = scene.dirichlet(V, facet_tags)
         if mixed:
             bcs += _multiplier_bc(W, fdim, contact_facets, mult_shape)
@@ -333,14 +372,17 @@ class _Run:
             )
             lam = multiplier
         surface = ContactSurface(
-            u, v, dsc, obstacle, offset, material.sigma, material.E, h,
+            u, v, dsc, obstacle, offset, material.sigma(u, p), material.sigma(v, q),
+            scene.contact_modulus(), h,
             friction=friction,
-            u_prev=None if prev is None else (ufl.split(prev)[0] if mixed else prev),
+            u_prev=None if prev is None else (ufl.split(prev)[0] if split else prev),
             offset_prev=offset_prev, ds_nodal=ds_nodal, multiplier=lam, multiplier_test=lam_test,
         )  # fmt: skip
 
         t0 = time.perf_counter()
-        a_ufl = ufl.inner(material.sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx
+        a_ufl = ufl.inner(material.sigma(du, dp), ufl.sym(ufl.grad(v))) * ufl.dx
+        if up:
+            a_ufl += material.pressure_law(du, dp, q) * ufl.dx
         if mixed:  # a zero coupling of every component in every cell: the Jacobian's pattern
             zero = dolfinx.fem.Constant(mesh, 0.0)
             n_comp = ufl.shape(trial)[0]
@@ -360,7 +402,8 @@ class _Run:
             Fc_ufl = method.residual(surface)
             F_c = dolfinx.fem.form(Fc_ufl)
             J_c = dolfinx.fem.form(ufl.derivative(Fc_ufl, state, trial))
-        post = _PostProcessor(mesh, scene, num, surface, method, dsc, dsc_fine, material)
+        post = _PostProcessor(mesh, scene, num, surface, method, dsc, dsc_fine,
+                              material.von_mises(u, p))  # fmt: skip
         update = None
         if multiplier is not None:
             update = _compat.expression(method.update(surface), multiplier.function_space)
@@ -394,7 +437,7 @@ class _Run:
                 bounds.update(offset.value)
                 solver.set_bounds(bounds.lower, bounds.upper)
 
-        scene.initial_guess(state.sub(0) if mixed else state, 1.0 / num.steps)
+        scene.initial_guess(state.sub(0) if split else state, 1.0 / num.steps)
         steps_log: list[dict] = []
         xdmf_path = None if self.out is None else self.out / f"{scene.name}.xdmf"
         last: dict[str, Any] = {}
@@ -422,7 +465,7 @@ class _Run:
             steps_log.append(entry)
             if writer is not None:
                 t_out = time.perf_counter()
-                if mixed:
+                if split:
                     displacement.x.array[:] = state.x.array[out_map]
                 writer.write(rec.load, post.fields(displacement))
                 self.timings["output"] = self.timings.get("output", 0.0) + (
@@ -463,7 +506,7 @@ class _Run:
 
         summary = last
         dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-        if mixed:
+        if split:
             dofs = state.function_space.dofmap.index_map.size_global
         data: dict[str, Any] = {
             "status": "completed",
@@ -607,7 +650,7 @@ class _PostProcessor:
     errors, compiled once."""
 
     def __init__(self, mesh, scene, num, surface: ContactSurface, method, dsc, dsc_fine,
-                 material):  # fmt: skip
+                 von_mises):  # fmt: skip
         self.scene, self.num, self.surface, self.method = scene, num, surface, method
         self.mesh, self.dsc_fine = mesh, dsc_fine
         gdim = mesh.geometry.dim
@@ -623,7 +666,7 @@ class _PostProcessor:
         self.status = dolfinx.fem.Function(Q1, name="contact_status")
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
-        self.vm_expr = _compat.expression(material.von_mises(u), DG0)
+        self.vm_expr = _compat.expression(von_mises, DG0)
         self.gap_expr = _compat.expression(surface.gap(), Q1)
         self.mass1 = _assemble_vec(dolfinx.fem.form(q * dsc))
         n = surface.normal()

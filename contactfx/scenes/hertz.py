@@ -8,15 +8,22 @@ changes the force-depth relation, not a and p0 at given P; BENCHMARKS.md section
     3D: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2)
 
 (Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, sections 4.2 and 5.2).
+
+The 2D block may carry a bonded top layer -layer_thickness < y < 0 of Young's modulus layer_E
+(same Poisson's ratio; the mesh resolves the interface). With layer_E != E the half-space
+closed form does not apply (the contact then depends on a / layer_thickness and on the modulus
+contrast) and the scene reports no reference.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import dolfinx
 import numpy as np
 import ufl
 
+from contactfx import _compat
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
@@ -84,11 +91,21 @@ class Hertz2DParams(SceneParams):
                          "(needs friction)", nonnegative=True)  # fmt: skip
     gap0: float = param(0.0, "initial clearance of the indenter at load 0 (< 0: interference; "
                         "the final position is still -depth)")  # fmt: skip
+    layer_thickness: float = param(0.0, "thickness of a bonded top layer -t < y < 0 (0: "
+                                   "homogeneous block)", nonnegative=True)  # fmt: skip
+    layer_E: float = param(0.0, "Young's modulus of the top layer (0: same as E)",
+                           nonnegative=True)  # fmt: skip
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.gap0 != 0.0 and self.shift > 0.0:
             raise ValueError("--gap0 and --shift cannot be combined")
+        if not self.layer_thickness < self.height:
+            raise ValueError(
+                f"--layer-thickness must be < --height, got {self.layer_thickness} >= {self.height}"
+            )
+        if self.layer_E > 0.0 and self.layer_thickness == 0.0:
+            raise ValueError("--layer-E needs --layer-thickness > 0")
 
 
 class Hertz2D(Scene):
@@ -97,6 +114,15 @@ class Hertz2D(Scene):
     Params = Hertz2DParams
     contact_tag = RectangleFacets.TOP
 
+    @property
+    def layered(self) -> bool:
+        return self.p.layer_thickness > 0.0
+
+    @property
+    def layer_E(self) -> float:
+        """Young's modulus of the top layer (E without a layer)."""
+        return self.p.layer_E if self.layered and self.p.layer_E > 0.0 else self.p.E
+
     def build_mesh(self, comm):
         p = self.p
         return gmsh_mesh(
@@ -104,7 +130,21 @@ class Hertz2D(Scene):
             x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
             refine_x0=-p.refine_half_width, refine_x1=p.refine_half_width,
             h_contact=p.h_contact, h_far=p.h_far,
+            interfaces=(-p.layer_thickness,) if self.layered else (),
         )  # fmt: skip
+
+    def modulus(self, mesh):
+        """Piecewise constant (DG0) modulus: layer_E in the layer, E below. The interface is a
+        mesh line, so each cell lies on one side and its midpoint tells which."""
+        if not self.layered:
+            return None
+        field = dolfinx.fem.Function(_compat.function_space(mesh, "DG", 0), name="youngs_modulus")
+        top, bottom, t = self.layer_E, self.p.E, self.p.layer_thickness
+        field.interpolate(lambda x: np.where(x[1] > -t, top, bottom))
+        return field
+
+    def contact_modulus(self) -> float:
+        return self.layer_E
 
     def obstacle(self) -> Obstacle:
         return _indenter(self.p.profile, self.p.radius)
@@ -117,17 +157,23 @@ class Hertz2D(Scene):
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, RectangleFacets.BOTTOM)
 
-    def reference(self, force: float) -> dict[str, float]:
+    def _hertz(self, force: float) -> dict[str, float]:
+        """The half-space closed form, or {} for a layer of another modulus (none applies)."""
+        if self.layer_E != self.p.E:
+            return {}
         return hertz_2d(force, self.p.radius, self.material().E_star)
 
+    def reference(self, force: float) -> dict[str, float]:
+        return self._hertz(force)
+
     def exact_pressure(self, x, ref: dict):
-        if self.p.shift > 0.0:  # the pressure under a sliding indenter moves with it
+        if self.p.shift > 0.0 or not ref:  # moving indenter, or no closed form (a layer)
             return None
         return _elliptic(ref["p0"], x[0] ** 2 / ref["a"] ** 2)
 
     def friction_reference(self, summary: dict, friction) -> dict[str, float]:
-        ref = hertz_2d(summary["force"], self.p.radius, self.material().E_star)
-        return _cattaneo_mindlin(summary, ref["a"], exponent=0.5)
+        ref = self._hertz(summary["force"])
+        return _cattaneo_mindlin(summary, ref["a"], exponent=0.5) if ref else {}
 
 
 @dataclass(frozen=True)

@@ -169,6 +169,24 @@ def test_rectangle_sizes(rectangle_mesh: MeshData) -> None:
     _check_sizes(sizes, distance, band, graded, p["h_contact"], p["h_far"])
 
 
+def test_rectangle_interfaces() -> None:
+    p = dict(RECTANGLE, interfaces=(-0.1, -1.0))
+    width, height = p["x1"] - p["x0"], p["y1"] - p["y0"]
+    data = build(MPI.COMM_WORLD, partial(rectangle, **p), gdim=2, name="layered")
+    _check_boundary_tagged_once(data)
+    # Straight-sided triangles tile the layers and the interfaces exactly: only round-off.
+    assert _measure(data) == pytest.approx(width * height, rel=1e-12)
+    assert _measure(data, RectangleFacets.LEFT) == pytest.approx(height, rel=1e-12)
+    mesh = data.mesh
+    for y in p["interfaces"]:
+        on_line = dolfinx.mesh.locate_entities(mesh, 1, lambda x, y=y: np.isclose(x[1], y))
+        tags = dolfinx.mesh.meshtags(mesh, 1, np.sort(on_line), np.ones_like(on_line))
+        dS = ufl.dS(domain=mesh, subdomain_data=tags, subdomain_id=1)
+        length = dolfinx.fem.assemble_scalar(dolfinx.fem.form(1.0 * dS))
+        # the interface is a chain of interior mesh edges covering its full width
+        assert mesh.comm.allreduce(length, op=MPI.SUM) == pytest.approx(width, rel=1e-12)
+
+
 def test_box_measures(box_mesh: MeshData) -> None:
     p = BOX
     dx, dy, dz = p["x1"] - p["x0"], p["y1"] - p["y0"], p["z1"] - p["z0"]
@@ -212,6 +230,7 @@ def test_uniform_rectangle() -> None:
         (partial(rectangle, **dict(RECTANGLE, h_contact=-1)), 2, "h_contact must be > 0, got -1"),
         (partial(rectangle, **dict(RECTANGLE, refine_x1=3.0)), 2, "refine_x1 must be <= x1"),
         (partial(rectangle, **dict(RECTANGLE, h_far=0.01)), 2, "h_contact must be <= h_far"),
+        (partial(rectangle, **dict(RECTANGLE, interfaces=(0.5,))), 2, "interface must be < y1"),
         (partial(box, **dict(BOX, z1=-2.0)), 3, "z0 must be < z1"),
         (partial(box, **dict(BOX, refine_radius=0.0)), 3, "refine_radius must be > 0"),
     ],
