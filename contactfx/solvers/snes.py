@@ -235,8 +235,11 @@ class ContactSNES:
     def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
         t0 = time.perf_counter()
         if _DEADLINE and self.comm.allreduce(t0 > _DEADLINE[-1], op=MPI.LOR):
+            # stop SNES through its own divergence test (a NaN residual): raising here would
+            # leave x read-locked on PETSc >= 3.20
             self._late = True
-            raise TimeLimitExceeded()
+            F.set(np.nan)
+            return
         self._sync(x)
         self.K.mult(x, F)
         F.axpy(-1.0, self.b)
@@ -268,9 +271,9 @@ class ContactSNES:
         try:
             self.snes.solve(None, x)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash
-            if self._late:
-                raise TimeLimitExceeded() from None
             raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
+        if self._late:
+            raise TimeLimitExceeded()
         self._sync(x)
         wall = time.perf_counter() - t0
         reason = self.snes.getConvergedReason()
