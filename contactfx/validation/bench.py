@@ -77,6 +77,9 @@ MEASURES: dict[str, tuple[str, tuple[str, str]]] = {
 
 PENALTIES = (10.0, 100.0, 1000.0)
 
+#: relative errors below this are round-off (e.g. the force under force control): no rate
+ROUNDOFF = 1e-10
+
 
 def expand_methods(spec: str) -> list[tuple[str, dict]]:
     """'nitsche,penalty@100,al-ssn' -> [(label, Numerics overrides), ...]. ``nitsche`` expands
@@ -172,9 +175,9 @@ def run_case(
 
 def observed_rates(rows: list[dict], column: str) -> tuple[float, float]:
     """Least-squares slope of log(error) against log(h) over the rows, and the rate between
-    the two finest levels (nan when undefined)."""
+    the two finest levels (nan when undefined; round-off errors are left out)."""
     pts = [(r["h"], r[column]) for r in rows if r.get("status") == "ok"]
-    pts = [(h, e) for h, e in pts if np.isfinite(e) and e > 0.0]
+    pts = [(h, e) for h, e in pts if np.isfinite(e) and e > ROUNDOFF]
     if len(pts) < 2:
         return float("nan"), float("nan")
     h, e = np.log(np.array(pts)).T

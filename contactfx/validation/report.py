@@ -19,10 +19,6 @@ import numpy as np
 __all__ = ["machine", "write_bench", "write_csv", "markdown_table"]
 
 
-#: errors below this are round-off (the measure is exact by construction)
-ROUNDOFF = 1e-10
-
-
 def machine(ranks: int) -> str:
     """One line naming the machine, the versions and the date."""
     from contactfx.io.provenance import versions
@@ -103,7 +99,7 @@ def _has(rows: list[dict], column: str, floor: float = 0.0) -> bool:
 
 def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
     """bench.csv, bench.md and the plots; returns the paths written."""
-    from contactfx.validation.bench import CASES, MEASURES, observed_rates
+    from contactfx.validation.bench import CASES, MEASURES, ROUNDOFF, observed_rates
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -171,7 +167,7 @@ def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(6.0, 4.2))
     for (label, degree), srs in series.items():
         pts = [(r["t_run"] if kind == "time" else r["h"], r[column]) for r in srs]
-        pts = [(x, e) for x, e in pts if math.isfinite(e) and e > 0.0]
+        pts = [(x, e) for x, e in pts if math.isfinite(e) and e > 1e-10]
         if not pts:
             continue
         x, e = np.array(pts).T
