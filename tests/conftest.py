@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 
@@ -21,15 +20,9 @@ def pytest_collection_modifyitems(config, items):
 
 def clean_env() -> dict[str, str]:
     """Environment for child processes: no MPI singleton state of the test process."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
-    env.update(
-        OMPI_ALLOW_RUN_AS_ROOT="1",
-        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-        OMPI_MCA_rmaps_base_oversubscribe="1",
-        OPENBLAS_NUM_THREADS="1",
-        OMP_NUM_THREADS="1",
-    )
-    return env
+    from contactfx.validation.stress import child_env
+
+    return child_env()
 
 
 def contactfx_cmd(*args: str, ranks: int = 1) -> list[str]:
