@@ -15,7 +15,7 @@ class Uzawa:
     """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
 
     ``update`` is a compiled expression of the multiplier's next value, interpolated into the
-    multiplier's space; ``mask`` (bool per local dof of that space) selects the contact
+    multiplier's space (or a callable that fills the Function it is given); ``mask`` (bool per local dof of that space) selects the contact
     boundary's nodes, elsewhere the multiplier is kept at zero. The loop stops when
     max |lambda_{k+1} - lambda_k| <= tol max |lambda_{k+1}| over the contact nodes: the nodal
     constraint violation and complementarity residual are then below tol max |lambda| / r.
@@ -64,7 +64,10 @@ class Uzawa:
             total.assembly += stats.assembly
             total.solve += stats.solve
             total.reason = stats.reason
-            self._next.interpolate(self.update)
+            if callable(self.update):  # a nodal evaluation (interface quantities)
+                self.update(self._next)
+            else:
+                self._next.interpolate(self.update)
             new = np.where(mask, self._next.x.array, 0.0)
             change = self._max((new - lam)[mask])
             size = self._max(new[mask])

@@ -1,0 +1,185 @@
+"""Contact across a fitted interface inside one mesh: crack faces, fracture planes, joints.
+
+Kinematics (Heaviside enrichment on a fitted interface). The interface Gamma is a set of tagged
+interior facets; a sign field H (cellwise +1 on the side the interface normal n_I points to, -1
+on the other, from the cells' midpoints) splits the cells that touch it. The displacement is
+
+    w = u + H a,
+
+u and a continuous Lagrange fields of the same degree, a nonzero only at the dofs on Gamma
+(elsewhere fixed to zero, which removes them from the system), and zero at the crack tips, so
+that the jump vanishes there. Across Gamma the jump is [[w]] = w(+side) - w(-side) = 2 a; across
+every other facet w is continuous. (The shifted-Heaviside enrichment of extended finite
+elements on a mesh that already resolves the crack: Moes, Dolbow & Belytschko 1999,
+doi:10.1002/(SICI)1097-0207(19990910)46:1<131::AID-NME726>3.0.CO;2-J; for a fitted crack it is
+the same space as doubled nodes.) Every contact term is an interior-facet integral of the jump
+and of the averaged stress: pure UFL, exact Jacobians.
+
+Interface contact as the contact of the +side ("body", outward normal n = -n_I) against the
+-side ("obstacle"): the gap is the normal opening g = [[w]] . n_I (>= 0, faces may open but not
+interpenetrate), the relative tangential motion is the tangential jump, and the traction on the
++side face is -p n + t_T. :class:`InterfaceSurface` offers the same members as
+:class:`contactfx.contact.gap.ContactSurface`, so Nitsche's method and the augmented Lagrangian
+methods write the same residuals for both (two-sided Nitsche with the averaged stress: Chouly,
+Fabre, Hild, Pousin & Renard 2018, doi:10.1051/m2an/2017056; Annavarapu, Hautefeuille & Dolbow
+2014, doi:10.1016/j.cma.2013.09.025 for crack faces).
+
+Interface laws beyond Signorini, all through the gap (the laws module's forms are unchanged):
+
+* a proppant floor of thickness h_p on part of Gamma: g = opening - h_p (aperture >= h_p there);
+* fluid pressure p_f on both faces: a load on the faces, and the contact law acts on the
+  effective normal stress sigma_n + p_f (so Nitsche's consistency term uses the stress plus
+  p_f I; the tangential stress is unchanged);
+* Barton-Bandis joint closure (Bandis, Lumsden & Barton 1983, doi:10.1016/0148-9062(83)90595-8):
+  closure v = -opening and effective stress s' with s' = K_ni v / (1 - v / V_m), i.e.
+  v = psi(s') = s' V_m / (K_ni V_m + s'). Written as Signorini with the stress-dependent gap
+  g = opening + psi([s']_+), s' = -(sigma_n + p_f): g = 0 with s' > 0 is the closure law, s' = 0
+  with g >= 0 a joint opened beyond its initial aperture. The pressure estimate in psi is the
+  averaged interface stress for every method (Nitsche's consistency with a normal compliance,
+  cf. Juntunen & Stenberg 2009, doi:10.1090/S0025-5718-08-02183-2).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import ufl
+
+from contactfx.contact.gap import tangential
+from contactfx.contact.laws import Friction, positive_part
+
+__all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal"]
+
+
+def oriented_jump(w, H):
+    """[[w]] = w(+side) - w(-side) on facets where H changes sign (whatever dolfinx's '+' / '-'
+    restriction of the facet is)."""
+    return 0.5 * (H("+") - H("-")) * (w("+") - w("-"))
+
+
+def interface_normal(H, n):
+    """Unit normal n_I of the interface, pointing from the H = -1 side to the H = +1 side
+    (n is ufl.FacetNormal: n('+') is the outward normal of the '+' cell)."""
+    return -H("+") * n("+")
+
+
+@dataclass(frozen=True)
+class BartonBandis:
+    """Hyperbolic normal closure of a rock joint: initial normal stiffness ``Kni`` (stress /
+    length), maximal closure ``Vm`` (length), initial aperture ``w0`` (length, >= Vm)."""
+
+    Kni: float
+    Vm: float
+    w0: float
+
+    def __post_init__(self) -> None:
+        if not (self.Kni > 0.0 and self.Vm > 0.0 and self.w0 > 0.0):
+            raise ValueError("Barton-Bandis parameters K_ni, V_m and w0 must be > 0")
+        if self.Vm > self.w0:
+            raise ValueError(f"maximal closure V_m = {self.Vm} exceeds the aperture w0 = {self.w0}")
+
+    def closure(self, s):
+        """v = psi(s) for an effective normal stress s >= 0 (numbers or UFL)."""
+        return s * self.Vm / (self.Kni * self.Vm + s)
+
+
+@dataclass(frozen=True)
+class InterfaceSurface:
+    """What a method needs to write its terms on a fitted interface (see the module docstring).
+
+    w, v: total displacement of the state and of the test functions (u + H a); H: the DG0 sign
+    field; ds: interior-facet measure restricted to the interface; stress(_test): sigma(w),
+    sigma(v) (cellwise); E: modulus scaling the method parameters; h: cell diameter (UFL).
+    floor: proppant thickness (UFL, 0 where unpropped) or None; fluid: fluid pressure on the
+    faces (UFL) or None; joint: a :class:`BartonBandis` law or None. Friction, previous state
+    ``u_prev`` (total displacement of the last converged step), ``ds_nodal`` and the multiplier
+    as in :class:`contactfx.contact.gap.ContactSurface`.
+    """
+
+    w: object
+    v_total: object
+    H: object
+    ds: ufl.Measure
+    stress_cell: object
+    stress_test_cell: object
+    E: float
+    h_cell: object
+    floor: object = None
+    fluid: object = None
+    joint: BartonBandis | None = None
+    friction: Friction | None = None
+    u_prev: object = None
+    ds_nodal: ufl.Measure | None = None
+    multiplier: object = None
+    multiplier_test: object = None
+    offset = None  # no rigid obstacle
+
+    @property
+    def mesh(self):
+        return self.ds.ufl_domain()
+
+    # -- the ContactSurface members the methods use -----------------------------------------
+    @property
+    def u(self):
+        """The oriented displacement jump [[w]] (the +side's motion relative to the -side)."""
+        return oriented_jump(self.w, self.H)
+
+    @property
+    def v(self):
+        return oriented_jump(self.v_total, self.H)
+
+    @property
+    def h(self):
+        return ufl.avg(self.h_cell)
+
+    def _identity(self):
+        return ufl.Identity(ufl.shape(self.w)[0])
+
+    @property
+    def stress(self):
+        """Averaged stress of the state, plus p_f I (the contact law acts on the effective
+        stress)."""
+        s = ufl.avg(self.stress_cell)
+        if self.fluid is not None:
+            s = s + self.fluid * self._identity()
+        return s
+
+    @property
+    def stress_test(self):
+        return ufl.avg(self.stress_test_cell)
+
+    def interface_normal(self):
+        """n_I: from the -side to the +side."""
+        return interface_normal(self.H, ufl.FacetNormal(self.mesh))
+
+    def normal(self, w=None):
+        """Outward normal of the +side face: -n_I."""
+        return -self.interface_normal()
+
+    def opening(self, w=None):
+        """Normal opening [[w]] . n_I (> 0 open)."""
+        jump = self.u if w is None else oriented_jump(w, self.H)
+        return ufl.dot(jump, self.interface_normal())
+
+    def effective_pressure(self):
+        """s' = -(n . sigma n + p_f): the normal stress the faces (or the joint) carry."""
+        n = self.normal()
+        return -self.sigma_n(self.stress, n)
+
+    def gap(self, w=None):
+        """opening - proppant floor (+ joint closure psi(s'))."""
+        g = self.opening(w)
+        if self.floor is not None:
+            g = g - self.floor
+        if self.joint is not None:
+            g = g + self.joint.closure(positive_part(self.effective_pressure()))
+        return g
+
+    sigma_n = staticmethod(lambda stress, n: ufl.dot(n, ufl.dot(stress, n)))
+    sigma_t = staticmethod(lambda stress, n: tangential(ufl.dot(stress, n), n))
+
+    def slip_increment(self, n):
+        """Tangential jump increment since the last converged step."""
+        if self.u_prev is None:
+            raise ValueError("the slip increment needs the previous state (friction only)")
+        return tangential(self.u - oriented_jump(self.u_prev, self.H), n)
