@@ -6,6 +6,8 @@ No other module of contactfx checks a version; they call the functions below.
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import dolfinx
 import dolfinx.fem.petsc
 import numpy as np
@@ -31,6 +33,8 @@ __all__ = [
     "dirichletbc",
     "cell_diameter",
     "mixed_space",
+    "numpy_math",
+    "ufl_math",
 ]
 
 DOLFINX_VERSION: tuple[int, int] = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
@@ -153,3 +157,15 @@ def mixed_space(mesh, degree: int, gdim: int, multiplier_shape: tuple[int, ...])
     else:
         Qe = ufl.FiniteElement("Lagrange", cell, 1)
     return dolfinx.fem.FunctionSpace(mesh, ufl.MixedElement([Ve, Qe]))
+
+
+# Math namespaces (sqrt, atan2, cos, sin) for closed forms written once for numpy arrays and UFL
+# expressions (contactfx.scenes.crack_fields). numpy < 2 has no atan2 alias, UFL < 2023 names
+# it atan_2.
+numpy_math = SimpleNamespace(sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin)
+ufl_math = SimpleNamespace(
+    sqrt=ufl.sqrt,
+    atan2=getattr(ufl, "atan2", None) or ufl.atan_2,
+    cos=ufl.cos,
+    sin=ufl.sin,
+)

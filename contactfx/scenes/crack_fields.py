@@ -1,0 +1,181 @@
+"""Closed forms for crack-face contact and joints (plane strain; BENCHMARKS.md sections 6, 7).
+
+Crack |x| < a on y = 0 in an infinite plate, in the crack's own frame. Signs: tension positive
+for stresses; pressures p, normal stresses sigma_n and effective stresses s' are positive in
+compression (ARCHITECTURE.md); ``E' = E / (1 - nu^2)``.
+
+Stress field of a crack with loaded faces (Westergaard 1939, J. Appl. Mech. 6, A49-A53,
+doi:10.1115/1.4008969; Tada, Paris & Irwin 2000, The Stress Analysis of Cracks Handbook, 3rd
+ed., doi:10.1115/1.801535). With z = x + i y and the face load subtracted from the remotely
+loaded Griffith crack,
+
+    mode I  (face pressure p):  Z = p (z / sqrt(z^2 - a^2) - 1),
+        sxx = Re Z - y Im Z',      syy = Re Z + y Im Z',   sxy = -y Re Z';
+    mode II (face shear q):     Z = q (z / sqrt(z^2 - a^2) - 1),
+        sxx = 2 Im Z + y Re Z',    syy = -y Re Z',         sxy = Re Z - y Im Z',
+
+Z' = -load a^2 / (z^2 - a^2)^(3/2). Both derive from Airy functions (mode I
+phi = Re ZZ + y Im Zb, mode II phi = -y Re Zb with Zb' = Z, ZZ' = Zb); in mode II the real
+and imaginary parts are not placed as in mode I (swapping them, sxx = 2 Re Z + y Im Z', ...,
+breaks equilibrium). The branch of sqrt(z^2 - a^2) is sqrt(r1 r2) exp(i (t1 + t2) / 2) with
+z -+ a = r1,2 exp(i t1,2), t1,2 = atan2(y, x -+ a) in (-pi, pi]: it behaves as z at infinity
+and its only cut is the crack. Face conditions (upper face y -> 0+ and lower face y -> 0-, |x| < a):
+
+    syy = -p,  sxy = -q,
+
+i.e. the face y = 0+ (outward normal -e_y) carries the traction (q, p): the pressure p pushes
+the faces apart and the shear q pushes the upper face towards +x. The stresses vanish at
+infinity, K_I = p sqrt(pi a), K_II = q sqrt(pi a) (syy, sxy ~ K / sqrt(2 pi r) ahead of the
+tips), and the face displacement jumps are Sneddon's ellipses (Sneddon 1946,
+doi:10.1098/rspa.1946.0077)
+
+    u_y(0+) - u_y(0-) = 4 p / E' sqrt(a^2 - x^2),   u_x(0+) - u_x(0-) = 4 q / E' sqrt(a^2 - x^2).
+
+Closed crack under compression sigma_n > 0 and shear tau with Coulomb friction mu: it sticks
+if |tau| <= mu sigma_n, otherwise it slides as a whole under the driving shear
+q = sign(tau) (|tau| - mu sigma_n) (BENCHMARKS.md section 6). Under uniaxial compression sigma
+with the crack at beta to the plane normal to the compression, sigma_n = sigma cos^2 beta,
+tau = sigma sin beta cos beta, so K_II = sigma sqrt(pi a) cos beta (sin beta - mu cos beta)
+when tan beta > mu. A strip of full width W with traction data raises K by the factor
+sqrt(sec(pi a / W)) (Feddersen 1966, ASTM STP 410, 77-79; Tada et al. 2000).
+
+Joints: Barton-Bandis hyperbolic closure s' = K_ni v / (1 - v / V_m) (Bandis, Lumsden &
+Barton 1983, doi:10.1016/0148-9062(83)90595-8). Propped crack: a rigid proppant layer of
+thickness h on |x| < b is first touched at x = +-b, where the Sneddon opening under the net
+pressure p* = h E' / (4 sqrt(a^2 - b^2)) equals h.
+
+The field functions take a math namespace ``m`` with ``sqrt, atan2, cos, sin``:
+:data:`contactfx._compat.numpy_math` (the default) for numpy arrays,
+:data:`contactfx._compat.ufl_math` to build UFL expressions (e.g. of ``ufl.SpatialCoordinate``).
+Functions without ``m`` use arithmetic only and accept both, except :func:`driving_shear` and
+:func:`inclined_crack_KII` (numpy / float: they branch on the data).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from contactfx._compat import numpy_math
+
+__all__ = [
+    "crack_perturbation_stress",
+    "opening",
+    "stress_intensity",
+    "crack_plane_tractions",
+    "driving_shear",
+    "inclined_crack_KII",
+    "width_correction",
+    "bb_closure",
+    "bb_stress",
+    "bb_stiffness",
+    "joint_column",
+    "propping_pressure",
+]
+
+
+def _griffith(x, y, a, m):
+    """Real and imaginary parts of w = z / sqrt(z^2 - a^2) - 1 and of
+    w' = -a^2 (z^2 - a^2)^(-3/2), in real arithmetic (z = x + i y)."""
+    half_angle = 0.5 * (m.atan2(y, x - a) + m.atan2(y, x + a))
+    modulus = m.sqrt(m.sqrt(((x - a) ** 2 + y**2) * ((x + a) ** 2 + y**2)))  # |z^2 - a^2|^(1/2)
+    c, s = m.cos(half_angle), m.sin(half_angle)
+    re_w = (x * c + y * s) / modulus - 1.0
+    im_w = (y * c - x * s) / modulus
+    scale = a**2 / modulus**3
+    re_dw = -scale * m.cos(3.0 * half_angle)
+    im_dw = scale * m.sin(3.0 * half_angle)
+    return re_w, im_w, re_dw, im_dw
+
+
+def crack_perturbation_stress(x, y, a, p, q, m: Any = numpy_math):
+    """Stresses (sxx, syy, sxy) at (x, y) of an infinite plane-strain plate with the crack
+    |x| < a, y = 0 whose faces carry the pressure p and the shear q, stress-free at infinity.
+
+    Face conditions (both faces, |x| < a): syy = -p, sxy = -q. Exactly on y = 0 the atan2
+    branch evaluates the upper face (numpy's arctan2 takes y = -0.0 as the lower face); the
+    crack tips (x, y) = (+-a, 0) are singular.
+    """
+    re_w, im_w, re_dw, im_dw = _griffith(x, y, a, m)
+    sxx = p * (re_w - y * im_dw) + q * (2.0 * im_w + y * re_dw)
+    syy = p * (re_w + y * im_dw) - q * y * re_dw
+    sxy = -p * y * re_dw + q * (re_w - y * im_dw)
+    return sxx, syy, sxy
+
+
+def opening(s, a, load, E, nu, m: Any = numpy_math):
+    """Face displacement jump 4 load (1 - nu^2) / E sqrt(a^2 - s^2) at |s| <= a (Sneddon):
+    the opening u_y(0+) - u_y(0-) for load = p, the slip u_x(0+) - u_x(0-) for load = q."""
+    return 4.0 * load * (1.0 - nu**2) / E * m.sqrt(a**2 - s**2)
+
+
+def stress_intensity(load, a):
+    """K = load sqrt(pi a): K_I for the face pressure, K_II for the (driving) face shear."""
+    return load * (np.pi * a) ** 0.5
+
+
+def crack_plane_tractions(sigma, beta_deg, m: Any = numpy_math):
+    """(sigma_n, tau) = (sigma cos^2 beta, sigma sin beta cos beta) on a crack at beta (degrees)
+    to the plane normal to a uniaxial compression sigma > 0 (sigma_n > 0 in compression)."""
+    beta = beta_deg * (np.pi / 180.0)
+    c, s = m.cos(beta), m.sin(beta)
+    return sigma * c**2, sigma * s * c
+
+
+def driving_shear(tau, sigma_n, mu):
+    """Shear that slides the faces: sign(tau) (|tau| - mu sigma_n) if |tau| > mu sigma_n, else 0
+    (stick). Friction needs contact: an open crack (sigma_n <= 0) slides under tau itself."""
+    tau = np.asarray(tau, dtype=float)
+    resistance = mu * np.maximum(np.asarray(sigma_n, dtype=float), 0.0)
+    return np.sign(tau) * np.maximum(np.abs(tau) - resistance, 0.0)
+
+
+def inclined_crack_KII(sigma, a, beta_deg, mu):
+    """K_II = sigma sqrt(pi a) cos beta (sin beta - mu cos beta) if tan beta > mu, else 0:
+    a closed crack at beta (degrees, 0 <= beta <= 90) to the plane normal to a uniaxial
+    compression sigma > 0."""
+    sigma_n, tau = crack_plane_tractions(sigma, beta_deg)
+    return stress_intensity(driving_shear(tau, sigma_n, mu), a)
+
+
+def width_correction(a, W, m: Any = numpy_math):
+    """K / K_inf = sqrt(sec(pi a / W)) for a central crack of length 2a in a strip of width W."""
+    return (1.0 / m.cos(np.pi * a / W)) ** 0.5
+
+
+def bb_closure(s_eff, Kni, Vm):
+    """Barton-Bandis closure v = s' V_m / (K_ni V_m + s') at the effective stress s' >= 0."""
+    return s_eff * Vm / (Kni * Vm + s_eff)
+
+
+def bb_stress(v, Kni, Vm):
+    """Barton-Bandis effective stress s' = K_ni v / (1 - v / V_m) at the closure 0 <= v < V_m."""
+    return Kni * v / (1.0 - v / Vm)
+
+
+def bb_stiffness(s_eff, Kni, Vm):
+    """Barton-Bandis tangent stiffness ds'/dv = K_ni [1 - s' / (K_ni V_m + s')]^(-2)."""
+    return Kni * (1.0 - s_eff / (Kni * Vm + s_eff)) ** -2
+
+
+def joint_column(s_c, p, E, nu, H, w0, Kni, Vm) -> dict[str, Any]:
+    """Two blocks of height H with lateral rollers around a Barton-Bandis joint (initial
+    aperture w0), top compression s_c, fluid pressure p on the faces: the closure v at
+    s' = s_c - p, the aperture w0 - v, the oedometric modulus M = E (1 - nu) / ((1 + nu)
+    (1 - 2 nu)) and the top settlement 2 H s_c / M + v."""
+    M = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    closure = bb_closure(s_c - p, Kni, Vm)
+    return {
+        "closure": closure,
+        "aperture": w0 - closure,
+        "settlement": 2.0 * H * s_c / M + closure,
+        "M": M,
+    }
+
+
+def propping_pressure(h, a, b, E, nu):
+    """Net pressure p* = h E' / (4 sqrt(a^2 - b^2)) at which the Sneddon opening equals the
+    proppant thickness h at the proppant edges x = +-b (b < a): above it the proppant carries
+    nothing."""
+    return h * E / (1.0 - nu**2) / (4.0 * (a**2 - b**2) ** 0.5)
