@@ -123,8 +123,10 @@ def _table(data: dict) -> str:
          f"{data['ksp_iterations']}"),
         ("time mesh / compile / assembly / solve [s]",
          " / ".join(f"{t.get(k, 0.0):.2f}" for k in ("mesh", "compile", "assembly", "solve"))),
-        ("contact force", f"{data['force']:.6g}"),
     ]  # fmt: skip
+    if "normal_force" in data:  # a fitted interface (crack, fracture, joint)
+        return _rows(rows + _interface_rows(data))
+    rows.append(("contact force", f"{data['force']:.6g}"))
     if "force_rel_error" in ref:
         rows.append(("reference force", f"{ref['force']:.6g}  (rel. error "
                      f"{ref['force_rel_error']:.2%})"))  # fmt: skip
@@ -157,6 +159,27 @@ def _table(data: dict) -> str:
         rows.append((key.replace("_", " "), f"{value:.4g}"))
     for key, value in data.get("errors", {}).items():
         rows.append((key.replace("_", " "), f"{value:.4e}"))
+    return _rows(rows)
+
+
+def _interface_rows(data: dict) -> list[tuple[str, str]]:
+    rows = [
+        ("interface normal / tangential force",
+         f"{data['normal_force']:.6g} / {data['tangential_force']:.6g}"),
+        ("closed length / max penetration",
+         f"{data['closed_length']:.6g} / {data['max_penetration']:.3e}"),
+    ]  # fmt: skip
+    if "proppant_force" in data:
+        rows.append(("proppant force / min aperture (propped)",
+                     f"{data['proppant_force']:.6g} / {data['min_aperture_propped']:.6g}"))
+    for key, value in {**data.get("reference", {}), **data.get("errors", {})}.items():
+        rows.append((key.replace("_", " "), f"{value:.6g}"))
+    if data.get("plot"):
+        rows.append(("line plot", data["plot"]))
+    return rows
+
+
+def _rows(rows: list[tuple[str, str]]) -> str:
     width = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)
 

@@ -1,0 +1,379 @@
+"""Crack-face contact in a plate (plane strain): a pressurised crack (Sneddon), an inclined
+frictional crack under compression, and a fracture partly held open by a proppant layer.
+
+Geometry: the square [-W/2, W/2]^2 with a straight crack |s| < a through its centre at the angle
+beta to the x axis (s along the crack, n_I = (-sin beta, cos beta) its normal), a chain of mesh
+edges refined to ``h_crack`` and graded to ``h_far`` (:func:`contactfx.meshes.crack_plate`).
+The plate stands for an infinite one: its boundary carries the traction sigma n of
+
+* ``--boundary infinite`` (default): the infinite-plate closed-form stress of the load case
+  where one exists (uniform remote stress plus the Westergaard field of the crack faces'
+  pressure and driving shear, :mod:`contactfx.scenes.crack_fields`), so that the finite plate
+  has the infinite plate's solution and the only error is the discretisation's;
+* ``--boundary remote``: the remote stress only (a finite plate under uniform traction; the
+  crack then feels the plate's width, K / K_inf = sqrt(sec(pi a / W)) for a strip).
+
+Three pinned vertices (two corners of the bottom edge) remove the rigid motions; the loads are
+in equilibrium, so they carry no force. The load factor t scales every load.
+
+Stress intensity factors are computed from the crack-face jump near the tips (displacement
+extrapolation): K(r) = E' / 8 sqrt(2 pi / r) [[u]](r) at the nodes with r = a - |s| <= a / 4,
+fitted by K0 + K1 r (least squares) and extrapolated to r = 0; the mean of both tips
+(Chan, Tuba & Wilson 1970, doi:10.1016/0013-7944(70)90026-3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+
+from contactfx._compat import ufl_math
+from contactfx.meshes import CrackPlateFacets, crack_plate
+from contactfx.scenes import crack_fields as cf
+from contactfx.scenes._common import gmsh_mesh
+from contactfx.scenes.base import SceneParams, param
+from contactfx.scenes.interface_base import STATUS, InterfaceScene, Profile
+
+__all__ = ["CrackSneddon", "CrackInclined", "ProppedFracture", "stress_intensity_from_jump"]
+
+_OUTER = (CrackPlateFacets.BOTTOM, CrackPlateFacets.RIGHT, CrackPlateFacets.TOP,
+          CrackPlateFacets.LEFT)  # fmt: skip
+
+
+def stress_intensity_from_jump(s, jump, a: float, E: float, nu: float, reach: float = 0.25):
+    """K from the crack-face displacement jump near both tips (see the module docstring);
+    nan when a tip has fewer than 3 nodes within ``reach`` a."""
+    Ep = E / (1.0 - nu**2)
+    values = []
+    for sign in (1.0, -1.0):
+        r = a - sign * np.asarray(s)
+        sel = (r > 1e-12 * a) & (r <= reach * a) & (sign * np.asarray(s) > 0)
+        if sel.sum() < 3:
+            return float("nan")
+        K = Ep / 8.0 * np.sqrt(2.0 * np.pi / r[sel]) * np.abs(np.asarray(jump)[sel])
+        K1, K0 = np.polyfit(r[sel], K, 1)
+        values.append(K0)
+    return float(np.mean(values))
+
+
+@dataclass(frozen=True)
+class _PlateParams(SceneParams):
+    E: float = param(10e9, "Young's modulus", positive=True)
+    nu: float = param(0.25, "Poisson's ratio, in (-1, 0.5)")
+    crack_half_length: float = param(1.0, "crack half-length a", positive=True)
+    plate_width: float = param(20.0, "plate width W (the square [-W/2, W/2]^2)", positive=True)
+    h_crack: float = param(0.05, "element size along the crack", positive=True)
+    h_far: float = param(2.0, "element size far from the crack", positive=True)
+    grading: float = param(0.3, "element size increase per unit distance", positive=True)
+    boundary: str = param("infinite", "plate boundary traction: infinite (closed-form "
+                          "infinite-plate field) or remote (uniform remote stress)",
+                          choices=("infinite", "remote"))  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.crack_half_length < 0.5 * self.plate_width:
+            raise ValueError(
+                f"--crack-half-length ({self.crack_half_length}) must be < plate-width / 2 "
+                f"({0.5 * self.plate_width})"
+            )
+        if not self.h_crack <= self.h_far:
+            raise ValueError(f"--h-crack ({self.h_crack}) must be <= --h-far ({self.h_far})")
+
+
+class _CrackPlate(InterfaceScene):
+    """Shared geometry, supports and boundary tractions of the crack scenes."""
+
+    interface_tag = CrackPlateFacets.CRACK
+
+    # -- load case: remote stress (global frame) and the crack-face loads of the closed form
+    def angle(self) -> float:
+        return 0.0
+
+    def remote_stress(self) -> np.ndarray:
+        return np.zeros((2, 2))
+
+    def face_loads(self) -> tuple[float, float]:
+        """(p, q): the pressure and driving shear of the infinite-plate closed form (0, 0 when
+        there is none); their Westergaard field is added to the remote stress."""
+        return 0.0, 0.0
+
+    def split_points(self) -> tuple[float, ...]:
+        return ()
+
+    # -- geometry -------------------------------------------------------------------------
+    def _axes(self):
+        beta = np.radians(self.angle())
+        d = np.array([np.cos(beta), np.sin(beta)])
+        n = np.array([-np.sin(beta), np.cos(beta)])
+        return d, n
+
+    def build_mesh(self, comm):
+        p = self.p
+        return gmsh_mesh(
+            comm, crack_plate, 2, self.name, half_width=0.5 * p.plate_width,
+            crack_half_length=p.crack_half_length, angle=self.angle(), h_crack=p.h_crack,
+            h_far=p.h_far, grading=p.grading, split_at=self.split_points(),
+        )  # fmt: skip
+
+    def length_scale(self) -> float:
+        return self.p.plate_width
+
+    def h_contact(self) -> float:
+        return self.p.h_crack
+
+    def side(self, x):
+        _, n = self._axes()
+        return n[0] * x[0] + n[1] * x[1]
+
+    def tips(self):
+        d, _ = self._axes()
+        a = self.p.crack_half_length
+        return [a * d, -a * d]
+
+    def frame(self):
+        d, _ = self._axes()
+        return np.zeros(2), d
+
+    def pinned(self):
+        half = 0.5 * self.p.plate_width
+        return [(np.array([-half, -half]), 0), (np.array([-half, -half]), 1),
+                (np.array([half, -half]), 1)]  # fmt: skip
+
+    def _boundary_stress(self, x):
+        """UFL stress on the plate boundary at load factor 1."""
+        sigma = ufl.as_matrix(self.remote_stress().tolist())
+        p, q = self.face_loads()
+        if self.p.boundary == "infinite" and (p != 0.0 or q != 0.0):
+            d, n = self._axes()
+            xl = d[0] * x[0] + d[1] * x[1]
+            yl = n[0] * x[0] + n[1] * x[1]
+            sxx, syy, sxy = cf.crack_perturbation_stress(
+                xl, yl, self.p.crack_half_length, p, q, ufl_math
+            )
+            R = ufl.as_matrix([[d[0], n[0]], [d[1], n[1]]])  # local -> global
+            local = ufl.as_matrix([[sxx, sxy], [sxy, syy]])
+            sigma = sigma + R * local * R.T
+        return sigma
+
+    def load(self, v, ds, t):
+        mesh = ds.ufl_domain()
+        x = ufl.SpatialCoordinate(mesh)
+        n = ufl.FacetNormal(mesh)
+        sigma = self._boundary_stress(x)
+        dso = ds(_OUTER, metadata={"quadrature_degree": 8})
+        return t * ufl.dot(ufl.dot(sigma, n), v) * dso
+
+    def _sqrt_ellipse(self, s):
+        a = self.p.crack_half_length
+        return ufl.sqrt(ufl.max_value(a**2 - s**2, 0.0))
+
+    def _ellipse(self, s, load):
+        """Closed-form jump 4 load (1 - nu^2) / E sqrt(a^2 - s^2) (numpy or UFL)."""
+        scale = 4.0 * load * (1.0 - self.p.nu**2) / self.p.E
+        if isinstance(s, np.ndarray):
+            return scale * np.sqrt(np.maximum(self.p.crack_half_length**2 - s**2, 0.0))
+        return scale * self._sqrt_ellipse(s)
+
+    def _K(self, prof: Profile, jump) -> float:
+        return stress_intensity_from_jump(prof.s, jump, self.p.crack_half_length, self.p.E,
+                                          self.p.nu)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class CrackSneddonParams(_PlateParams):
+    pressure: float = param(1e6, "fluid pressure p on the crack faces (< 0: suction closes it)")
+
+
+class CrackSneddon(_CrackPlate):
+    name = "crack-sneddon"
+    summary = "pressurised crack (Sneddon opening, K_I); negative pressure closes it"
+    Params = CrackSneddonParams
+    numerics_defaults = {"steps": 1}
+
+    def fluid_pressure(self):
+        return self.p.pressure
+
+    def face_loads(self):
+        return max(self.p.pressure, 0.0), 0.0
+
+    def exact_opening(self, s):
+        return self._ellipse(s, max(self.p.pressure, 0.0))
+
+    def exact_pressure_interface(self, s):
+        if self.p.pressure >= 0.0:
+            return None  # no contact: the normal force is checked instead
+        return -self.p.pressure + 0.0 * s
+
+    def reference_profile(self, s):
+        return {"opening": self._ellipse(s, max(self.p.pressure, 0.0))}
+
+    def interface_reference(self, prof, summary):
+        p = self.p.pressure
+        out = {"K_I_exact": cf.stress_intensity(max(p, 0.0), self.p.crack_half_length)}
+        if p > 0.0:
+            K = self._K(prof, prof.opening)
+            out["K_I"] = K
+            out["K_rel_error"] = abs(K - out["K_I_exact"]) / out["K_I_exact"]
+            # "no false contact": the contact force relative to the fluid force on a face
+            out["false_contact"] = abs(summary["normal_force"]) / (
+                2.0 * p * self.p.crack_half_length
+            )
+        else:
+            out["contact_force_exact"] = -p * 2.0 * self.p.crack_half_length
+            out["force_rel_error"] = abs(summary["normal_force"] - out["contact_force_exact"]) / (
+                out["contact_force_exact"]
+            )
+        return out
+
+
+@dataclass(frozen=True)
+class CrackInclinedParams(_PlateParams):
+    beta: float = param(45.0, "crack angle to the x axis, degrees (the plane normal to the "
+                        "compression)")  # fmt: skip
+    sigma: float = param(10e6, "uniaxial compression along y", positive=True)
+
+
+class CrackInclined(_CrackPlate):
+    name = "crack-inclined"
+    summary = "inclined closed crack under uniaxial compression, Coulomb friction (K_II)"
+    Params = CrackInclinedParams
+    numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 1}
+
+    def __init__(self, params, friction_mu: float | None = None) -> None:
+        super().__init__(params)
+        self.mu = friction_mu
+
+    def angle(self):
+        return self.p.beta
+
+    def remote_stress(self):
+        return np.array([[0.0, 0.0], [0.0, -self.p.sigma]])
+
+    def _plane(self):
+        d, n = self._axes()
+        S = self.remote_stress()
+        sigma_n = -n @ S @ n
+        tau = d @ S @ n
+        return sigma_n, tau
+
+    def _q(self) -> float:
+        sigma_n, tau = self._plane()
+        mu = 0.0 if self.mu is None else self.mu
+        return float(cf.driving_shear(tau, sigma_n, mu))
+
+    def face_loads(self):
+        return 0.0, self._q()
+
+    def exact_slip(self, s):
+        return self._ellipse(s, self._q())
+
+    def exact_pressure_interface(self, s):
+        return self._plane()[0] + 0.0 * s
+
+    def reference_profile(self, s):
+        return {"slip": self._ellipse(s, self._q())}
+
+    def interface_reference(self, prof, summary):
+        sigma_n, tau = self._plane()
+        mu = 0.0 if self.mu is None else self.mu
+        a = self.p.crack_half_length
+        exact = float(cf.inclined_crack_KII(self.p.sigma, a, self.p.beta, mu))
+        out = {"sigma_n": sigma_n, "tau": tau, "K_II_exact": exact,
+               "K_II_normalised_exact": exact / (self.p.sigma * np.sqrt(np.pi * a))}  # fmt: skip
+        K = self._K(prof, prof.slip) if exact > 0.0 else float(np.max(np.abs(prof.slip)))
+        out["K_II"] = K
+        if exact > 0.0:
+            out["K_II_normalised"] = K / (self.p.sigma * np.sqrt(np.pi * a))
+            out["K_rel_error"] = abs(K - exact) / exact
+            # sliding: the face shear equals mu sigma_n at the nodes away from the tips
+            inner = np.abs(prof.s) < a - 2.0 * self.p.h_crack
+            shear = np.abs(prof.t[inner])
+            out["face_shear_error"] = float(
+                np.max(np.abs(shear - mu * sigma_n), initial=0.0) / sigma_n
+            )
+            out["slipping_fraction"] = float(np.mean(prof.status[inner] == STATUS["slip"]))
+        else:
+            out["max_slip"] = K  # stick: no slip at all
+        return out
+
+    def run(self, numerics, **kwargs):
+        self.mu = numerics.mu if numerics.friction == "coulomb" else None
+        if numerics.friction == "tresca":
+            raise ValueError("crack-inclined compares with Coulomb friction: use --friction "
+                             "coulomb or none")  # fmt: skip
+        return super().run(numerics, **kwargs)
+
+
+@dataclass(frozen=True)
+class ProppedFractureParams(_PlateParams):
+    net_pressure: float = param(-1e6, "net pressure p_net = p - s_c (fluid minus closure)")
+    closure_stress: float = param(20e6, "remote compression s_c normal to the fracture",
+                                  nonnegative=True)  # fmt: skip
+    proppant_half_length: float = param(0.5, "proppant layer on |s| < b", positive=True)
+    proppant_thickness: float = param(1e-4, "proppant thickness h (aperture >= h there)",
+                                      positive=True)  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.proppant_half_length < self.crack_half_length:
+            raise ValueError(
+                f"--proppant-half-length ({self.proppant_half_length}) must be < "
+                f"--crack-half-length ({self.crack_half_length})"
+            )
+
+
+class ProppedFracture(_CrackPlate):
+    name = "propped-fracture"
+    summary = "fracture with a proppant layer under closure stress and fluid pressure"
+    Params = ProppedFractureParams
+    numerics_defaults = {"steps": 1}
+
+    def p_star(self) -> float:
+        p = self.p
+        return float(cf.propping_pressure(p.proppant_thickness, p.crack_half_length,
+                                          p.proppant_half_length, p.E, p.nu))  # fmt: skip
+
+    def open_branch(self) -> bool:
+        return self.p.net_pressure >= self.p_star()
+
+    def split_points(self):
+        b = self.p.proppant_half_length
+        return (-b, b)
+
+    def remote_stress(self):
+        d, n = self._axes()
+        return -self.p.closure_stress * np.outer(n, n)
+
+    def fluid_pressure(self):
+        return self.p.net_pressure + self.p.closure_stress
+
+    def face_loads(self):
+        return (self.p.net_pressure, 0.0) if self.open_branch() else (0.0, 0.0)
+
+    def floor(self, s):
+        b = self.p.proppant_half_length * (1.0 - 1e-9)  # the layer's end nodes are unpropped
+        return ufl.conditional(ufl.lt(abs(s), b), self.p.proppant_thickness, 0.0)
+
+    def exact_opening(self, s):
+        return self._ellipse(s, self.p.net_pressure) if self.open_branch() else None
+
+    def reference_profile(self, s):
+        if self.open_branch():
+            return {"opening": self._ellipse(s, self.p.net_pressure)}
+        return {}
+
+    def interface_reference(self, prof, summary):
+        out = {"p_star": self.p_star(), "open_branch": float(self.open_branch()),
+               "proppant_thickness": self.p.proppant_thickness}  # fmt: skip
+        propped = prof.floor > 0.0
+        out["min_aperture_propped_over_h"] = float(
+            np.min(prof.opening[propped], initial=np.inf) / self.p.proppant_thickness
+        )
+        out["proppant_force"] = summary.get("proppant_force", 0.0)
+        if self.open_branch():
+            K = self._K(prof, prof.opening)
+            exact = cf.stress_intensity(self.p.net_pressure, self.p.crack_half_length)
+            out.update(K_I=K, K_I_exact=exact, K_rel_error=abs(K - exact) / exact)
+        return out

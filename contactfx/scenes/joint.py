@@ -1,0 +1,105 @@
+"""Two stacked rock blocks with a joint between them: the Barton-Bandis column (plane strain).
+
+Blocks [0, L] x [0, H] and [0, L] x [H, 2 H], lateral rollers (u_x = 0: uniaxial strain, modulus
+M = E (1 - nu) / ((1 + nu)(1 - 2 nu))), the bottom on rollers (u_y = 0), the compression s_c on
+the top, and the fluid pressure p on the joint's faces. The joint closes by v under the
+effective stress s' = s_c - p by the Barton-Bandis law (Bandis, Lumsden & Barton 1983,
+doi:10.1016/0148-9062(83)90595-8): v = s' V_m / (K_ni V_m + s'), aperture w = w0 - v; the top
+settles by 2 H s_c / M + v. The solution is uniform in each block, so every mesh and method
+reproduces it to the solver tolerance (BENCHMARKS section 7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from contactfx.contact.interface import BartonBandis
+from contactfx.meshes import JointColumnFacets, joint_column
+from contactfx.scenes import crack_fields as cf
+from contactfx.scenes._common import gmsh_mesh
+from contactfx.scenes.base import SceneParams, param
+from contactfx.scenes.interface_base import InterfaceScene
+
+__all__ = ["JointColumn", "JointColumnParams"]
+
+
+@dataclass(frozen=True)
+class JointColumnParams(SceneParams):
+    E: float = param(10e9, "Young's modulus", positive=True)
+    nu: float = param(0.25, "Poisson's ratio, in (-1, 0.5)")
+    block_height: float = param(1.0, "height H of each block", positive=True)
+    width: float = param(0.5, "column width L", positive=True)
+    closure_stress: float = param(30e6, "compression s_c on the top", nonnegative=True)
+    fluid_pressure: float = param(10e6, "fluid pressure p in the joint", nonnegative=True)
+    aperture: float = param(1e-3, "initial joint aperture w0", positive=True)
+    Kni: float = param(50e9, "initial normal stiffness K_ni of the joint (stress / length)",
+                       positive=True)  # fmt: skip
+    Vm: float = param(3e-4, "maximal closure V_m", positive=True)
+    h: float = param(0.25, "element size", positive=True)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.Vm > self.aperture:
+            raise ValueError(f"--Vm ({self.Vm}) must be <= --aperture ({self.aperture})")
+
+
+class JointColumn(InterfaceScene):
+    name = "joint-column"
+    summary = "two blocks with a Barton-Bandis joint under compression and fluid pressure"
+    Params = JointColumnParams
+    interface_tag = JointColumnFacets.JOINT
+
+    def build_mesh(self, comm):
+        p = self.p
+        return gmsh_mesh(comm, joint_column, 2, self.name, width=p.width,
+                         block_height=p.block_height, h=p.h)  # fmt: skip
+
+    def length_scale(self) -> float:
+        return self.p.block_height
+
+    def h_contact(self) -> float:
+        return self.p.h
+
+    def supports(self):
+        F = JointColumnFacets
+        return [(F.BOTTOM, 1), (F.LEFT, 0), (F.RIGHT, 0)]
+
+    def side(self, x):
+        return x[1] - self.p.block_height
+
+    def frame(self):
+        return np.array([0.0, self.p.block_height]), np.array([1.0, 0.0])
+
+    def joint(self):
+        return BartonBandis(self.p.Kni, self.p.Vm, self.p.aperture)
+
+    def fluid_pressure(self):
+        return self.p.fluid_pressure
+
+    def load(self, v, ds, t):
+        return -t * self.p.closure_stress * v[1] * ds(JointColumnFacets.TOP)
+
+    def extra_quantities(self, mesh, w, ds):
+        return {"top_displacement": w[1] / self.p.width * ds(JointColumnFacets.TOP)}
+
+    def exact(self) -> dict:
+        p = self.p
+        return cf.joint_column(p.closure_stress, p.fluid_pressure, p.E, p.nu, p.block_height,
+                               p.aperture, p.Kni, p.Vm)  # fmt: skip
+
+    def interface_reference(self, prof, summary):
+        ref = self.exact()
+        closure = -float(np.mean(prof.opening))
+        aperture = self.p.aperture + float(np.mean(prof.opening))
+        settlement = -summary["top_displacement"]
+        out = {}
+        for key, value in (("closure", closure), ("aperture", aperture),
+                           ("settlement", settlement)):  # fmt: skip
+            out[f"{key}_exact"] = float(ref[key])
+            out[key] = value
+            out[f"{key}_rel_error"] = abs(value - ref[key]) / abs(ref[key])
+        # the spread along the joint (uniform in the exact solution)
+        out["aperture_spread"] = float(np.ptp(prof.opening)) if len(prof.opening) else 0.0
+        return out
