@@ -10,6 +10,7 @@ from types import SimpleNamespace
 
 import dolfinx
 import dolfinx.fem.petsc
+import dolfinx.mesh
 import numpy as np
 import ufl
 from petsc4py import PETSc
@@ -63,10 +64,21 @@ def petsc_vec(u: dolfinx.fem.Function) -> PETSc.Vec:
 
 
 def model_to_mesh(model, comm, rank: int, gdim: int):
-    """gmsh model (built on ``rank``) -> (mesh, cell_tags, facet_tags) on ``comm``."""
+    """gmsh model (built on ``rank``) -> (mesh, cell_tags, facet_tags) on ``comm``.
+
+    Ghost mode ``shared_facet`` on both stacks, so that interior-facet integrals (``dS``) include
+    the facets on partition boundaries. dolfinx 0.5's ``model_to_mesh`` has no ``partitioner``
+    argument, but its ``create_mesh`` defaults to ``GhostMode.shared_facet``; dolfinx >= 0.8
+    defaults to ``GhostMode.none`` (a ``dS`` form over a facet on a partition boundary then
+    raises RuntimeError), so the partitioner is passed explicitly.
+    """
     from dolfinx.io import gmshio
 
-    out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    if _NEW:
+        partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet)
+        out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim, partitioner=partitioner)
+    else:
+        out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
     if hasattr(out, "mesh"):  # dolfinx >= 0.10 returns a MeshData named tuple
         return out.mesh, out.cell_tags, out.facet_tags
     return out[0], out[1], out[2]

@@ -17,23 +17,32 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
     )
     top = data.facet_tags.find(RectangleFacets.TOP)
 
-Command line: ``python3 -m contactfx.meshes {rectangle,box} ... --out mesh.msh``.
+Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,joint-column} ...
+--out mesh.msh``.
 """
 
 from contactfx.meshes._build import Builder, MeshData, MshInfo, build, write_msh
 from contactfx.meshes.box import BoxCells, BoxFacets, box
+from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
+from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
 
 __all__ = [
     "BoxCells",
     "BoxFacets",
     "Builder",
+    "CrackPlateCells",
+    "CrackPlateFacets",
+    "JointColumnCells",
+    "JointColumnFacets",
     "MeshData",
     "MshInfo",
     "RectangleCells",
     "RectangleFacets",
     "box",
     "build",
+    "crack_plate",
+    "joint_column",
     "rectangle",
     "write_msh",
 ]

@@ -3,8 +3,9 @@
 A *builder* is a function ``builder(model)`` that receives the ``gmsh.model`` namespace of an open
 gmsh session, creates the geometry, the physical groups and the mesh-size field, and calls
 ``model.mesh.generate(gdim)``. The geometry modules (:mod:`contactfx.meshes.rectangle`,
-:mod:`contactfx.meshes.box`) define builders with keyword-only parameters that they validate
-before any gmsh call; callers bind the parameters with :func:`functools.partial`::
+:mod:`contactfx.meshes.box`, :mod:`contactfx.meshes.crack_plate`,
+:mod:`contactfx.meshes.joint_column`) define builders with keyword-only parameters that they
+validate before any gmsh call; callers bind the parameters with :func:`functools.partial`::
 
     data = build(comm, partial(rectangle, x0=-1.0, x1=1.0, ...), gdim=2, name="block")
 
@@ -37,7 +38,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
 from pathlib import Path
@@ -77,8 +78,13 @@ class MeshData:
     """A distributed dolfinx mesh with its physical groups as mesh tags.
 
     ``cell_tags`` holds the physical groups of the cells (named ``"cells"``), ``facet_tags``
-    those of the boundary facets (named ``"facets"``); the tag values are the IntEnum values of
-    the geometry module that built the mesh.
+    those of the facets (named ``"facets"``): the boundary facets and, for geometries with
+    cracks or joints, interior facets; the tag values are the IntEnum values of the geometry
+    module that built the mesh.
+
+    In parallel the mesh has ghost mode ``shared_facet`` (see :func:`build`): a facet on a
+    partition boundary is present on both ranks, with both its cells, and carries its tag on
+    both; integrals over ``ufl.dS`` count it once (on its owner).
     """
 
     mesh: dolfinx.mesh.Mesh
@@ -100,7 +106,8 @@ def model_to_mesh(
 ) -> tuple[dolfinx.mesh.Mesh, dolfinx.mesh.MeshTags, dolfinx.mesh.MeshTags]:
     """Distribute the gmsh model that lives on ``rank`` as a dolfinx mesh with cell and facet tags.
 
-    The only dolfinx call of :mod:`contactfx.meshes`. Collective on ``comm``.
+    The only dolfinx call of :mod:`contactfx.meshes`; ghost mode ``shared_facet``. Collective on
+    ``comm``.
     """
     from contactfx import _compat  # dolfinx is imported only when a mesh is built
 
@@ -140,6 +147,13 @@ def build(comm: MPI.Comm, builder: Builder, gdim: int, name: str) -> MeshData:
 
     Collective on ``comm``. If the builder raises on rank 0 (invalid parameters raise
     ``ValueError``), every rank raises an exception of the same type and message.
+
+    The mesh is partitioned with ghost mode ``shared_facet`` on every supported dolfinx: each
+    rank also holds, as ghosts, the cells across its facets on partition boundaries, so that
+    interior-facet integrals (``ufl.dS``: cracks, joints, material interfaces) include the
+    facets on partition boundaries, each integrated once (by the rank that owns the facet). With
+    ghost mode ``none``, dolfinx's default from 0.8 on, such a facet has one local cell: dolfinx
+    0.9 refuses to create a ``dS`` form over it (RuntimeError), dolfinx 0.5 silently skips it.
 
     Args:
         comm: The communicator of the mesh.
@@ -231,13 +245,18 @@ def add_physical_groups(
     model: type[gmsh.model],
     domain: IntEnum,
     sides: Mapping[IntEnum, tuple[int, float]],
+    interior: Mapping[IntEnum, Sequence[int]] | None = None,
 ) -> None:
     """Tag all entities of the top dimension as ``domain`` and their boundary by planes.
 
     ``sides`` maps each facet tag to ``(axis, value)``, the plane ``x[axis] == value`` its
     boundary entities lie in. Every boundary entity must lie in exactly one of the planes, so
-    the facet tags cover the boundary exactly once. Physical names are the lower-case enum names.
-    Call after the geometry is synchronised.
+    the facet tags cover the boundary exactly once. ``interior`` maps further facet tags to
+    entities of dimension ``dim - 1`` inside the domain (cracks, joints: curves embedded in a
+    surface or shared by two surfaces), e.g. the children of a line in the map returned by
+    ``model.occ.fragment``; none of them may be a boundary entity, and each group must be
+    non-empty. Physical names are the lower-case enum names. Call after the geometry is
+    synchronised.
     """
     dim = model.getDimension()
     cells = [tag for _, tag in model.getEntities(dim)]
@@ -261,8 +280,16 @@ def add_physical_groups(
     for side, tags in members.items():
         if not tags:
             raise RuntimeError(f"no boundary entity on side {side.name}")
-        model.addPhysicalGroup(dim - 1, tags, side.value)
-        model.setPhysicalName(dim - 1, side.value, side.name.lower())
+    boundary = {tag for tags in members.values() for tag in tags}
+    for group, tags in (interior or {}).items():
+        if not tags:
+            raise RuntimeError(f"no entity in interior group {group.name}")
+        if boundary.intersection(tags):
+            raise RuntimeError(f"interior group {group.name} contains boundary entities")
+        members[group] = list(tags)
+    for group, tags in members.items():
+        model.addPhysicalGroup(dim - 1, tags, group.value)
+        model.setPhysicalName(dim - 1, group.value, group.name.lower())
 
 
 def set_graded_size(
