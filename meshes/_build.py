@@ -300,12 +300,13 @@ def set_graded_size(
     size_max: float,
     dist_min: float,
     grading: float,
-) -> None:
+) -> int:
     """Make the mesh size grow linearly from ``size_min`` to ``size_max`` away from a zone.
 
     ``distance`` is a gmsh MathEval expression in x, y, z for the distance to the zone; the size
     is ``size_min`` up to ``dist_min`` and grows by ``grading`` per unit distance beyond (see
-    the module docstring). Also disables every other source of mesh size.
+    the module docstring). Also disables every other source of mesh size. Returns the size
+    field's tag (to combine it with others).
     """
     import gmsh
 
@@ -328,6 +329,7 @@ def set_graded_size(
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    return size
 
 
 def matheval_number(value: float) -> str:

@@ -68,6 +68,7 @@ def crack_plate(
     h_far: float,
     grading: float = 0.3,
     split_at: tuple[float, ...] = (),
+    h_tip: float | None = None,
 ) -> None:
     """Build and mesh the cracked square [-half_width, half_width]^2 in ``model`` (a gmsh builder).
 
@@ -82,6 +83,8 @@ def crack_plate(
         grading: Size increase per unit distance from the crack (dimensionless).
         split_at: Distinct positions -a < s < a along the crack (signed distance from the
             centre) that must be mesh nodes, e.g. the ends of a proppant layer (length).
+        h_tip: Element size at the crack tips, <= h_crack (default h_crack): the size grows
+            from h_tip at the tips by ``grading`` per unit distance up to h_crack (length).
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -98,6 +101,10 @@ def crack_plate(
     # the tips' distance to the edges, half_width - a * max(|cos|, |sin|), is then > 0.
     check_less("crack_half_length", crack_half_length, "half_width", half_width)
     check_less_equal("h_crack", h_crack, "h_far", h_far)
+    h_tip = h_crack if h_tip is None else h_tip
+    check_finite(h_tip=h_tip)
+    check_positive(h_tip=h_tip)
+    check_less_equal("h_tip", h_tip, "h_crack", h_crack)
     for s in split_at:
         check_finite(split_at=s)
         check_less("-crack_half_length", -crack_half_length, "split_at", s)
@@ -137,7 +144,7 @@ def crack_plate(
     across = f"(y*{c}-x*{n})"
     beyond_tips = f"(Fabs({along}-{a})+Fabs({along}+{a})-2*{a})/2"
     distance = f"Sqrt(({beyond_tips})^2+{across}^2)"
-    set_graded_size(
+    size = set_graded_size(
         model,
         distance,
         size_min=h_crack,
@@ -146,6 +153,20 @@ def crack_plate(
         grading=grading,
     )
     import gmsh
+
+    if h_tip < h_crack:  # the smaller of that size and h_tip + grading * (distance to a tip)
+        field = model.mesh.field
+        tip_distance = field.add("MathEval")
+        field.setString(tip_distance, "F", f"Sqrt((Fabs({along})-{a})^2+{across}^2)")
+        tip = field.add("Threshold")
+        field.setNumber(tip, "InField", tip_distance)
+        field.setNumber(tip, "SizeMin", h_tip)
+        field.setNumber(tip, "SizeMax", h_far)
+        field.setNumber(tip, "DistMin", 0.0)
+        field.setNumber(tip, "DistMax", (h_far - h_tip) / grading)
+        both = field.add("Min")
+        field.setNumbers(both, "FieldsList", [size, tip])
+        field.setAsBackgroundMesh(both)
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
     model.mesh.generate(2)

@@ -445,6 +445,7 @@ class _InterfaceRun:
             png = self.out / "interface.png"
             if comm.rank == 0:
                 _plot_profile(prof, scene, png)
+                _write_profile(prof, self.out / "interface.csv")
         dofs_total = state.function_space.dofmap.index_map.size_global * (
             state.function_space.dofmap.index_map_bs
         )
@@ -714,6 +715,14 @@ class _InterfacePost:
         self.w_out.interpolate(self.w_expr)
         self.vm.interpolate(self.vm_expr)
         return [self.w_out, self.vm, *self.fields_nodal.values(), self.status]
+
+
+def _write_profile(prof: Profile, path: Path) -> None:
+    """The interface profile as CSV (one row per interface node, sorted by s)."""
+    cols = np.column_stack([prof.s, prof.x, prof.opening, prof.slip, prof.p, prof.t,
+                            prof.status, prof.floor])  # fmt: skip
+    np.savetxt(path, cols, delimiter=",", comments="",
+               header="s,x,y,opening,slip,normal_traction,tangential_traction,status,proppant")
 
 
 def _plot_profile(prof: Profile, scene: InterfaceScene, path: Path) -> None:
