@@ -20,6 +20,8 @@ lambda_n = p and lambda_T = T.
   complementarity functions collocated at the nodes (trapezoidal / vertex quadrature):
   C_n = lambda_n - p (``min``, Alart-Curnier: = min(lambda_n, r g)) or the Fischer-Burmeister
   function of (lambda_n, r g) (``fb``), and C_T = lambda_T - T (Alart-Curnier) with friction.
+  They are stresses, tested like the tractions: every row of the residual is a force, so
+  that one absolute tolerance fits all rows.
   The multiplier's dofs away from the contact boundary are fixed to zero (a trace space on
   dolfinx versions without mixed-dimensional assembly; Hueeber & Wohlmuth 2005,
   doi:10.1016/j.cma.2004.09.012 for the semi-smooth Newton view of these equations).
@@ -149,7 +151,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         else:
             c_n = fischer_burmeister(lam_n, r * s.gap(), s.E)
         if lam_t is None:  # scalar pressure multiplier
-            return lam * ufl.dot(s.v, n) * s.ds + c_n / r * mu * s.ds_nodal
+            return lam * ufl.dot(s.v, n) * s.ds + c_n * mu * s.ds_nodal
         # traction multiplier t = lam: -int t . v, and C(lam, u) = -c_n n + (lam_T - T) = 0
         c = -c_n * n + lam_t - t_T
-        return -ufl.dot(lam, s.v) * s.ds + ufl.dot(c, mu) / r * s.ds_nodal
+        return -ufl.dot(lam, s.v) * s.ds + ufl.dot(c, mu) * s.ds_nodal

@@ -69,8 +69,8 @@ class _PlateParams(SceneParams):
     plate_width: float = param(20.0, "plate width W (the square [-W/2, W/2]^2)", positive=True)
     h_crack: float = param(0.025, "element size along the crack", positive=True)
     h_tip: float = param(0.0025, "element size at the crack tips (<= h-crack)", positive=True)
-    h_far: float = param(2.0, "element size far from the crack", positive=True)
-    grading: float = param(0.3, "element size increase per unit distance", positive=True)
+    h_far: float = param(0.5, "element size far from the crack", positive=True)
+    grading: float = param(0.15, "element size increase per unit distance", positive=True)
     boundary: str = param("infinite", "plate boundary traction: infinite (closed-form "
                           "infinite-plate field) or remote (uniform remote stress)",
                           choices=("infinite", "remote"))  # fmt: skip

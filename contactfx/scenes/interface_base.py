@@ -136,6 +136,16 @@ class InterfaceScene(Scene):
         """Named UFL functionals (integrals, summed over ranks) the scene reports."""
         return {}
 
+    @classmethod
+    def default_numerics(cls, **overrides):
+        num = super().default_numerics(**overrides)
+        if num.method not in INTERFACE_METHODS:
+            raise ValueError(
+                f"method {num.method} is not offered on fitted interfaces (it bounds dofs, not "
+                "displacement jumps); use " + ", ".join(INTERFACE_METHODS)
+            )
+        return num
+
     def run(self, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
             verbose=True) -> RunResult:  # fmt: skip
         return _InterfaceRun(self, numerics, comm, out, petsc_options or {}, verbose).execute()
@@ -473,6 +483,9 @@ class _InterfaceRun:
             "xdmf": None if xdmf_path is None else str(xdmf_path),
             "plot": None if png is None else str(png),
             **last,
+            # the names the rigid-obstacle scenes use, for tools reading any run.json
+            "force": last["normal_force"],
+            "peak_pressure": last["max_pressure"],
             "reference": reference,
             "errors": post.field_errors(),
         }
@@ -655,6 +668,9 @@ class _InterfacePost:
         if "proppant" in self.fields_nodal:
             st[closed & (self.fields_nodal["proppant"].x.array > 0.0)] = STATUS["propped"]
         gap = self.fields_nodal["gap"].x.array[:n][on]
+        complementarity = self.comm.allreduce(
+            float(np.max(np.abs(gap * p[:n][on]), initial=0.0)), op=MPI.MAX
+        )
         out: dict[str, Any] = {
             "normal_force": self._sum(self.force_form),
             "tangential_force": 0.0 if self.tforce_form is None else self._sum(self.tforce_form),
@@ -663,6 +679,7 @@ class _InterfacePost:
                 float(max(-gap.min(initial=0.0), 0.0)), op=MPI.MAX
             ),
             "max_pressure": p_max,
+            "complementarity": complementarity,
         }
         if self.propped_form is not None:
             out["proppant_force"] = self._sum(self.propped_form)

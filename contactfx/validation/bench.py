@@ -61,6 +61,15 @@ CASES: dict[str, BenchCase] = {
     ),  # fmt: skip
     "punch2d": BenchCase("punch2d", {}, 2.0, "flat rigid punch, plane strain"),
     "sliding-block": BenchCase("sliding-block", {}, 2.0, "Coulomb block dragged to gross slip"),
+    "crack-sneddon": BenchCase("crack-sneddon", {}, 2.0, "pressurised crack, Sneddon opening"),
+    "crack-inclined": BenchCase(
+        "crack-inclined", {"beta": 45.0}, 2.0, "inclined crack, compression, Coulomb mu 0.3"
+    ),
+    "propped-fracture": BenchCase(
+        "propped-fracture", {"net_pressure": 1e6}, 2.0,
+        "propped fracture, open branch p_net > p* (Sneddon)",
+    ),  # fmt: skip
+    "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
 }
 
 #: error measures: column, label, where in run.json
@@ -73,6 +82,10 @@ MEASURES: dict[str, tuple[str, tuple[str, str]]] = {
     "err_u_H1": ("displacement, H1 semi-norm", ("errors", "displacement_H1_rel")),
     "err_punch": ("punch pressure on |x| <= 0.8 a", ("scores", "normalised_pressure_error")),
     "err_Q": ("gross-slip force Q = mu P", ("reference", "Q_rel_error")),
+    "err_opening": ("crack opening, L2 on the crack", ("errors", "opening_L2_rel")),
+    "err_slip": ("crack slip, L2 on the crack", ("errors", "slip_L2_rel")),
+    "err_K": ("stress intensity factor", ("reference", "K_rel_error")),
+    "err_settlement": ("joint column settlement", ("reference", "settlement_rel_error")),
 }
 
 PENALTIES = (10.0, 100.0, 1000.0)

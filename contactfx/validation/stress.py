@@ -122,6 +122,26 @@ def cases() -> list[StressCase]:
         out.append(StressCase(f"interference gap0=-3e-3, {method}", "initial penetration",
                               "hertz2d", {**hz, "gap0": -3e-3}, {"method": method, "steps": 4},
                               quick=method == "nitsche"))  # fmt: skip
+    crack = {"h_crack": 0.05, "h_tip": 0.005, "h_far": 1.0, "grading": 0.3}
+    for mu in (0.0, 0.3, 0.6, 1.0):
+        for method in ("nitsche", "al-ssn"):
+            out.append(StressCase(f"crack beta=45 mu={mu:g}, {method}", "crack friction",
+                                  "crack-inclined", crack, {"method": method, "mu": mu},
+                                  quick=mu == 0.3 and method == "nitsche"))  # fmt: skip
+    for beta in (5.0, 85.0):  # nearly normal and nearly parallel to the compression
+        out.append(StressCase(f"crack beta={beta:g} mu=0.3", "crack friction", "crack-inclined",
+                              {**crack, "beta": beta}, {"method": "nitsche"}))  # fmt: skip
+    for p_net in (6e5, 3e5, -1e6, -20e6):  # p* = 3.08e5: open, barely propped, closing
+        for method in ("nitsche", "al-ssn"):
+            out.append(StressCase(f"proppant p_net={p_net:g}, {method}", "proppant",
+                                  "propped-fracture", {**crack, "net_pressure": p_net},
+                                  {"method": method},
+                                  quick=p_net == -1e6 and method == "nitsche"))  # fmt: skip
+    for s_c, p in ((30e6, 10e6), (3e9, 0.0), (30e6, 29.9e6), (30e6, 40e6)):
+        # the last: fluid pressure above the load, no equilibrium (a clear failure expected)
+        out.append(StressCase(f"joint s_c={s_c:g} p={p:g}", "joint closure", "joint-column",
+                              {"closure_stress": s_c, "fluid_pressure": p}, {"method": "nitsche"},
+                              quick=s_c == 3e9))  # fmt: skip
     for ranks in (1, 2, 3):
         out.append(StressCase(f"{ranks} rank(s)", "parallel", "hertz2d", hz,
                               {"method": "nitsche"}, quick=ranks < 3, ranks=ranks))  # fmt: skip
@@ -138,6 +158,9 @@ def _primary_error(data: dict) -> tuple[str, float]:
     """The case's error against the closed form: pressure in L2 on the contact boundary, else
     the punch's normalised pressure, else the gross-slip force, else the force."""
     for name, section, key in (
+        ("K", "reference", "K_rel_error"),
+        ("settlement", "reference", "settlement_rel_error"),
+        ("opening L2", "errors", "opening_L2_rel"),
         ("p L2", "errors", "pressure_L2_rel"),
         ("punch p", "scores", "normalised_pressure_error"),
         ("Q = mu P", "reference", "Q_rel_error"),
