@@ -170,8 +170,12 @@ def _interface_rows(data: dict) -> list[tuple[str, str]]:
          f"{data['closed_length']:.6g} / {data['max_penetration']:.3e}"),
     ]  # fmt: skip
     if "proppant_force" in data:
-        rows.append(("proppant force / min aperture (propped)",
-                     f"{data['proppant_force']:.6g} / {data['min_aperture_propped']:.6g}"))
+        rows.append(
+            (
+                "proppant force / min aperture (propped)",
+                f"{data['proppant_force']:.6g} / {data['min_aperture_propped']:.6g}",
+            )
+        )
     for key, value in {**data.get("reference", {}), **data.get("errors", {})}.items():
         rows.append((key.replace("_", " "), f"{value:.6g}"))
     if data.get("plot"):

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from contactfx.scenes.bar import Bar1D
-from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
 from contactfx.scenes.base import METHODS, Numerics, RunResult, Scene
+from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
@@ -15,8 +15,19 @@ __all__ = ["SCENES", "get_scene", "Scene", "Numerics", "RunResult", "METHODS"]
 
 SCENES: dict[str, type[Scene]] = {
     cls.name: cls
-    for cls in (Hertz2D, Hertz3D, Westergaard, FlatPunch2D, FlatPunch3D, SlidingBlock, Bar1D,
-                CrackSneddon, CrackInclined, ProppedFracture, JointColumn)
+    for cls in (
+        Hertz2D,
+        Hertz3D,
+        Westergaard,
+        FlatPunch2D,
+        FlatPunch3D,
+        SlidingBlock,
+        Bar1D,
+        CrackSneddon,
+        CrackInclined,
+        ProppedFracture,
+        JointColumn,
+    )
 }
 
 

@@ -229,8 +229,9 @@ class CrackSneddon(_CrackPlate):
             )
         else:
             out["contact_force_exact"] = -p * 2.0 * self.p.crack_half_length
-            out["force_rel_error"] = abs(summary["normal_force"] - out["contact_force_exact"]) / (
-                out["contact_force_exact"]
+            out["force_rel_error"] = (
+                abs(summary["normal_force"] - out["contact_force_exact"])
+                / (out["contact_force_exact"])
             )
         return out
 
@@ -299,6 +300,10 @@ class CrackInclined(_CrackPlate):
             shear = np.abs(prof.t[inner])
             out["face_shear_error"] = float(
                 np.max(np.abs(shear - mu * sigma_n), initial=0.0) / sigma_n
+            )
+            # the Coulomb law itself at the slipping nodes: |t| = mu p (computed p)
+            out["friction_law_error"] = float(
+                np.max(np.abs(shear - mu * prof.p[inner]), initial=0.0) / sigma_n
             )
             out["slipping_fraction"] = float(np.mean(prof.status[inner] == STATUS["slip"]))
         else:

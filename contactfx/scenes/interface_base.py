@@ -75,6 +75,7 @@ class InterfaceScene(Scene):
     tips, frame), the supports and loads, and the closed-form references."""
 
     interface_tag: ClassVar[int]
+
     #: component supports: (facet tag, component) pairs with zero displacement; they hold for
     #: the total displacement, so for u and a alike
     def supports(self) -> list[tuple[int, int]]:
@@ -636,8 +637,7 @@ class _InterfacePost:
                 dolfinx.fem.form(exact**2 * dS_fine),
             )
         self.extra = {
-            k: dolfinx.fem.form(v)
-            for k, v in scene.extra_quantities(mesh, surface.w, ds).items()
+            k: dolfinx.fem.form(v) for k, v in scene.extra_quantities(mesh, surface.w, ds).items()
         }
         # the displacement w for ParaView: discontinuous across the interface
         DG0 = _compat.function_space(mesh, "DG", 0)
@@ -738,8 +738,13 @@ def _write_profile(prof: Profile, path: Path) -> None:
     """The interface profile as CSV (one row per interface node, sorted by s)."""
     cols = np.column_stack([prof.s, prof.x, prof.opening, prof.slip, prof.p, prof.t,
                             prof.status, prof.floor])  # fmt: skip
-    np.savetxt(path, cols, delimiter=",", comments="",
-               header="s,x,y,opening,slip,normal_traction,tangential_traction,status,proppant")
+    np.savetxt(
+        path,
+        cols,
+        delimiter=",",
+        comments="",
+        header="s,x,y,opening,slip,normal_traction,tangential_traction,status,proppant",
+    )
 
 
 def _plot_profile(prof: Profile, scene: InterfaceScene, path: Path) -> None:
@@ -781,4 +786,3 @@ def _plot_profile(prof: Profile, scene: InterfaceScene, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
-

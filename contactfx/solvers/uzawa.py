@@ -15,8 +15,9 @@ class Uzawa:
     """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
 
     ``update`` is a compiled expression of the multiplier's next value, interpolated into the
-    multiplier's space (or a callable that fills the Function it is given); ``mask`` (bool per local dof of that space) selects the contact
-    boundary's nodes, elsewhere the multiplier is kept at zero. The loop stops when
+    multiplier's space (or a callable that fills the Function it is given); ``mask`` (bool per
+    local dof of that space) selects the contact boundary's nodes, elsewhere the multiplier is
+    kept at zero. The loop stops when
     max |lambda_{k+1} - lambda_k| <= tol max |lambda_{k+1}| over the contact nodes: the nodal
     constraint violation and complementarity residual are then below tol max |lambda| / r.
     On failure (inner divergence or ``max_it`` outer iterations) the multiplier of the last

@@ -66,7 +66,9 @@ CASES: dict[str, BenchCase] = {
         "crack-inclined", {"beta": 45.0}, 2.0, "inclined crack, compression, Coulomb mu 0.3"
     ),
     "propped-fracture": BenchCase(
-        "propped-fracture", {"net_pressure": 1e6}, 2.0,
+        "propped-fracture",
+        {"net_pressure": 1e6},
+        2.0,
         "propped fracture, open branch p_net > p* (Sneddon)",
     ),  # fmt: skip
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
