@@ -245,13 +245,13 @@ class CrackInclinedParams(_PlateParams):
 
 class CrackInclined(_CrackPlate):
     name = "crack-inclined"
-    summary = "inclined closed crack under uniaxial compression, Coulomb friction (K_II)"
+    summary = "inclined closed crack under uniaxial compression, Coulomb / Tresca friction (K_II)"
     Params = CrackInclinedParams
     numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 1}
 
-    def __init__(self, params, friction_mu: float | None = None) -> None:
+    def __init__(self, params) -> None:
         super().__init__(params)
-        self.mu = friction_mu
+        self.friction = None  # the friction law of the run (set by run)
 
     def angle(self):
         return self.p.beta
@@ -266,10 +266,19 @@ class CrackInclined(_CrackPlate):
         tau = d @ S @ n
         return sigma_n, tau
 
+    def _bound(self, p):
+        """Friction bound of the law at the contact pressure p (numbers)."""
+        f = self.friction
+        if f is None:
+            return 0.0 * p
+        if f.name == "coulomb":
+            return f.mu * p
+        return f.threshold + 0.0 * p
+
     def _q(self) -> float:
+        """Driving shear: tau minus the friction resistance when it is exceeded, else 0."""
         sigma_n, tau = self._plane()
-        mu = 0.0 if self.mu is None else self.mu
-        return float(cf.driving_shear(tau, sigma_n, mu))
+        return float(cf.driving_shear(tau, self._bound(sigma_n), 1.0))
 
     def face_loads(self):
         return 0.0, self._q()
@@ -285,9 +294,8 @@ class CrackInclined(_CrackPlate):
 
     def interface_reference(self, prof, summary):
         sigma_n, tau = self._plane()
-        mu = 0.0 if self.mu is None else self.mu
         a = self.p.crack_half_length
-        exact = float(cf.inclined_crack_KII(self.p.sigma, a, self.p.beta, mu))
+        exact = abs(self._q()) * np.sqrt(np.pi * a)
         out = {"sigma_n": sigma_n, "tau": tau, "K_II_exact": exact,
                "K_II_normalised_exact": exact / (self.p.sigma * np.sqrt(np.pi * a))}  # fmt: skip
         K = self._K(prof, prof.slip) if exact > 0.0 else float(np.max(np.abs(prof.slip)))
@@ -295,15 +303,15 @@ class CrackInclined(_CrackPlate):
         if exact > 0.0:
             out["K_II_normalised"] = K / (self.p.sigma * np.sqrt(np.pi * a))
             out["K_rel_error"] = abs(K - exact) / exact
-            # sliding: the face shear equals mu sigma_n at the nodes away from the tips
+            # sliding: the face shear equals the bound at sigma_n at the nodes off the tips
             inner = np.abs(prof.s) < a - 2.0 * self.p.h_crack
             shear = np.abs(prof.t[inner])
             out["face_shear_error"] = float(
-                np.max(np.abs(shear - mu * sigma_n), initial=0.0) / sigma_n
+                np.max(np.abs(shear - self._bound(sigma_n)), initial=0.0) / sigma_n
             )
-            # the Coulomb law itself at the slipping nodes: |t| = mu p (computed p)
+            # the friction law itself at the slipping nodes: |t| = bound(p) (computed p)
             out["friction_law_error"] = float(
-                np.max(np.abs(shear - mu * prof.p[inner]), initial=0.0) / sigma_n
+                np.max(np.abs(shear - self._bound(prof.p[inner])), initial=0.0) / sigma_n
             )
             out["slipping_fraction"] = float(np.mean(prof.status[inner] == STATUS["slip"]))
         else:
@@ -311,10 +319,7 @@ class CrackInclined(_CrackPlate):
         return out
 
     def run(self, numerics, **kwargs):
-        self.mu = numerics.mu if numerics.friction == "coulomb" else None
-        if numerics.friction == "tresca":
-            raise ValueError("crack-inclined compares with Coulomb friction: use --friction "
-                             "coulomb or none")  # fmt: skip
+        self.friction = numerics.friction_law()
         return super().run(numerics, **kwargs)
 
 

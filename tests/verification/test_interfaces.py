@@ -129,6 +129,16 @@ def test_inclined_crack_methods_agree(numerics):
     assert ref["K_rel_error"] < 0.03
 
 
+def test_inclined_crack_tresca():
+    # beta 45: tau = 5 MPa; Tresca threshold 2 MPa slides the crack with q = 3 MPa
+    scene = CrackInclined(CrackInclined.Params(beta=45.0))
+    data = _run(scene, method="nitsche", friction="tresca", threshold=2e6, mu=0.0)
+    ref = data["reference"]
+    assert ref["K_II_normalised_exact"] == pytest.approx(0.3, rel=1e-12)
+    assert ref["K_rel_error"] < 0.05  # as the Coulomb table (1.3-2.5 % measured)
+    assert ref["friction_law_error"] < 1e-9  # |t| = threshold at every sliding node
+
+
 # -- propped fracture ------------------------------------------------------------------------
 def test_propped_open_branch_is_sneddon():
     scene = ProppedFracture(ProppedFracture.Params(net_pressure=1e6))
