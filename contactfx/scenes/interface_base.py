@@ -9,9 +9,10 @@ rigid-obstacle scenes (Nitsche, penalty, augmented Lagrangian), written against
 
 Outputs: along the interface the aperture, slip, normal and tangential traction and the status
 (0 open, 1 closed / stick, 2 slip, 3 propped) as P1 fields in the XDMF file (zero away from the
-interface) and as a PNG line plot (``interface.png``) against the interface coordinate s; the
-displacement w as a discontinuous field (``displacement``), so that ParaView's Warp By Vector
-opens the crack.
+interface), as a PNG line plot (``interface.png``) against the interface coordinate s and as
+CSV (``interface.csv``); the continuous part u (``displacement``) and the enrichment a
+(``enrichment``): the faces are at u + a and u - a (XDMF stores no discontinuous fields on
+dolfinx >= 0.8).
 """
 
 from __future__ import annotations
@@ -342,7 +343,7 @@ class _InterfaceRun:
         F_c = dolfinx.fem.form(Fc_ufl)
         J_c = dolfinx.fem.form(ufl.derivative(Fc_ufl, state, trial))
         post = _InterfacePost(mesh, scene, num, surface, method, dS_nodal, dS_fine, s_coord,
-                              material, H, ds, facet_tags)  # fmt: skip
+                              material, H, ds, facet_tags, U)  # fmt: skip
         update = None
         if multiplier is not None:
             update = _NodalUpdate(method.update(surface), multiplier, dS_nodal)
@@ -580,7 +581,7 @@ class _InterfacePost:
     """Nodal interface fields, forces, errors against the closed forms, the gathered profile."""
 
     def __init__(self, mesh, scene, num, surface: InterfaceSurface, method, dS_nodal, dS_fine,
-                 s_coord, material, H, ds, facet_tags) -> None:  # fmt: skip
+                 s_coord, material, H, ds, facet_tags, U) -> None:  # fmt: skip
         self.mesh, self.scene, self.num, self.surface = mesh, scene, num, surface
         self.comm = mesh.comm
         gdim = mesh.geometry.dim
@@ -639,13 +640,18 @@ class _InterfacePost:
         self.extra = {
             k: dolfinx.fem.form(v) for k, v in scene.extra_quantities(mesh, surface.w, ds).items()
         }
-        # the displacement w for ParaView: discontinuous across the interface
+        # the continuous part u ("displacement": the displacement everywhere but in the cells
+        # touching the interface, where w = u + H a) and the enrichment a ("enrichment": the
+        # faces are at u + a and u - a, the jump is 2 a); XDMF on dolfinx >= 0.8 stores no
+        # discontinuous fields
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm_expr = _compat.expression(material.von_mises(surface.w), DG0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
-        Vd = _compat.function_space(mesh, "DG", 1, (gdim,))
-        self.w_out = dolfinx.fem.Function(Vd, name="displacement")
-        self.w_expr = _compat.expression(surface.w, Vd)
+        V1 = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
+        self.u_out = dolfinx.fem.Function(V1, name="displacement")
+        self.a_out = dolfinx.fem.Function(V1, name="enrichment")
+        self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(gdim)]), V1)
+        self.a_expr = _compat.expression(ufl.as_vector([U[gdim + i] for i in range(gdim)]), V1)
         self.x_nodes = _compat.dof_coordinates(Q1)
 
     def _sum(self, form) -> float:
@@ -729,9 +735,10 @@ class _InterfacePost:
                        a[:, 8])  # fmt: skip
 
     def fields(self, state) -> list:
-        self.w_out.interpolate(self.w_expr)
+        self.u_out.interpolate(self.u_expr)
+        self.a_out.interpolate(self.a_expr)
         self.vm.interpolate(self.vm_expr)
-        return [self.w_out, self.vm, *self.fields_nodal.values(), self.status]
+        return [self.u_out, self.a_out, self.vm, *self.fields_nodal.values(), self.status]
 
 
 def _write_profile(prof: Profile, path: Path) -> None:
