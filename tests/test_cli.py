@@ -59,6 +59,19 @@ BAD = [
     (["bench", "--degree", "3"], "--degree must list 1 and/or 2"),
     (["stress", "--axis", "nosuch"], "unknown axis 'nosuch'"),
     (["stress", "--time-limit", "-1"], "--time-limit must be > 0"),
+    (["run", "crack-sneddon", "--method", "vi"], "method vi is not offered on fitted interfaces"),
+    (["run", "crack-sneddon", "--h-tip", "0.1"], "element sizes must satisfy --h-tip"),
+    (["run", "crack-sneddon", "--crack-half-length", "12"], "must be < plate-width / 2"),
+    (["run", "crack-inclined", "--nu", "0.5"], "Poisson's ratio nu must lie in (-1, 0.5)"),
+    (["run", "crack-inclined", "--boundary", "free"], "--boundary must be one of"),
+    (["run", "propped-fracture", "--proppant-thickness=-1e-4"], "--proppant-thickness must be > 0"),
+    (
+        ["run", "propped-fracture", "--proppant-half-length", "1.5"],
+        "--proppant-half-length (1.5) must be < --crack-half-length",
+    ),
+    (["run", "joint-column", "--Vm", "2e-3"], "--Vm (0.002) must be <= --aperture"),
+    # the fluid pushes harder than the load: no equilibrium, the solve diverges
+    (["run", "joint-column", "--fluid-pressure", "40e6"], "nonlinear solve diverged"),
 ]
 
 
