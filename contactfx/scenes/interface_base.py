@@ -791,7 +791,8 @@ def _plot_profile(prof: Profile, scene: InterfaceScene, path: Path) -> None:
     for name, code in STATUS.items():
         sel = prof.status == code
         if np.any(sel) and code > 0:
-            ax.plot(s[sel], np.zeros(sel.sum()), "|", ms=8, label=name)
+            label = "closed / stick" if name == "stick" else name
+            ax.plot(s[sel], np.zeros(sel.sum()), "|", ms=8, label=label)
     ax.set_ylabel("traction")
     ax.set_xlabel("s (along the interface)")
     ax.legend(fontsize=8)
