@@ -464,13 +464,9 @@ class _Run:
                 entry["stick_size"] = summary["stick_size"]
             steps_log.append(entry)
             if writer is not None:
-                t_out = time.perf_counter()
                 if split:
                     displacement.x.array[:] = state.x.array[out_map]
-                writer.write(rec.load, post.fields(displacement))
-                self.timings["output"] = self.timings.get("output", 0.0) + (
-                    time.perf_counter() - t_out
-                )
+                _write_timed(writer, rec.load, post.fields(displacement), self.timings)
             if friction is not None:  # this step is the history of the next one
                 prev.x.array[:] = state.x.array
                 offset_prev.value[:] = offset.value
@@ -490,14 +486,7 @@ class _Run:
         try:
             if xdmf_path is not None:
                 writer = ResultsWriter(xdmf_path, mesh).__enter__()
-            t_solve0 = time.perf_counter()
-            a_before = solver.timer.assembly
-            records = run_load_program(solver, apply_load, steps=num.steps, on_step=on_step)
-            total = time.perf_counter() - t_solve0
-            self.timings["assembly"] = solver.timer.assembly
-            self.timings["solve"] = (
-                total - (solver.timer.assembly - a_before) - self.timings.get("output", 0.0)
-            )
+            records = _timed_load_program(solver, apply_load, num.steps, on_step, self.timings)
         finally:
             if writer is not None:
                 writer.__exit__(None, None, None)
@@ -545,6 +534,25 @@ class _Run:
         if self.out is not None:
             write_json(self.out / "run.json", data, comm)
         return RunResult(data)
+
+
+def _timed_load_program(solver, apply_load, steps: int, on_step, timings: dict) -> list:
+    """run_load_program, recording the assembly time and the solve time (wall time less
+    assembly and the output written by on_step, see :func:`_write_timed`) in ``timings``."""
+    t0 = time.perf_counter()
+    a_before = solver.timer.assembly
+    records = run_load_program(solver, apply_load, steps=steps, on_step=on_step)
+    total = time.perf_counter() - t0
+    timings["assembly"] = solver.timer.assembly
+    timings["solve"] = total - (solver.timer.assembly - a_before) - timings.get("output", 0.0)
+    return records
+
+
+def _write_timed(writer, t: float, fields, timings: dict) -> None:
+    """writer.write(t, fields), adding its wall time to timings["output"]."""
+    t0 = time.perf_counter()
+    writer.write(t, fields)
+    timings["output"] = timings.get("output", 0.0) + (time.perf_counter() - t0)
 
 
 def _vertex_rule(fdim: int) -> dict:

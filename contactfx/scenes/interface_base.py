@@ -40,9 +40,11 @@ from contactfx.scenes.base import (
     _boundary_mask,
     _prepare_output,
     _say,
+    _timed_load_program,
     _vertex_rule,
+    _write_timed,
 )
-from contactfx.solvers.loadstep import StepRecord, run_load_program
+from contactfx.solvers.loadstep import StepRecord
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
 from contactfx.solvers.uzawa import Uzawa
 
@@ -423,11 +425,7 @@ class _InterfaceRun:
                 "tangential_force": summary["tangential_force"],
             })  # fmt: skip
             if writer is not None:
-                t_out = time.perf_counter()
-                writer.write(rec.load, post.fields(state))
-                self.timings["output"] = self.timings.get("output", 0.0) + (
-                    time.perf_counter() - t_out
-                )
+                _write_timed(writer, rec.load, post.fields(state), self.timings)
             if prev is not None:
                 prev.x.array[:] = state.x.array
             outer = f"  outer {rec.stats.outer:3d}" if multiplier is not None else ""
@@ -441,14 +439,7 @@ class _InterfaceRun:
         try:
             if xdmf_path is not None:
                 writer = ResultsWriter(xdmf_path, mesh).__enter__()
-            t_solve0 = time.perf_counter()
-            a_before = solver.timer.assembly
-            records = run_load_program(solver, apply_load, steps=num.steps, on_step=on_step)
-            total = time.perf_counter() - t_solve0
-            self.timings["assembly"] = solver.timer.assembly
-            self.timings["solve"] = (
-                total - (solver.timer.assembly - a_before) - self.timings.get("output", 0.0)
-            )
+            records = _timed_load_program(solver, apply_load, num.steps, on_step, self.timings)
         finally:
             if writer is not None:
                 writer.__exit__(None, None, None)
