@@ -762,20 +762,14 @@ def _plot_profile(prof: Profile, scene: InterfaceScene, path: Path) -> None:
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 8.0), sharex=True)
     s = prof.s
     ref = scene.reference_profile(s)
-    ax = axes[0]
-    ax.plot(s, prof.opening, "o-", ms=2, label="opening (computed)")
-    if np.any(prof.floor > 0.0):
-        ax.plot(s, prof.floor, "k--", lw=1, label="proppant thickness")
-    if "opening" in ref:
-        ax.plot(s, ref["opening"], "-", lw=1, label="opening (closed form)")
-    ax.set_ylabel("opening")
-    ax.legend(fontsize=8)
-    ax = axes[1]
-    ax.plot(s, prof.slip, "o-", ms=2, label="slip (computed)")
-    if "slip" in ref:
-        ax.plot(s, ref["slip"], "-", lw=1, label="slip (closed form)")
-    ax.set_ylabel("slip")
-    ax.legend(fontsize=8)
+    for ax, name, computed in ((axes[0], "opening", prof.opening), (axes[1], "slip", prof.slip)):
+        ax.plot(s, computed, "o-", ms=2, label=f"{name} (computed)")
+        if name == "opening" and np.any(prof.floor > 0.0):
+            ax.plot(s, prof.floor, "k--", lw=1, label="proppant thickness")
+        if name in ref:
+            ax.plot(s, ref[name], "-", lw=1, label=f"{name} (closed form)")
+        ax.set_ylabel(name)
+        ax.legend(fontsize=8)
     ax = axes[2]
     ax.plot(s, prof.p, "o-", ms=2, label="contact pressure")
     ax.plot(s, prof.t, "s-", ms=2, label="tangential traction")
