@@ -4,7 +4,7 @@
 # compression $s_c$ on top and the fluid pressure $p$ in the joint. The joint closes by
 # $v = s' V_m / (K_{ni} V_m + s')$ under the effective stress $s' = s_c - p$ (Barton-Bandis), and
 # the top settles by $2 H s_c / M + v$. The solution is uniform in each block: every mesh and
-# every method reproduces the table of BENCHMARKS section 7.
+# every method reproduces the table of docs/verification.md section 7.
 #
 # It illustrates how to:
 # - run the joint law with Nitsche's method and the augmented Lagrangian,

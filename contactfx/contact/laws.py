@@ -1,6 +1,6 @@
 """Pointwise contact and friction laws as UFL expressions.
 
-Conventions (ARCHITECTURE.md): gap g >= 0 when apart, pressure p >= 0 in compression, g p = 0;
+Conventions (docs/architecture.md): gap g >= 0 when apart, pressure p >= 0 in compression, g p = 0;
 the tangential traction t_T on the body satisfies |t_T| <= s (s = mu p for Coulomb, a given
 threshold for Tresca), and it opposes the slip where |t_T| = s.
 

@@ -4,7 +4,7 @@ Bar (0, L), E A = E, u(0) = 0, body force f, wall at x = L + g0 (u(L) <= g0). Wi
 Chouly-Hild parameter gamma0' = 1 / gamma0 and N P1 elements of size h, the Nitsche solution
 penetrates by pen = gamma0' f h^2 / (2 E (1 - theta gamma0')) and its multiplier differs from
 lambda = f L / 2 - E g0 / L by 0 (theta = 1), -E pen / L (0), -2 E pen / L (-1)
-(BENCHMARKS.md section 8; Chouly & Hild 2013, doi:10.1137/12088344X).
+(docs/verification.md section 8; Chouly & Hild 2013, doi:10.1137/12088344X).
 """
 
 from __future__ import annotations

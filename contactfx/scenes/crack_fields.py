@@ -1,8 +1,8 @@
-"""Closed forms for crack-face contact and joints (plane strain; BENCHMARKS.md sections 6, 7).
+"""Closed forms for crack-face contact and joints (plane strain; docs/verification.md sections 6, 7).
 
 Crack |x| < a on y = 0 in an infinite plate, in the crack's own frame. Signs: tension positive
 for stresses; pressures p, normal stresses sigma_n and effective stresses s' are positive in
-compression (ARCHITECTURE.md); ``E' = E / (1 - nu^2)``.
+compression (docs/architecture.md); ``E' = E / (1 - nu^2)``.
 
 Stress field of a crack with loaded faces (Westergaard 1939, J. Appl. Mech. 6, A49-A53,
 doi:10.1115/1.4008969; Tada, Paris & Irwin 2000, The Stress Analysis of Cracks Handbook, 3rd
@@ -33,7 +33,7 @@ doi:10.1098/rspa.1946.0077)
 
 Closed crack under compression sigma_n > 0 and shear tau with Coulomb friction mu: it sticks
 if |tau| <= mu sigma_n, otherwise it slides as a whole under the driving shear
-q = sign(tau) (|tau| - mu sigma_n) (BENCHMARKS.md section 6). Under uniaxial compression sigma
+q = sign(tau) (|tau| - mu sigma_n) (docs/verification.md section 6). Under uniaxial compression sigma
 with the crack at beta to the plane normal to the compression, sigma_n = sigma cos^2 beta,
 tau = sigma sin beta cos beta, so K_II = sigma sqrt(pi a) cos beta (sin beta - mu cos beta)
 when tan beta > mu. A strip of full width W with traction data raises K by the factor

@@ -3,7 +3,7 @@
 2D (plane strain, half-width a): p(x) = P / (pi sqrt(a^2 - x^2)); the pressure is singular at
 the edge, so the score is the normalised interior pressure pi sqrt(a^2 - x^2) p_h / P on
 |x| <= 0.8 a. 3D (circular punch of radius a, quarter model): stiffness P = 2 a E* delta
-(Johnson 1985, doi:10.1017/CBO9781139171731, sections 2.8 and 3.8; BENCHMARKS.md section 2).
+(Johnson 1985, doi:10.1017/CBO9781139171731, sections 2.8 and 3.8; docs/verification.md section 2).
 The edge radius regularises the corner; the contact extends beyond a by O(edge radius).
 """
 

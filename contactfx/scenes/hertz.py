@@ -2,7 +2,7 @@
 
 A rigid cylinder / sphere of radius R is pressed by the depth ``depth`` into an elastic block
 whose bottom is clamped. The reference is evaluated at the computed force P (the finite block
-changes the force-depth relation, not a and p0 at given P; BENCHMARKS.md section 1):
+changes the force-depth relation, not a and p0 at given P; docs/verification.md section 1):
 
     2D: a = sqrt(4 P R / (pi E*)),  p0 = 2 P / (pi a)
     3D: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2)

@@ -6,7 +6,7 @@ the top, and the fluid pressure p on the joint's faces. The joint closes by v un
 effective stress s' = s_c - p by the Barton-Bandis law (Bandis, Lumsden & Barton 1983,
 doi:10.1016/0148-9062(83)90595-8): v = s' V_m / (K_ni V_m + s'), aperture w = w0 - v; the top
 settles by 2 H s_c / M + v. The solution is uniform in each block, so every mesh and method
-reproduces it to the solver tolerance (BENCHMARKS section 7).
+reproduces it to the solver tolerance (docs/verification.md section 7).
 """
 
 from __future__ import annotations

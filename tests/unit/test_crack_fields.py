@@ -1,6 +1,6 @@
 """Unit tests of :mod:`contactfx.scenes.crack_fields`: the Westergaard crack field satisfies
 equilibrium, compatibility, the face conditions, decay and the tip asymptotics; its strains
-integrate to Sneddon's opening and slip; the tables of BENCHMARKS.md sections 6 and 7.
+integrate to Sneddon's opening and slip; the tables of docs/verification.md sections 6 and 7.
 
 Run at 1 and 2 ranks::
 
@@ -179,7 +179,7 @@ def test_slip_from_the_strains():
 
 
 def test_inclined_crack_table():
-    """BENCHMARKS.md section 6: K_II / (sigma sqrt(pi a)), printed to 5 decimals."""
+    """docs/verification.md section 6: K_II / (sigma sqrt(pi a)), printed to 5 decimals."""
     table = {0.0: (0.43301, 0.5, 0.43301), 0.3: (0.20801, 0.35, 0.35801), 0.6: (0.0, 0.2, 0.28301)}
     sigma = 7.0
     for mu, row in table.items():
@@ -205,12 +205,12 @@ def test_crack_plane_and_friction():
 
 
 def test_width_correction():
-    """Feddersen: sqrt(sec(pi a / W)) = 1.0062 at W / a = 20 (BENCHMARKS.md section 6)."""
+    """Feddersen: sqrt(sec(pi a / W)) = 1.0062 at W / a = 20 (docs/verification.md section 6)."""
     assert width_correction(1.0, 20.0) == pytest.approx(1.0062, abs=1e-4)
     assert width_correction(A, 20.0 * A) == pytest.approx(width_correction(1.0, 20.0), rel=1e-14)
 
 
-# BENCHMARKS.md section 7, SI units: E = 10 GPa, nu = 0.25 (M = 12 GPa), H = 1 m, w0 = 1 mm,
+# docs/verification.md section 7, SI units: E = 10 GPa, nu = 0.25 (M = 12 GPa), H = 1 m, w0 = 1 mm,
 # K_ni = 50 GPa/m, V_m = 0.3 mm (K_ni V_m = 15 MPa). The closure v = s' V_m / (K_ni V_m + s') is
 # a fraction of a mm (the printed table rounds it: 171.429 um is 2.5e-6 off 6/35 mm).
 COLUMN = dict(E=10e9, nu=0.25, H=1.0, w0=1e-3, Kni=50e9, Vm=0.3e-3)

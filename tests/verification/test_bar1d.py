@@ -1,4 +1,4 @@
-"""1D bar with Nitsche contact: the exact discrete solution (BENCHMARKS.md section 8)."""
+"""1D bar with Nitsche contact: the exact discrete solution (docs/verification.md section 8)."""
 
 import pytest
 
@@ -19,7 +19,7 @@ def test_bar_penetration_and_multiplier_exact(theta):
 
 
 def test_bar_table_values():
-    # the closed form itself against the numbers printed in BENCHMARKS.md
+    # the closed form itself against the numbers printed in docs/verification.md
     e1 = bar_nitsche_exact(E=1, L=1, f=1, g0=0.3, n=8, theta=1, gamma0=2.0)
     e0 = bar_nitsche_exact(E=1, L=1, f=1, g0=0.3, n=8, theta=0, gamma0=2.0)
     assert e1["penetration"] == pytest.approx(7.8125e-3, rel=1e-14)

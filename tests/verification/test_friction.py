@@ -1,6 +1,6 @@
 """Friction (Tresca, Coulomb) for every method that supports it: the sliding block's exact
 gross-slip force and traction, the Coulomb cone at every quadrature point, the frictionless
-limit, and the Cattaneo-Mindlin trend under a Hertz contact (BENCHMARKS.md section 4)."""
+limit, and the Cattaneo-Mindlin trend under a Hertz contact (docs/verification.md section 4)."""
 
 import pytest
 

@@ -1,5 +1,5 @@
 """Hertz line contact (2D) and sphere contact (3D) against the closed form at the computed force
-(BENCHMARKS.md section 1)."""
+(docs/verification.md section 1)."""
 
 import pytest
 
@@ -30,7 +30,7 @@ def test_hertz2d_coarse(num, degree):
     ref = Hertz2D(COARSE).run(num, verbose=False)["reference"]
     # the contact edge is resolved to the element containing it: |a_h - a| <= h / 2
     assert ref["a_error_over_h"] <= 0.5
-    # about 10 elements across a: a few percent on the peak (BENCHMARKS.md section 1)
+    # about 10 elements across a: a few percent on the peak (docs/verification.md section 1)
     assert ref["p0_rel_error"] < 0.03
 
 
@@ -57,7 +57,7 @@ def test_nitsche_and_vi_agree(degree):
 def test_hertz3d():
     result = Hertz3D(Hertz3DParams(h_contact=0.015)).run(Numerics(), verbose=False)
     ref = result["reference"]
-    # quarter model, about 7 tetrahedra across a = 0.1: 5 % (BENCHMARKS.md section 1)
+    # quarter model, about 7 tetrahedra across a = 0.1: 5 % (docs/verification.md section 1)
     assert ref["a_rel_error"] < 0.05
     assert ref["p0_rel_error"] < 0.05
 

@@ -1,5 +1,5 @@
 """Near-incompressible Hertz line contact with the mixed displacement-pressure (Taylor-Hood
-P2/P1) formulation, against the closed form at the computed force (BENCHMARKS.md section 1).
+P2/P1) formulation, against the closed form at the computed force (docs/verification.md section 1).
 
 Measured on this mesh (h_contact = 6e-3, about 4.5 elements across a = 0.027), Nitsche
 theta = 1, gamma0 = 10, one load step:

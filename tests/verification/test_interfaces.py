@@ -1,4 +1,4 @@
-"""Fitted interfaces (BENCHMARKS sections 6 and 7): Barton-Bandis joint column, Sneddon's
+"""Fitted interfaces (docs/verification.md sections 6 and 7): Barton-Bandis joint column, Sneddon's
 pressurised crack, the inclined frictional crack, the propped fracture.
 
 Run serially and with ``mpirun -n 2 python -m mpi4py -m pytest``: the contact quantities are
@@ -40,7 +40,7 @@ def test_joint_column_table(numerics, s_c, p):
     ref = data["reference"]
     exact = joint_column(s_c, p, 10e9, 0.25, 1.0, 1e-3, 50e9, 3e-4)
     # the solution is uniform in each block: P1 represents it exactly, so the only error is
-    # the solver's (Newton to rtol 1e-10 / round-off); 1e-6 is BENCHMARKS' requirement
+    # the solver's (Newton to rtol 1e-10 / round-off); 1e-6 is the requirement of docs/verification.md
     for key in ("closure", "aperture", "settlement"):
         assert ref[key] == pytest.approx(exact[key], rel=1e-6), key
     # the joint carries the effective stress: normal force = (s_c - p) L
@@ -72,7 +72,7 @@ def test_sneddon_opening_converges():
         params = CrackSneddon.Params(h_crack=h, h_tip=h / 10, h_far=20 * h, grading=6 * h)
         errors.append(_run(CrackSneddon(params), method="nitsche")["errors"]["opening_L2_rel"])
     rates = [math.log2(e0 / e1) for e0, e1 in zip(errors[:-1], errors[1:], strict=True)]
-    # BENCHMARKS: about O(h); with the tips graded the observed rates are 1.5-1.7
+    # docs/verification.md: about O(h); with the tips graded the observed rates are 1.5-1.7
     assert min(rates) > 0.9, (errors, rates)
 
 
@@ -88,7 +88,7 @@ def test_sneddon_suction_closes_with_uniform_pressure(numerics):
 
 
 # -- inclined crack under compression: K_II table ------------------------------------------
-KII_TABLE = {  # BENCHMARKS section 6, K_II / (sigma sqrt(pi a)) at beta = 30 / 45 / 60
+KII_TABLE = {  # docs/verification.md section 6, K_II / (sigma sqrt(pi a)) at beta = 30 / 45 / 60
     0.0: (0.43301, 0.5, 0.43301),
     0.3: (0.20801, 0.35, 0.35801),
     0.6: (0.0, 0.2, 0.28301),
@@ -108,7 +108,7 @@ def test_inclined_crack_KII_table(mu, column, beta):
         assert ref["max_slip"] < 1e-12
         assert data["errors"]["slip_L2"] < 1e-12
         return
-    # displacement extrapolation of the slip, 1.3-2.5 % on the default mesh: BENCHMARKS asks 5 %
+    # displacement extrapolation of the slip, 1.3-2.5 % on the default mesh: docs/verification.md asks 5 %
     assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.05)
     # the whole crack slides: the Coulomb law |t| = mu p holds at every node (to round-off:
     # t and p are the projections at the same points)

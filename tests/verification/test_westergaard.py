@@ -1,4 +1,4 @@
-"""Westergaard's wavy surface (BENCHMARKS.md section 3): partial contact half-width and the
+"""Westergaard's wavy surface (docs/verification.md section 3): partial contact half-width and the
 optimal convergence rates of the smooth full-contact solution."""
 
 import numpy as np
