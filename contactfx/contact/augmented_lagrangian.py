@@ -33,14 +33,17 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.gap import ContactSurface, tangential
 from contactfx.contact.laws import (
     active,
     ball_projection,
     fischer_burmeister,
     norm,
     positive_part,
+    tangential,
 )
+from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.surface import Surface
+from contactfx.params import param, validate
 
 __all__ = ["AugmentedLagrangianUzawa", "AugmentedLagrangianSSN", "split_multiplier"]
 
@@ -53,18 +56,19 @@ def split_multiplier(lam, n):
     return -ufl.dot(lam, n), tangential(lam, n)
 
 
+_R0 = "augmented Lagrangian augmentation, r = r0 E / h"
+_FRICTION = ("none", "tresca", "coulomb")
+
+
 @dataclass(frozen=True)
-class _AugmentedBase:
-    r0: float = 10.0
-
+class _AugmentedBase(MethodBase):
     def __post_init__(self) -> None:
-        if not self.r0 > 0.0:
-            raise ValueError(f"augmentation r0 must be > 0, got {self.r0}")
+        validate(self)
 
-    def r(self, s: ContactSurface):
+    def r(self, s: Surface):
         return self.r0 * s.E / s.h
 
-    def _augmented(self, s: ContactSurface, lam):
+    def _augmented(self, s: Surface, lam):
         """(p, T trial, T) from the multiplier lam; T and its trial are None without friction."""
         n = s.normal()
         lam_n, lam_t = split_multiplier(lam, n)
@@ -74,7 +78,7 @@ class _AugmentedBase:
         trial = lam_t - self.r(s) * s.slip_increment(n)
         return p, trial, ball_projection(trial, s.friction.bound(p), s.E)
 
-    def _slip(self, s: ContactSurface, lam):
+    def _slip(self, s: Surface, lam):
         p, trial, _ = self._augmented(s, lam)
         return active(p) * active(norm(trial, s.E) - s.friction.bound(p))
 
@@ -84,26 +88,45 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
     """r0 > 0 (r = r0 E / h). ``s.multiplier`` is the nodal multiplier Function (scalar P1
     without friction, vector P1 with); the outer loop is :class:`contactfx.solvers.uzawa.Uzawa`."""
 
+    r0: float = param(10.0, _R0, positive=True)
+    al_tol: float = param(1e-8, "al-uzawa stop: max nodal multiplier change / max multiplier",
+                          positive=True)  # fmt: skip
+    al_max_it: int = param(100, "al-uzawa maximal outer iterations", positive=True)
     name = "al-uzawa"
-    mixed = False
+    multiplier = "nodal"
+    supports = Supports(
+        friction=_FRICTION, mixed_up=True, interfaces=True, dim1=False,
+        why_not={"nodal_quadrature": "it already collocates the contact law at the nodes",
+                 "dim1": "its nodal multiplier update cannot be compiled on intervals; use "
+                         "al-ssn for 1D scenes"},
+    )  # fmt: skip
 
-    def pressure(self, s: ContactSurface):
+    def attach(self, solver, problem):
+        """Uzawa's outer loop around the Newton solver (the problem gives the multiplier
+        Function, its nodal update and the contact nodes)."""
+        from contactfx.solvers.uzawa import Uzawa
+
+        update = problem.nodal_update(self.update(problem.surface))
+        return Uzawa(solver, problem.multiplier, update, problem.multiplier_mask,
+                     tol=self.al_tol, max_it=self.al_max_it)  # fmt: skip
+
+    def pressure(self, s: Surface):
         return self._augmented(s, s.multiplier)[0]
 
-    def tangential_traction(self, s: ContactSurface):
+    def tangential_traction(self, s: Surface):
         return self._augmented(s, s.multiplier)[2]
 
-    def slip_indicator(self, s: ContactSurface):
+    def slip_indicator(self, s: Surface):
         return self._slip(s, s.multiplier)
 
-    def update(self, s: ContactSurface):
+    def update(self, s: Surface):
         """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
         p, _, t_T = self._augmented(s, s.multiplier)
         if t_T is None:
             return p
         return -p * s.normal() + t_T
 
-    def residual(self, s: ContactSurface):
+    def residual(self, s: Surface):
         p, _, t_T = self._augmented(s, s.multiplier)
         form = p * ufl.dot(s.v, s.normal()) * s.ds
         if t_T is not None:
@@ -117,30 +140,33 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     ``s.multiplier`` / ``s.multiplier_test`` are the multiplier component of the mixed unknown
     and its test function; ``s.ds_nodal`` is the vertex-quadrature contact measure."""
 
-    ncp: str = "min"
+    r0: float = param(10.0, _R0, positive=True)
+    ncp: str = param("min", "al-ssn complementarity function: min (Alart-Curnier) or fb "
+                     "(Fischer-Burmeister)", choices=("min", "fb"))  # fmt: skip
     name = "al-ssn"
-    mixed = True
+    multiplier = "field"
+    supports = Supports(
+        friction=_FRICTION, interfaces=True, iterative=False,
+        why_not={"nodal_quadrature": "it already collocates the contact law at the nodes",
+                 "mixed_up": "it has its own mixed (u, lambda) space",
+                 "iterative": "a saddle-point system"},
+    )  # fmt: skip
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.ncp not in ("min", "fb"):
-            raise ValueError(f"ncp must be 'min' or 'fb', got {self.ncp}")
-
-    def pressure(self, s: ContactSurface):
+    def pressure(self, s: Surface):
         return split_multiplier(s.multiplier, s.normal())[0]
 
-    def tangential_traction(self, s: ContactSurface):
+    def tangential_traction(self, s: Surface):
         return split_multiplier(s.multiplier, s.normal())[1]
 
-    def contact_indicator(self, s: ContactSurface):
+    def contact_indicator(self, s: Surface):
         """[lambda_n - r g]_+: > 0 exactly where the surfaces are closed (between the nodes
         too; lambda_n itself only vanishes up to the solver tolerance where open)."""
         return self._augmented(s, s.multiplier)[0]
 
-    def slip_indicator(self, s: ContactSurface):
+    def slip_indicator(self, s: Surface):
         return self._slip(s, s.multiplier)
 
-    def residual(self, s: ContactSurface):
+    def residual(self, s: Surface):
         n = s.normal()
         lam, mu = s.multiplier, s.multiplier_test
         lam_n, lam_t = split_multiplier(lam, n)

@@ -7,15 +7,11 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.laws import Friction
+from contactfx.contact.laws import Friction, tangential
 from contactfx.contact.obstacles import Obstacle
+from contactfx.contact.surface import Expr, sigma_n, sigma_t
 
-__all__ = ["ContactSurface", "tangential"]
-
-
-def tangential(w, n):
-    """Tangential part (I - n n) w of the vector w."""
-    return w - ufl.dot(w, n) * n
+__all__ = ["ContactSurface"]
 
 
 @dataclass(frozen=True)
@@ -38,21 +34,21 @@ class ContactSurface:
     method has one.
     """
 
-    u: object
-    v: object
+    u: Expr
+    v: Expr
     ds: ufl.Measure
     obstacle: Obstacle
-    offset: object
-    stress: object
-    stress_test: object
+    offset: Expr
+    stress: Expr
+    stress_test: Expr
     E: float
-    h: object
+    h: Expr
     friction: Friction | None = None
-    u_prev: object = None
-    offset_prev: object = None
+    u_prev: Expr | None = None
+    offset_prev: Expr | None = None
     ds_nodal: ufl.Measure | None = None
-    multiplier: object = None
-    multiplier_test: object = None
+    multiplier: Expr | None = None
+    multiplier_test: Expr | None = None
 
     @property
     def mesh(self):
@@ -77,15 +73,8 @@ class ContactSurface:
         """n(u) = -grad phi at x + u - offset: outward normal of the body at contact."""
         return self.obstacle.normal(self.position(w))
 
-    @staticmethod
-    def sigma_n(stress, n):
-        """Normal stress n . stress n (< 0 in compression)."""
-        return ufl.dot(n, ufl.dot(stress, n))
-
-    @staticmethod
-    def sigma_t(stress, n):
-        """Tangential traction (I - n n) stress n."""
-        return tangential(ufl.dot(stress, n), n)
+    sigma_n = staticmethod(sigma_n)
+    sigma_t = staticmethod(sigma_t)
 
     def slip_increment(self, n):
         """Tangential displacement of the body relative to the obstacle since the last

@@ -45,8 +45,8 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.gap import tangential
-from contactfx.contact.laws import Friction, positive_part
+from contactfx.contact.laws import Friction, positive_part, tangential
+from contactfx.contact.surface import Expr, sigma_n, sigma_t
 
 __all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal"]
 
@@ -96,23 +96,22 @@ class InterfaceSurface:
     as in :class:`contactfx.contact.gap.ContactSurface`.
     """
 
-    w: object
-    v_total: object
-    H: object
+    w: Expr
+    v_total: Expr
+    H: Expr
     ds: ufl.Measure
-    stress_cell: object
-    stress_test_cell: object
+    stress_cell: Expr
+    stress_test_cell: Expr
     E: float
-    h_cell: object
-    floor: object = None
-    fluid: object = None
+    h_cell: Expr
+    floor: Expr | None = None
+    fluid: Expr | None = None
     joint: BartonBandis | None = None
     friction: Friction | None = None
-    u_prev: object = None
+    u_prev: Expr | None = None
     ds_nodal: ufl.Measure | None = None
-    multiplier: object = None
-    multiplier_test: object = None
-    offset = None  # no rigid obstacle
+    multiplier: Expr | None = None
+    multiplier_test: Expr | None = None
 
     @property
     def mesh(self):
@@ -175,8 +174,8 @@ class InterfaceSurface:
             g = g + self.joint.closure(positive_part(self.effective_pressure()))
         return g
 
-    sigma_n = staticmethod(lambda stress, n: ufl.dot(n, ufl.dot(stress, n)))
-    sigma_t = staticmethod(lambda stress, n: tangential(ufl.dot(stress, n), n))
+    sigma_n = staticmethod(sigma_n)
+    sigma_t = staticmethod(sigma_t)
 
     def slip_increment(self, n):
         """Tangential jump increment since the last converged step."""

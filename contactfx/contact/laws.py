@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import ufl
 
 __all__ = [
+    "tangential",
     "positive_part",
     "active",
     "ball_projection",
@@ -26,6 +27,11 @@ __all__ = [
     "Coulomb",
     "friction_law",
 ]
+
+
+def tangential(w, n):
+    """Tangential part (I - n n) w of the vector w."""
+    return w - ufl.dot(w, n) * n
 
 
 def positive_part(x):

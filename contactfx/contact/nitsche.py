@@ -31,47 +31,47 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.gap import ContactSurface
 from contactfx.contact.laws import active, ball_projection, norm, positive_part
+from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.surface import Surface
+from contactfx.params import param, validate
 
 __all__ = ["Nitsche"]
 
 
 @dataclass(frozen=True)
-class Nitsche:
+class Nitsche(MethodBase):
     """theta in {1, 0, -1}; gamma0 > 0 (gamma_N = gamma0 E / h)."""
 
-    theta: float = 1.0
-    gamma0: float = 10.0
+    theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
+    gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
     name = "nitsche"
-    mixed = False
+    supports = Supports(friction=("none", "tresca", "coulomb"), mixed_up=True,
+                        nodal_quadrature=True, interfaces=True)  # fmt: skip
 
     def __post_init__(self) -> None:
-        if self.theta not in (1, 0, -1):
-            raise ValueError(f"theta must be one of 1, 0, -1, got {self.theta}")
-        if not self.gamma0 > 0.0:
-            raise ValueError(f"gamma0 must be > 0, got {self.gamma0}")
+        validate(self)
 
-    def gamma(self, s: ContactSurface):
+    def gamma(self, s: Surface):
         return self.gamma0 * s.E / s.h
 
-    def pressure(self, s: ContactSurface):
+    def pressure(self, s: Surface):
         n = s.normal()
         return positive_part(-s.sigma_n(s.stress, n) - self.gamma(s) * s.gap())
 
-    def _trial_t(self, s: ContactSurface):
+    def _trial_t(self, s: Surface):
         n = s.normal()
         return s.sigma_t(s.stress, n) - self.gamma(s) * s.slip_increment(n)
 
-    def tangential_traction(self, s: ContactSurface):
+    def tangential_traction(self, s: Surface):
         return ball_projection(self._trial_t(s), s.friction.bound(self.pressure(s)), s.E)
 
-    def slip_indicator(self, s: ContactSurface):
+    def slip_indicator(self, s: Surface):
         """1 where the friction bound is reached (slip), else 0."""
         p = self.pressure(s)
         return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))
 
-    def residual(self, s: ContactSurface):
+    def residual(self, s: Surface):
         n = s.normal()
         gamma = self.gamma(s)
         sn_u = s.sigma_n(s.stress, n)

@@ -13,29 +13,34 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.gap import ContactSurface
 from contactfx.contact.laws import positive_part
+from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.surface import Surface
+from contactfx.params import param, validate
 
 __all__ = ["Penalty"]
 
 
 @dataclass(frozen=True)
-class Penalty:
+class Penalty(MethodBase):
     """kappa0 > 0 (kappa = kappa0 E / h)."""
 
-    kappa0: float = 100.0
+    kappa0: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True,
+                          option="penalty")  # fmt: skip
     name = "penalty"
-    mixed = False
+    supports = Supports(
+        mixed_up=True, nodal_quadrature=True, interfaces=True,
+        why_not={"friction": "its stick traction needs the tangential traction history"},
+    )  # fmt: skip
 
     def __post_init__(self) -> None:
-        if not self.kappa0 > 0.0:
-            raise ValueError(f"penalty parameter must be > 0, got {self.kappa0}")
+        validate(self)
 
-    def kappa(self, s: ContactSurface):
+    def kappa(self, s: Surface):
         return self.kappa0 * s.E / s.h
 
-    def pressure(self, s: ContactSurface):
+    def pressure(self, s: Surface):
         return self.kappa(s) * positive_part(-s.gap())
 
-    def residual(self, s: ContactSurface):
+    def residual(self, s: Surface):
         return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from contactfx.numerics import Numerics
 from contactfx.scenes.bar import Bar1D
-from contactfx.scenes.base import METHODS, Numerics, RunResult, Scene
+from contactfx.scenes.base import Scene
 from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
@@ -11,7 +12,7 @@ from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.westergaard import Westergaard
 
-__all__ = ["SCENES", "get_scene", "Scene", "Numerics", "RunResult", "METHODS"]
+__all__ = ["SCENES", "get_scene", "Scene", "Numerics"]
 
 SCENES: dict[str, type[Scene]] = {
     cls.name: cls

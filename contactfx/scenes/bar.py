@@ -18,8 +18,9 @@ import ufl
 from contactfx import _compat
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.mechanics.elasticity import Elastic
+from contactfx.params import param
 from contactfx.scenes._common import fix
-from contactfx.scenes.base import Scene, SceneParams, param
+from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["Bar1D", "bar_nitsche_exact"]
 
@@ -45,7 +46,7 @@ class Bar1DParams(SceneParams):
     cells: int = param(8, "number of elements N", positive=True)
 
 
-class Bar1D(Scene):
+class Bar1D(ObstacleScene):
     name = "bar1d"
     summary = "1D bar pushed by a body force against a rigid wall (exact discrete Nitsche)"
     Params = Bar1DParams

@@ -32,11 +32,13 @@ import numpy as np
 import ufl
 
 from contactfx._compat import ufl_math
+from contactfx.driver.interface_post import STATUS, Profile
 from contactfx.meshes import CrackPlateFacets, crack_plate
+from contactfx.params import param
 from contactfx.scenes import crack_fields as cf
 from contactfx.scenes._common import gmsh_mesh
-from contactfx.scenes.base import SceneParams, param
-from contactfx.scenes.interface_base import STATUS, InterfaceScene, Profile
+from contactfx.scenes.base import SceneParams
+from contactfx.scenes.interface_base import InterfaceScene
 
 __all__ = ["CrackSneddon", "CrackInclined", "ProppedFracture", "stress_intensity_from_jump"]
 
@@ -216,7 +218,7 @@ class CrackSneddon(_CrackPlate):
     def reference_profile(self, s):
         return {"opening": self._ellipse(s, max(self.p.pressure, 0.0))}
 
-    def interface_reference(self, prof, summary):
+    def interface_reference(self, prof, q, friction):
         p = self.p.pressure
         out = {"K_I_exact": cf.stress_intensity(max(p, 0.0), self.p.crack_half_length)}
         if p > 0.0:
@@ -224,13 +226,13 @@ class CrackSneddon(_CrackPlate):
             out["K_I"] = K
             out["K_rel_error"] = abs(K - out["K_I_exact"]) / out["K_I_exact"]
             # "no false contact": the contact force relative to the fluid force on a face
-            out["false_contact"] = abs(summary["normal_force"]) / (
+            out["false_contact"] = abs(q.force) / (
                 2.0 * p * self.p.crack_half_length
             )
         else:
             out["contact_force_exact"] = -p * 2.0 * self.p.crack_half_length
             out["force_rel_error"] = (
-                abs(summary["normal_force"] - out["contact_force_exact"])
+                abs(q.force - out["contact_force_exact"])
                 / (out["contact_force_exact"])
             )
         return out
@@ -251,7 +253,10 @@ class CrackInclined(_CrackPlate):
 
     def __init__(self, params) -> None:
         super().__init__(params)
-        self.friction = None  # the friction law of the run (set by run)
+        self.friction = None  # the friction law of the run (set by configure)
+
+    def configure(self, numerics) -> None:
+        self.friction = numerics.friction_law()
 
     def angle(self):
         return self.p.beta
@@ -292,7 +297,7 @@ class CrackInclined(_CrackPlate):
     def reference_profile(self, s):
         return {"slip": self._ellipse(s, self._q())}
 
-    def interface_reference(self, prof, summary):
+    def interface_reference(self, prof, q, friction):
         sigma_n, tau = self._plane()
         a = self.p.crack_half_length
         exact = abs(self._q()) * np.sqrt(np.pi * a)
@@ -318,9 +323,6 @@ class CrackInclined(_CrackPlate):
             out["max_slip"] = K  # stick: no slip at all
         return out
 
-    def run(self, numerics, **kwargs):
-        self.friction = numerics.friction_law()
-        return super().run(numerics, **kwargs)
 
 
 @dataclass(frozen=True)
@@ -381,14 +383,14 @@ class ProppedFracture(_CrackPlate):
             return {"opening": self._ellipse(s, self.p.net_pressure)}
         return {}
 
-    def interface_reference(self, prof, summary):
+    def interface_reference(self, prof, q, friction):
         out = {"p_star": self.p_star(), "open_branch": float(self.open_branch()),
                "proppant_thickness": self.p.proppant_thickness}  # fmt: skip
         propped = prof.floor > 0.0
         out["min_aperture_propped_over_h"] = float(
             np.min(prof.opening[propped], initial=np.inf) / self.p.proppant_thickness
         )
-        out["proppant_force"] = summary.get("proppant_force", 0.0)
+        out["proppant_force"] = q.interface.proppant_force
         if self.open_branch():
             K = self._K(prof, prof.opening)
             exact = cf.stress_intensity(self.p.net_pressure, self.p.crack_half_length)

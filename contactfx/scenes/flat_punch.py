@@ -15,8 +15,9 @@ import numpy as np
 
 from contactfx.contact.obstacles import FlatPunch, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
+from contactfx.params import param
 from contactfx.scenes._common import fix, gmsh_mesh
-from contactfx.scenes.base import Scene, SceneParams, param
+from contactfx.scenes.base import ObstacleScene, SceneParams
 from contactfx.scenes.hertz import QuarterBlock
 
 __all__ = ["FlatPunch2D", "FlatPunch3D"]
@@ -35,7 +36,7 @@ class FlatPunch2DParams(SceneParams):
     h_far: float = param(0.1, "element size far from the punch", positive=True)
 
 
-class FlatPunch2D(Scene):
+class FlatPunch2D(ObstacleScene):
     name = "punch2d"
     summary = "flat punch with rounded edges on a plane-strain block; normalised pressure"
     Params = FlatPunch2DParams

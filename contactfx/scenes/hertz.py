@@ -26,8 +26,9 @@ import ufl
 from contactfx import _compat
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
+from contactfx.params import param
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
-from contactfx.scenes.base import Scene, SceneParams, param
+from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "hertz_2d", "hertz_3d"]
 
@@ -58,17 +59,17 @@ def _indent_then_shift(t: float, depth: float, shift: float, gdim: int) -> np.nd
     return offset
 
 
-def _cattaneo_mindlin(summary: dict, a: float, exponent: float) -> dict[str, float]:
+def _cattaneo_mindlin(f, a: float, exponent: float) -> dict[str, float]:
     """Stick size c = a (1 - Q / (mu P))^exponent (2D: 1/2, 3D: 1/3) at the computed normal
     force P and tangential force Q (Johnson 1985, section 7.1; approximate on a rigid-elastic
-    pair, Dundurs beta != 0). With Q the x component and the bound mu P = friction_bound."""
-    bound = summary.get("friction_bound", 0.0)
-    if bound <= 0.0:
+    pair, Dundurs beta != 0). With Q the x component and the bound mu P of the friction
+    quantities ``f`` (:class:`contactfx.results.Friction`)."""
+    if f.bound <= 0.0:
         return {}
-    ratio = abs(summary["tangential_force"][0]) / bound
+    ratio = abs(f.tangential_force[0]) / f.bound
     c = a * max(0.0, 1.0 - ratio) ** exponent
-    return {"Q_over_bound": ratio, "c": c, "c_computed": summary["stick_size"],
-            "c_over_a_computed": summary["stick_size"] / a, "c_over_a": c / a}  # fmt: skip
+    return {"Q_over_bound": ratio, "c": c, "c_computed": f.stick_size,
+            "c_over_a_computed": f.stick_size / a, "c_over_a": c / a}  # fmt: skip
 
 
 def _indenter(profile: str, radius: float) -> Obstacle:
@@ -108,7 +109,7 @@ class Hertz2DParams(SceneParams):
             raise ValueError("--layer-E needs --layer-thickness > 0")
 
 
-class Hertz2D(Scene):
+class Hertz2D(ObstacleScene):
     name = "hertz2d"
     summary = "rigid cylinder pressed into a plane-strain block; reference Hertz a and p0"
     Params = Hertz2DParams
@@ -171,9 +172,9 @@ class Hertz2D(Scene):
             return None
         return _elliptic(ref["p0"], x[0] ** 2 / ref["a"] ** 2)
 
-    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
-        ref = self._hertz(summary["force"])
-        return _cattaneo_mindlin(summary, ref["a"], exponent=0.5) if ref else {}
+    def friction_reference(self, q, friction) -> dict[str, float]:
+        ref = self._hertz(q.force)
+        return _cattaneo_mindlin(q.friction, ref["a"], exponent=0.5) if ref else {}
 
 
 @dataclass(frozen=True)
@@ -192,7 +193,7 @@ class Hertz3DParams(SceneParams):
                          "indentation (needs friction; half model)", nonnegative=True)  # fmt: skip
 
 
-class QuarterBlock(Scene):
+class QuarterBlock(ObstacleScene):
     """A block [0, size]^2 x [-height, 0] with the symmetry planes x = 0 and y = 0 (quarter
     model of an axisymmetric indentation), clamped at the bottom, contact on the top. With a
     tangential shift along x the plane x = 0 is no symmetry plane: then the half model
@@ -253,6 +254,6 @@ class Hertz3D(QuarterBlock):
             return None
         return _elliptic(ref["p0"], (x[0] ** 2 + x[1] ** 2) / ref["a"] ** 2)
 
-    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
-        ref = hertz_3d(summary["force"], self.p.radius, self.material().E_star)
-        return _cattaneo_mindlin(summary, ref["a"], exponent=1.0 / 3.0)
+    def friction_reference(self, q, friction) -> dict[str, float]:
+        ref = hertz_3d(q.force, self.p.radius, self.material().E_star)
+        return _cattaneo_mindlin(q.friction, ref["a"], exponent=1.0 / 3.0)

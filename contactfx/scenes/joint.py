@@ -17,9 +17,10 @@ import numpy as np
 
 from contactfx.contact.interface import BartonBandis
 from contactfx.meshes import JointColumnFacets, joint_column
+from contactfx.params import param
 from contactfx.scenes import crack_fields as cf
 from contactfx.scenes._common import gmsh_mesh
-from contactfx.scenes.base import SceneParams, param
+from contactfx.scenes.base import SceneParams
 from contactfx.scenes.interface_base import InterfaceScene
 
 __all__ = ["JointColumn", "JointColumnParams"]
@@ -89,11 +90,11 @@ class JointColumn(InterfaceScene):
         return cf.joint_column(p.closure_stress, p.fluid_pressure, p.E, p.nu, p.block_height,
                                p.aperture, p.Kni, p.Vm)  # fmt: skip
 
-    def interface_reference(self, prof, summary):
+    def interface_reference(self, prof, q, friction):
         ref = self.exact()
         closure = -float(np.mean(prof.opening))
         aperture = self.p.aperture + float(np.mean(prof.opening))
-        settlement = -summary["top_displacement"]
+        settlement = -q.interface.extra["top_displacement"]
         out = {}
         for key, value in (("closure", closure), ("aperture", aperture),
                            ("settlement", settlement)):  # fmt: skip

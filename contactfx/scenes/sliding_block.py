@@ -23,8 +23,9 @@ import ufl
 
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
+from contactfx.params import param
 from contactfx.scenes._common import fix_component, gmsh_mesh
-from contactfx.scenes.base import Scene, SceneParams, param
+from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["SlidingBlock", "SlidingBlockParams"]
 
@@ -42,7 +43,7 @@ class SlidingBlockParams(SceneParams):
     h: float = param(0.05, "element size", positive=True)
 
 
-class SlidingBlock(Scene):
+class SlidingBlock(ObstacleScene):
     name = "sliding-block"
     summary = "block pressed on a rigid plane, then dragged: stick, then gross slip at Q = mu P"
     Params = SlidingBlockParams
@@ -89,14 +90,14 @@ class SlidingBlock(Scene):
     def reference(self, force: float) -> dict[str, float]:
         return {"force": self.p.pressure * self.p.width}
 
-    def friction_reference(self, summary: dict, friction) -> dict[str, float]:
+    def friction_reference(self, q, friction) -> dict[str, float]:
         """After the drag the whole face slides (the shift exceeds the stick displacement):
         Coulomb's gross slip Q = mu P."""
         if friction.name != "coulomb" or friction.mu == 0.0 or self.p.shift == 0.0:
             return {}
-        q_ref = friction.mu * summary["force"]
-        q = abs(summary["tangential_force"][0])
-        return {"Q": q_ref, "Q_rel_error": abs(q - q_ref) / q_ref}
+        q_ref = friction.mu * q.force
+        q_h = abs(q.friction.tangential_force[0])
+        return {"Q": q_ref, "Q_rel_error": abs(q_h - q_ref) / q_ref}
 
     def friction_scores(self, x, p, t, bound, status) -> dict[str, float]:
         """Where the face slides, |t_T| = bound exactly: the largest deviation relative to p."""

@@ -25,8 +25,9 @@ import ufl
 
 from contactfx.contact.obstacles import Obstacle, Sinusoid
 from contactfx.meshes import RectangleFacets, rectangle
+from contactfx.params import param
 from contactfx.scenes._common import fix_component, gmsh_mesh
-from contactfx.scenes.base import Scene, SceneParams, param
+from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["Westergaard"]
 
@@ -44,7 +45,7 @@ class WestergaardParams(SceneParams):
     h_far: float = param(1.0 / 8, "element size at depth", positive=True)
 
 
-class Westergaard(Scene):
+class Westergaard(ObstacleScene):
     name = "westergaard"
     summary = "rigid sinusoid on a half-plane under mean pressure; Westergaard a, p0, exact u"
     Params = WestergaardParams

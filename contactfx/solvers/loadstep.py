@@ -62,12 +62,12 @@ def run_load_program(
             try:
                 stats = solver.solve()
             except TimeLimitExceeded:
-                previous.copy(x)
+                _restore(previous, x)
                 raise TimeLimitExceeded(f" at load factor {t:.6g}") from None
             except ConvergenceError as err:
                 cutbacks += 1
                 if cutbacks > max_cutbacks:
-                    previous.copy(x)
+                    _restore(previous, x)
                     raise ConvergenceError(err.reason, step + 1, t) from None
                 dt *= 0.5
                 continue
@@ -90,3 +90,9 @@ def run_load_program(
         if older is not None:
             older.destroy()
     return records
+
+
+def _restore(previous: PETSc.Vec, x: PETSc.Vec) -> None:
+    """x = the last converged state, ghosts included (every rank sees the same state)."""
+    previous.copy(x)
+    x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import dolfinx
 import numpy as np
@@ -29,8 +29,8 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "ContactSNES", "time_limit",
-           "DEFAULT_OPTIONS", "GAMG_OPTIONS"]  # fmt: skip
+__all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "ContactSNES",
+           "time_limit", "rigid_body_modes", "DEFAULT_OPTIONS", "GAMG_OPTIONS"]  # fmt: skip
 
 
 class ConvergenceError(RuntimeError):
@@ -106,20 +106,19 @@ def snes_reason_name(reason: int) -> str:
 
 @dataclass
 class SolveStats:
-    """Iterations and wall time (s) of one nonlinear solve."""
+    """Iterations of one nonlinear solve and the SNES reason."""
 
     newton: int = 0
     ksp: int = 0
-    assembly: float = 0.0
-    solve: float = 0.0
     reason: str = ""
     outer: int = 1  # augmented Lagrangian (Uzawa) outer iterations
 
 
 @dataclass
-class _Timer:
+class Timer:
+    """Accumulated wall time (s) of the assembly (bulk, loads, contact terms)."""
+
     assembly: float = 0.0
-    extra: dict = field(default_factory=dict)
 
 
 def rigid_body_modes(V) -> PETSc.NullSpace:
@@ -176,7 +175,8 @@ class ContactSNES:
         self._a_c = contact_jacobian
         self._F_c = contact_residual
         self.prefix = prefix
-        self.timer = _Timer()
+        self.user_options = dict(user_options or {})
+        self.timer = Timer()
 
         t0 = time.perf_counter()
         self.K = _compat.assemble_matrix(_compat.create_matrix(stiffness), stiffness)
@@ -259,14 +259,41 @@ class ContactSNES:
         J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
         self.timer.assembly += time.perf_counter() - t0
 
+    def solve_linear(self, free: np.ndarray, extra=None) -> None:
+        """u = the solution of (K + extra) u = b with the owned dofs not marked ``free`` (and
+        the Dirichlet dofs) fixed to zero, by this solver's linear solver (its options prefix
+        and the command line apply): a linear start for the Newton solve."""
+        rows = np.flatnonzero(~free).astype(np.int32)
+        rows = np.union1d(rows, self._bc_rows).astype(np.int32)
+        A = self.K.copy()
+        if extra is not None:
+            S = _compat.assemble_matrix(_compat.create_matrix(extra), extra)
+            A.axpy(1.0, S, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            S.destroy()
+        A.zeroRowsColumnsLocal(rows, diag=1.0)
+        b = self.b.copy()
+        b.getArray()[rows] = 0.0
+        x = _compat.petsc_vec(self.u)
+        ksp = PETSc.KSP().create(self.comm)
+        ksp.setOptionsPrefix(self.prefix)
+        ksp.setOperators(A)
+        ksp.setFromOptions()
+        ksp.solve(b, x)
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        for obj in (ksp, A, b):
+            obj.destroy()
+
+    @property
+    def owned_size(self) -> int:
+        """Number of owned (unrolled) dofs of the unknown on this rank."""
+        return self.K.getLocalSize()[0]
+
     # -- solve ---------------------------------------------------------------------------
     def solve(self) -> SolveStats:
         """Solve from the current u (its Dirichlet values are set first); raise on failure."""
         x = _compat.petsc_vec(self.u)
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
-        a0 = self.timer.assembly
-        t0 = time.perf_counter()
         self._late = False
         try:
             self.snes.solve(None, x)
@@ -275,14 +302,10 @@ class ContactSNES:
         if self._late:
             raise TimeLimitExceeded()
         self._sync(x)
-        wall = time.perf_counter() - t0
         reason = self.snes.getConvergedReason()
-        assembly = self.timer.assembly - a0
         stats = SolveStats(
             newton=self.snes.getIterationNumber(),
             ksp=self.snes.getLinearSolveIterations(),
-            assembly=assembly,
-            solve=wall - assembly,
             reason=snes_reason_name(reason),
         )
         if reason <= 0:

@@ -14,8 +14,7 @@ __all__ = ["Uzawa"]
 class Uzawa:
     """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
 
-    ``update`` is a compiled expression of the multiplier's next value, interpolated into the
-    multiplier's space (or a callable that fills the Function it is given); ``mask`` (bool per
+    ``update`` fills the Function it is given with the multiplier's next nodal values; ``mask`` (bool per
     local dof of that space) selects the contact boundary's nodes, elsewhere the multiplier is
     kept at zero. The loop stops when
     max |lambda_{k+1} - lambda_k| <= tol max |lambda_{k+1}| over the contact nodes: the nodal
@@ -62,13 +61,8 @@ class Uzawa:
                 raise ConvergenceError(f"{err.reason} (Uzawa iteration {k})") from None
             total.newton += stats.newton
             total.ksp += stats.ksp
-            total.assembly += stats.assembly
-            total.solve += stats.solve
             total.reason = stats.reason
-            if callable(self.update):  # a nodal evaluation (interface quantities)
-                self.update(self._next)
-            else:
-                self._next.interpolate(self.update)
+            self.update(self._next)
             new = np.where(mask, self._next.x.array, 0.0)
             change = self._max((new - lam)[mask])
             size = self._max(new[mask])

@@ -23,15 +23,16 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-__all__ = ["CASES", "MEASURES", "bench_main", "expand_methods", "linear_elastic_time",
-           "observed_rates", "parallel_ceiling"]  # fmt: skip
+from contactfx.results import MEASURES, measure
+
+__all__ = ["CASES", "MEASURES", "run_bench", "expand_methods", "method_label",
+           "linear_elastic_time", "observed_rates", "parallel_ceiling"]  # fmt: skip
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,41 +75,39 @@ CASES: dict[str, BenchCase] = {
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
 }
 
-#: error measures: column, label, where in run.json
-MEASURES: dict[str, tuple[str, tuple[str, str]]] = {
-    "err_force": ("force", ("reference", "force_rel_error")),
-    "err_a": ("half-width a", ("reference", "a_rel_error")),
-    "err_p0": ("peak pressure p0", ("reference", "p0_rel_error")),
-    "err_p_L2": ("pressure, L2 on contact", ("errors", "pressure_L2_rel")),
-    "err_u_L2": ("displacement, L2", ("errors", "displacement_L2_rel")),
-    "err_u_H1": ("displacement, H1 semi-norm", ("errors", "displacement_H1_rel")),
-    "err_punch": ("punch pressure on |x| <= 0.8 a", ("scores", "normalised_pressure_error")),
-    "err_Q": ("gross-slip force Q = mu P", ("reference", "Q_rel_error")),
-    "err_opening": ("crack opening, L2 on the crack", ("errors", "opening_L2_rel")),
-    "err_slip": ("crack slip, L2 on the crack", ("errors", "slip_L2_rel")),
-    "err_K": ("stress intensity factor", ("reference", "K_rel_error")),
-    "err_settlement": ("joint column settlement", ("reference", "settlement_rel_error")),
-}
-
 PENALTIES = (10.0, 100.0, 1000.0)
 
 #: relative errors below this are round-off (e.g. the force under force control): no rate
 ROUNDOFF = 1e-10
 
 
+def method_label(o: dict) -> str:
+    """The label of a method variant given as Numerics overrides: the method and the
+    parameter that distinguishes its variants (theta, gamma0, the penalty, r0), and the nodal
+    quadrature; bench and stress name their rows with it."""
+    m = o.get("method", "nitsche")
+    if m == "nitsche":
+        label = f"nitsche({o.get('theta', 1)})"
+        label += f" g0={o['gamma0']:g}" if "gamma0" in o else ""
+    elif m in ("penalty", "compliance"):
+        label = f"{m}({o.get('penalty', 10.0):g})"
+    elif "r0" in o:
+        label = f"{m}({o['r0']:g})"
+    else:
+        label = m
+    return label + (" nodal" if o.get("quadrature") == "nodal" else "")
+
+
 def expand_methods(spec: str) -> list[tuple[str, dict]]:
     """'nitsche,penalty@100,al-ssn' -> [(label, Numerics overrides), ...]. ``nitsche`` expands
     to theta = 1, 0, -1 and ``penalty`` to three parameters; ``name@value`` picks one (theta
-    for nitsche, the penalty factor for penalty, r0 for the augmented Lagrangian); a
-    ``+nodal`` suffix integrates the contact terms at the nodes (``--quadrature nodal``)."""
-    from contactfx.scenes import METHODS
+    for nitsche, the penalty factor for penalty / compliance, r0 for the augmented Lagrangian);
+    a ``+nodal`` suffix integrates the contact terms at the nodes (``--quadrature nodal``)."""
+    from contactfx.contact.registry import METHODS
 
-    out: list[tuple[str, dict]] = []
+    out: list[dict] = []
     for token in filter(None, (t.strip() for t in spec.split(","))):
         token, nodal = token.removesuffix("+nodal"), token.endswith("+nodal")
-        if nodal and not token.startswith(("nitsche", "penalty")):
-            raise ValueError(f"--method {token}+nodal: nodal quadrature is for nitsche / penalty")
-        first = len(out)
         name, _, value = token.partition("@")
         if name not in METHODS:
             raise ValueError(f"unknown method '{name}' in --method (known: {', '.join(METHODS)})")
@@ -116,22 +115,20 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
             number = float(value) if value else None
         except ValueError:
             raise ValueError(f"--method {token}: '{value}' is not a number") from None
+        extra = {"quadrature": "nodal"} if nodal else {}
         if name == "nitsche":
             thetas = (1, 0, -1) if number is None else (int(number),)
-            out += [(f"nitsche({t})", {"method": name, "theta": t}) for t in thetas]
-        elif name == "penalty":
-            values = PENALTIES if number is None else (number,)
-            out += [(f"penalty({k:g})", {"method": name, "penalty": k}) for k in values]
-        elif name.startswith("al-") and number is not None:
-            out.append((f"{name}({number:g})", {"method": name, "r0": number}))
+            out += [{"method": name, "theta": t, **extra} for t in thetas]
+        elif name in ("penalty", "compliance"):
+            values = PENALTIES if number is None and name == "penalty" else (number or 10.0,)
+            out += [{"method": name, "penalty": k, **extra} for k in values]
+        elif number is not None:
+            out.append({"method": name, "r0": number, **extra})
         else:
-            out.append((name, {"method": name}))
-        if nodal:
-            out[first:] = [(f"{label} nodal", {**o, "quadrature": "nodal"})
-                           for label, o in out[first:]]  # fmt: skip
+            out.append({"method": name, **extra})
     if not out:
         raise ValueError("--method: no method given")
-    return out
+    return [(method_label(o), o) for o in out]
 
 
 def _refined(params, coarsen: float, level: int):
@@ -145,11 +142,6 @@ def _refined(params, coarsen: float, level: int):
     if not sizes:
         raise ValueError(f"scene {type(params).__name__} has no mesh size to refine")
     return dataclasses.replace(params, **sizes)
-
-
-def _lookup(data: dict, where: tuple[str, str]) -> float:
-    value = data.get(where[0], {}).get(where[1])
-    return float("nan") if value is None else float(value)
 
 
 def run_case(
@@ -172,19 +164,19 @@ def run_case(
         row.update(status="n/a", reason=str(err))
         return row, scene, None
     try:
-        data = scene.run(num, comm=comm, petsc_options=petsc_options, verbose=False).data
+        res = scene.run(num, comm=comm, petsc_options=petsc_options, verbose=False)
     except (ConvergenceError, ValueError) as err:
         row.update(status="failed", reason=str(err))
         return row, scene, num
-    t = data["timings"]
+    t = res.timings
     row.update(
-        status="ok", reason="", dofs=data["dofs"], newton=data["newton_iterations"],
-        ksp=data["ksp_iterations"], outer=data["outer_iterations"],
+        status="ok", reason="", dofs=res.dofs, newton=res.newton_iterations,
+        ksp=res.ksp_iterations, outer=res.outer_iterations,
         t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
         t_run=t["assembly"] + t["solve"],
     )  # fmt: skip
-    for column, (_, where) in MEASURES.items():
-        row[column] = _lookup(data, where)
+    for column in MEASURES:
+        row[column] = measure(res, column)
     return row, scene, num
 
 
@@ -269,102 +261,42 @@ def parallel_ceiling(comm, n: int = 3_000_000, repeats: int = 3) -> float:
     return comm.size * alone / together
 
 
-def _int_list(text: str) -> list[int]:
-    try:
-        return [int(t) for t in text.split(",") if t.strip()]
-    except ValueError:
-        raise ValueError(f"expected comma-separated integers, got '{text}'") from None
-
-
-def _parser():
-    from contactfx.cli import _Parser
-
-    p = _Parser(prog="contactfx bench", description="error against run time over refinement")
-    p.add_argument("case", nargs="?", default=None, help="one case (same as --scene)")
-    p.add_argument(
-        "--scene",
-        default=None,
-        help=f"comma-separated cases, or all (default hertz2d): {', '.join(CASES)}",
-    )
-    p.add_argument(
-        "--method",
-        default="nitsche,penalty,al-uzawa,al-ssn,vi",
-        help="comma-separated method variants, e.g. nitsche,nitsche@-1,penalty@100",
-    )
-    p.add_argument("--levels", type=int, default=3, help="refinement levels (h halves)")
-    p.add_argument("--degree", default="1", help="comma-separated Lagrange degrees, e.g. 1,2")
-    p.add_argument("--solver", default="lu", choices=("lu", "gamg"))
-    p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNGs")
-    p.add_argument(
-        "--linear",
-        action="store_true",
-        help="also time one linear-elastic solve per mesh (contact / linear ratio)",
-    )
-    p.add_argument(
-        "--speedup",
-        action="store_true",
-        help="under mpirun, also run every case on rank 0 alone (parallel speed-up)",
-    )
-    return p  # fmt: skip
-
-
-def bench_main(argv: list[str], petsc_options: dict, comm) -> int:
-    ns = _parser().parse_args(argv)
-    if ns.case is not None and ns.scene is not None:
-        raise ValueError("give the case either positionally or with --scene, not both")
-    spec = ns.case or ns.scene or "hertz2d"
-    cases = list(CASES) if spec == "all" else [c.strip() for c in spec.split(",") if c.strip()]
-    for name in cases:
-        if name not in CASES:
-            raise ValueError(f"unknown bench case '{name}' (known: {', '.join(CASES)}, all)")
-    if ns.levels < 1:
-        raise ValueError(f"--levels must be >= 1, got {ns.levels}")
-    degrees = _int_list(ns.degree)
-    if not degrees or any(d not in (1, 2) for d in degrees):
-        raise ValueError(f"--degree must list 1 and/or 2, got '{ns.degree}'")
-    variants = expand_methods(ns.method)
-    ceiling = parallel_ceiling(comm) if ns.speedup and comm.size > 1 else 1.0
+def run_bench(cases: list[str], variants: list[tuple[str, dict]], degrees: list[int],
+              levels: int, comm, petsc_options: dict, *, solver: str = "lu",
+              linear: bool = False, speedup: bool = False) -> list[dict]:  # fmt: skip
+    """Every case x variant x degree x level; one row each (printed on rank 0 as it ends)."""
+    ceiling = parallel_ceiling(comm) if speedup and comm.size > 1 else 1.0
     rows: list[dict] = []
-    started = time.perf_counter()
     for case_name in cases:
         for label, overrides in variants:
             for degree in degrees:
-                levels = ns.levels if degree == 1 else min(ns.levels, CASES[case_name].p2_levels)
-                for level in range(levels):
+                n = levels if degree == 1 else min(levels, CASES[case_name].p2_levels)
+                for level in range(n):
                     row, scene, num = run_case(case_name, label, overrides, degree, level, comm,
-                                               petsc_options, ns.solver)  # fmt: skip
-                    if row["status"] == "ok" and ns.linear:
-                        lin, _ = linear_elastic_time(scene, degree, comm, ns.solver)
+                                               petsc_options, solver)  # fmt: skip
+                    if row["status"] == "ok" and linear:
+                        lin, _ = linear_elastic_time(scene, degree, comm, solver)
                         row["t_linear"] = lin
                         row["contact_over_linear"] = row["t_run"] / lin
-                    if row["status"] == "ok" and ns.speedup and comm.size > 1:
+                    if row["status"] == "ok" and speedup and comm.size > 1:
                         _add_speedup(row, scene, num, comm, ceiling)
                     rows.append(row)
                     if comm.rank == 0:
                         print(_format_row(row), flush=True)
                     if row["status"] == "n/a":
                         break  # the same at every level
-    if comm.rank == 0:
-        total = time.perf_counter() - started
-        print(f"bench: {len(rows)} runs in {total:.0f} s on {comm.size} rank(s)")
-        if ns.speedup and comm.size > 1:
-            print(f"parallel ceiling of this machine with {comm.size} ranks: {ceiling:.2f}x")
-        if ns.out is not None:
-            from contactfx.validation.report import write_bench
-
-            for path in write_bench(rows, ns.out, comm.size, total):
-                print(f"wrote {path}")
-    comm.barrier()
-    return 0
+    if speedup and comm.size > 1 and comm.rank == 0:
+        print(f"parallel ceiling of this machine with {comm.size} ranks: {ceiling:.2f}x")
+    return rows
 
 
 def _add_speedup(row: dict, scene, num, comm, ceiling: float) -> None:
     serial = None
     if comm.rank == 0:
-        serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False).data
-    serial = comm.bcast(serial, root=0)
-    ts = serial["timings"]
-    row["newton_serial"] = serial["newton_iterations"]
+        res = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
+        serial = (res.timings, res.newton_iterations)
+    ts, newton = comm.bcast(serial, root=0)
+    row["newton_serial"] = newton
     row["speedup"] = (ts["assembly"] + ts["solve"]) / row["t_run"]
     row["speedup_over_ceiling"] = row["speedup"] / ceiling
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
+import math
 import subprocess
 import sys
 import tempfile
@@ -28,7 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["StressCase", "cases", "stress_main", "child_env"]
+from contactfx.io.process import child_env
+from contactfx.results import PRIMARY, RunSummary, measure
+from contactfx.validation.bench import method_label
+
+__all__ = ["StressCase", "cases", "run_stress"]
 
 #: the coarse Hertz 2D mesh of the matrix (a is about 4 elements wide per side at depth 1.5e-3)
 _COARSE = {"h_contact": 6e-3, "h_far": 0.2}
@@ -49,19 +53,9 @@ class StressCase:
     ranks: int = 0
 
 
-def _method_label(num: dict) -> str:
-    m = num.get("method", "nitsche")
-    nodal = " nodal" if num.get("quadrature") == "nodal" else ""
-    if m == "nitsche":
-        return f"nitsche({num.get('theta', 1)}) g0={num.get('gamma0', 10.0):g}{nodal}"
-    if m == "penalty":
-        return f"penalty({num.get('penalty', 10.0):g}){nodal}"
-    return m
-
-
 def cases() -> list[StressCase]:
     """The whole matrix; ``quick`` marks the fast subset."""
-    from contactfx.scenes import Numerics
+    from contactfx.numerics import Numerics
 
     out: list[StressCase] = []
     hz = dict(_COARSE)
@@ -154,40 +148,30 @@ def _scene(name: str):
     return SCENES[name]
 
 
-def _primary_error(data: dict) -> tuple[str, float]:
-    """The case's error against the closed form: pressure in L2 on the contact boundary, else
-    the punch's normalised pressure, else the gross-slip force, else the force."""
-    for name, section, key in (
-        ("K", "reference", "K_rel_error"),
-        ("settlement", "reference", "settlement_rel_error"),
-        ("opening L2", "errors", "opening_L2_rel"),
-        ("p L2", "errors", "pressure_L2_rel"),
-        ("punch p", "scores", "normalised_pressure_error"),
-        ("Q = mu P", "reference", "Q_rel_error"),
-        ("force", "reference", "force_rel_error"),
-    ):
-        value = data.get(section, {}).get(key)
-        if value is not None:
-            return name, float(value)
+def _primary_error(res) -> tuple[str, float]:
+    """The case's error against the closed form: the first of :data:`contactfx.results.PRIMARY`
+    the run has."""
+    for name, column in PRIMARY:
+        value = measure(res, column)
+        if not math.isnan(value):
+            return name, value
     return "", float("nan")
 
 
-def _row(case: StressCase, data: dict | None, error: str, wall: float) -> dict:
-    row = {"axis": case.axis, "case": case.id, "method": _method_label(case.numerics)}
-    if data is None:
+def _row(case: StressCase, res: RunSummary | None, error: str, wall: float) -> dict:
+    row = {"axis": case.axis, "case": case.id, "method": method_label(case.numerics)}
+    if res is None:
         status = "time limit" if "time limit" in error else "failed"
         return {**row, "status": status, "reason": error, "time": wall}
-    measure, value = _primary_error(data)
-    h = data["h_contact"]
-    p0 = max(data["peak_pressure"], 1e-300)
+    name, value = _primary_error(res)
+    h = res.h_contact
+    p0 = max(res.peak_pressure, 1e-300)
     row.update(
-        status="converged", reason="", newton=data["newton_iterations"],
-        cutbacks=sum(s["cutbacks"] for s in data["steps"]),
-        penetration_over_h=abs(data["max_penetration"]) / h,
-        complementarity=data["complementarity"] / (p0 * h),
-        error_measure=measure, error=value,
-        p0_error=data.get("reference", {}).get("p0_rel_error", float("nan")),
-        force=data["force"], time=wall,
+        status="converged", reason="", newton=res.newton_iterations, cutbacks=res.cutbacks,
+        penetration_over_h=abs(res.max_penetration) / h,
+        complementarity=res.complementarity / (p0 * h),
+        error_measure=name, error=value, p0_error=measure(res, "err_p0"),
+        force=res.force, time=wall,
     )  # fmt: skip
     return row
 
@@ -201,25 +185,10 @@ def run_in_process(case: StressCase, comm, limit: float) -> dict:
         scene = scene_cls(scene_cls.Params(**case.params))
         num = scene_cls.default_numerics(**case.numerics)
         with time_limit(limit):
-            data = scene.run(num, comm=comm, verbose=False).data
+            res = scene.run(num, comm=comm, verbose=False)
     except (ConvergenceError, ValueError) as err:
         return _row(case, None, str(err), time.perf_counter() - t0)
-    return _row(case, data, "", time.perf_counter() - t0)
-
-
-def child_env() -> dict[str, str]:
-    """Environment for a child mpirun: none of this process's MPI singleton state, root and
-    oversubscription allowed, one thread per rank."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
-    env.update(
-        OMPI_ALLOW_RUN_AS_ROOT="1",
-        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-        OMPI_MCA_rmaps_base_oversubscribe="1",
-        PRTE_MCA_rmaps_default_mapping_policy=":oversubscribe",
-        OPENBLAS_NUM_THREADS="1",
-        OMP_NUM_THREADS="1",
-    )
-    return env
+    return _row(case, res, "", time.perf_counter() - t0)
 
 
 def run_child(case: StressCase, limit: float) -> dict:
@@ -240,45 +209,23 @@ def run_child(case: StressCase, limit: float) -> dict:
         lines = (proc.stderr.strip() or proc.stdout.strip() or "no output").splitlines()
         if proc.returncode != 0:
             return _row(case, None, lines[-1], wall)
-        data = json.loads((Path(tmp) / "run.json").read_text())
-    return _row(case, data, "", wall)
+        res = RunSummary.from_json(json.loads((Path(tmp) / "run.json").read_text()))
+    return _row(case, res, "", wall)
 
 
-def _parser():
-    from contactfx.cli import _Parser
-
-    p = _Parser(prog="contactfx stress", description="robustness matrix of extreme cases")
-    p.add_argument("--quick", action="store_true", help="the fast subset of the matrix")
-    p.add_argument("--axis", default=None, help="comma-separated axes to run (default all)")
-    p.add_argument("--time-limit", type=float, default=120.0,
-                   help="wall-time limit per case [s] (default 120)")  # fmt: skip
-    p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNG")
-    return p
-
-
-def stress_main(argv: list[str], petsc_options: dict, comm) -> int:
-    ns = _parser().parse_args(argv)
-    if not ns.time_limit > 0:
-        raise ValueError(f"--time-limit must be > 0, got {ns.time_limit}")
-    selected = [c for c in cases() if c.quick or not ns.quick]
-    if ns.axis is not None:
-        axes = [a.strip() for a in ns.axis.split(",")]
-        known = sorted({c.axis for c in cases()})
-        for a in axes:
-            if a not in known:
-                raise ValueError(f"unknown axis '{a}' (known: {', '.join(known)})")
-        selected = [c for c in selected if c.axis in axes]
+def run_stress(selected: list[StressCase], comm, limit: float) -> list[dict]:
+    """Run the cases (printing each row on rank 0); the parallel axis compares its forces
+    with its 1-rank run."""
     rows: list[dict] = []
-    reference_force = None  # the parallel axis compares with its 1-rank run
-    started = time.perf_counter()
+    reference_force = None
     for case in selected:
         if case.ranks == 0:
-            row = run_in_process(case, comm, ns.time_limit)
+            row = run_in_process(case, comm, limit)
         elif comm.size > 1:
             row = _row(case, None, "", 0.0)
             row.update(status="n/a", reason="child mpirun runs only from a serial stress run")
         else:
-            row = run_child(case, ns.time_limit)
+            row = run_child(case, limit)
         if case.axis == "parallel" and row["status"] == "converged":
             if case.ranks == 1:
                 reference_force = row["force"]
@@ -288,17 +235,7 @@ def stress_main(argv: list[str], petsc_options: dict, comm) -> int:
         rows.append(row)
         if comm.rank == 0:
             print(_format(row), flush=True)
-    if comm.rank == 0:
-        total = time.perf_counter() - started
-        failed = sum(r["status"] not in ("converged", "n/a") for r in rows)
-        print(f"stress: {len(rows)} cases, {failed} not converged, {total:.0f} s")
-        if ns.out is not None:
-            from contactfx.validation.report import write_stress
-
-            for path in write_stress(rows, ns.out, comm.size, total):
-                print(f"wrote {path}")
-    comm.barrier()
-    return 0
+    return rows
 
 
 def _format(row: dict) -> str:

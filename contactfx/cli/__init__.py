@@ -1,0 +1,74 @@
+"""Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench | stress``.
+
+PETSc options after ``--`` reach PETSc: they initialise petsc4py before dolfinx is imported and
+are copied under the solver's options prefix, so ``-- -snes_monitor -ksp_type gmres`` works.
+Errors are one line on rank 0 and a non-zero exit status on every rank.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from contactfx.cli.args import petsc_dict, split_petsc
+
+__all__ = ["main"]
+
+USAGE = (
+    "usage: contactfx {list | run SCENE [options] [-- PETSc options] | "
+    "bench [--scene CASES] [--method M,...] [--levels N] [--degree 1,2] [--out DIR] | "
+    "stress [--quick] [--axis AXES] [--out DIR]}"
+)
+
+
+def _dispatch(command: str, rest: list[str], petsc_options: dict, comm) -> int:
+    # the command modules import dolfinx: only after petsc4py.init
+    if command == "list":
+        from contactfx.cli.run import cmd_list
+
+        return cmd_list() if comm.rank == 0 else 0
+    if command == "run":
+        from contactfx.cli.run import cmd_run
+
+        return cmd_run(rest, petsc_options, comm)
+    if command == "bench":
+        from contactfx.cli.bench import cmd_bench
+
+        return cmd_bench(rest, petsc_options, comm)
+    if command == "stress":
+        from contactfx.cli.stress import cmd_stress
+
+        return cmd_stress(rest, petsc_options, comm)
+    raise ValueError(f"unknown command '{command}' ({USAGE})")
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    argv, petsc_args = split_petsc(argv)
+
+    import petsc4py
+
+    petsc4py.init([sys.argv[0], *petsc_args])
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    try:
+        petsc_options = petsc_dict(petsc_args)
+        if not argv or argv[0] in ("-h", "--help"):
+            if comm.rank == 0:
+                print(USAGE)
+            return 0 if argv else 2
+        return _dispatch(argv[0], argv[1:], petsc_options, comm)
+    except SystemExit as exc:  # argparse: --help (0) or a bad option (2, message printed)
+        return int(exc.code or 0)
+    except Exception as exc:  # noqa: BLE001 - every error becomes one line and a status
+        from contactfx.solvers.snes import ConvergenceError
+
+        if isinstance(exc, ValueError | OSError | ConvergenceError):
+            if comm.rank == 0:
+                print(f"contactfx: error: {exc}", file=sys.stderr, flush=True)
+            return 1
+        import traceback
+
+        traceback.print_exc()
+        comm.Abort(1)  # an unexpected error may be on one rank only: never hang the others
+        return 1

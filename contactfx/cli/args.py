@@ -1,0 +1,72 @@
+"""The argument layer shared by the commands: an argparse parser that raises instead of
+exiting, options generated from parameter dataclasses, and PETSc options after ``--``."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+
+from contactfx.params import option_name
+
+__all__ = ["Parser", "split_petsc", "petsc_dict", "add_options", "int_list"]
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse that raises ValueError (reported once, on rank 0) instead of exiting."""
+
+    def error(self, message: str):
+        raise ValueError(message)
+
+
+def split_petsc(argv: list[str]) -> tuple[list[str], list[str]]:
+    """(our arguments, PETSc arguments after '--')."""
+    if "--" in argv:
+        i = argv.index("--")
+        return argv[:i], argv[i + 1 :]
+    return argv, []
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def petsc_dict(args: list[str]) -> dict[str, str | None]:
+    """['-snes_monitor', '-ksp_type', 'gmres'] -> {'snes_monitor': None, 'ksp_type': 'gmres'}."""
+    out: dict[str, str | None] = {}
+    i = 0
+    while i < len(args):
+        key = args[i]
+        if not key.startswith("-") or _is_number(key):
+            raise ValueError(f"PETSc option expected after '--', got '{key}'")
+        value = None
+        if i + 1 < len(args) and (not args[i + 1].startswith("-") or _is_number(args[i + 1])):
+            value = args[i + 1]
+            i += 1
+        out[key.lstrip("-")] = value
+        i += 1
+    return out
+
+
+def add_options(parser, cls, defaults: dict) -> None:
+    """One ``--option`` per field of the parameter dataclass ``cls`` (its help and type)."""
+    for f in dataclasses.fields(cls):
+        name = option_name(f)
+        default = defaults.get(name, f.default)
+        kind = type(f.default)
+        parser.add_argument(
+            "--" + name.replace("_", "-"), dest=name, type=kind, default=default,
+            metavar=kind.__name__.upper(),
+            help=f"{f.metadata.get('help', '')} (default: {default})",
+        )  # fmt: skip
+
+
+def int_list(text: str) -> list[int]:
+    """'1,2' -> [1, 2]."""
+    try:
+        return [int(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise ValueError(f"expected comma-separated integers, got '{text}'") from None

@@ -1,0 +1,154 @@
+"""``contactfx list`` and ``contactfx run SCENE [options] [-- PETSc options]``."""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from pathlib import Path
+
+from contactfx.cli.args import Parser, add_options
+from contactfx.io.provenance import versions, write_json
+from contactfx.numerics import Numerics
+from contactfx.results import RunSummary
+from contactfx.scenes import SCENES, get_scene
+from contactfx.solvers.snes import ConvergenceError
+
+__all__ = ["cmd_list", "cmd_run", "table"]
+
+
+def _scene_parser(scene_cls) -> Parser:
+    parser = Parser(
+        prog=f"contactfx run {scene_cls.name}",
+        description=scene_cls.summary,
+        epilog="PETSc options go after '--', e.g. -- -snes_monitor -ksp_type gmres",
+    )
+    add_options(parser.add_argument_group("scene parameters"), scene_cls.Params, {})
+    add_options(parser.add_argument_group("numerics"), Numerics, scene_cls.numerics_defaults)
+    parser.add_argument("--out", type=Path, default=None, help="output folder (XDMF, run.json)")
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    return parser
+
+
+def _fields(cls, values: dict) -> dict:
+    return {f.name: values[f.name] for f in dataclasses.fields(cls)}
+
+
+def cmd_list() -> int:
+    def options(cls):
+        for f in dataclasses.fields(cls):
+            print(f"    --{f.name.replace('_', '-'):22s} {f.default!s:10s} {f.metadata['help']}")
+
+    for name, cls in SCENES.items():
+        print(f"{name:12s} {cls.summary}")
+        options(cls.Params)
+    print("numerics (every scene):")
+    options(Numerics)
+    return 0
+
+
+def table(res: RunSummary) -> str:
+    """The summary printed after a run."""
+    t, ref, num = res.timings, res.reference, res.numerics
+    method = num["method"] + (f" theta={num['theta']}" if num["method"] == "nitsche" else "")
+    kind = "P2/P1 mixed u-p" if num["formulation"] == "mixed-up" else f"P{num['degree']}"
+    rows = [
+        ("scene", res.scene),
+        ("method", f"{method}, {kind}"),
+        ("dofs / ranks", f"{res.dofs} / {res.ranks}"),
+        ("load steps / Newton / KSP",
+         f"{len(res.steps)} / {res.newton_iterations} / {res.ksp_iterations}"),
+        ("time mesh / compile / assembly / solve [s]",
+         " / ".join(f"{t.get(k, 0.0):.2f}" for k in ("mesh", "compile", "assembly", "solve"))),
+    ]  # fmt: skip
+    rows += _interface_rows(res) if res.interface is not None else _obstacle_rows(res, ref)
+    if res.outer_iterations > len(res.steps):
+        rows.append(("Uzawa outer iterations", str(res.outer_iterations)))
+    if res.interface is None:
+        rows += [(k.replace("_", " "), f"{v:.4g}") for k, v in res.scores.items()]
+        rows += [(k.replace("_", " "), f"{v:.4e}") for k, v in res.errors.items()]
+    else:
+        rows += [(k.replace("_", " "), f"{v:.6g}") for k, v in {**ref, **res.errors}.items()]
+    if res.plot:
+        rows.append(("line plot", res.plot))
+    width = max(len(r[0]) for r in rows)
+    return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)
+
+
+def _obstacle_rows(res: RunSummary, ref: dict) -> list[tuple[str, str]]:
+    rows = [("contact force", f"{res.force:.6g}")]
+    if "force_rel_error" in ref:
+        rows.append(("reference force", f"{ref['force']:.6g}  (rel. error "
+                     f"{ref['force_rel_error']:.2%})"))  # fmt: skip
+    if "a" in ref:
+        rows.append(("contact half-width a (ref)",
+                     f"{ref['a_computed']:.6g} vs {ref['a']:.6g}  (rel. error "
+                     f"{ref['a_rel_error']:.2%}, {ref['a_error_over_h']:.2f} h)"))  # fmt: skip
+    else:
+        rows.append(("contact half-width / radius", f"{res.contact_size:.6g}"))
+    if "p0" in ref:
+        rows.append(("peak pressure p0", f"{ref['p0_computed']:.6g} vs {ref['p0']:.6g}  "
+                     f"(rel. error {ref['p0_rel_error']:.2%})"))  # fmt: skip
+    else:
+        rows.append(("peak pressure", f"{res.peak_pressure:.6g}"))
+    f = res.friction
+    if f is not None:
+        rows.append(("tangential force Q / bound", f"{f.tangential_force[0]:.6g} / {f.bound:.6g}"))
+        stick = f"{f.stick_size:.6g}  (slip fraction {f.slip_fraction:.1%})"
+        if "c" in ref:
+            stick += f", Cattaneo-Mindlin {ref['c']:.6g}"
+        rows.append(("stick zone half-width / radius", stick))
+        rows.append(("max friction excess", f"{f.excess:.2e}"))
+    return rows
+
+
+def _interface_rows(res: RunSummary) -> list[tuple[str, str]]:
+    i = res.interface
+    rows = [
+        ("interface normal / tangential force", f"{res.force:.6g} / {i.tangential_force:.6g}"),
+        ("closed length / max penetration",
+         f"{res.contact_size:.6g} / {res.max_penetration:.3e}"),
+    ]  # fmt: skip
+    if i.proppant_force is not None:
+        rows.append(("proppant force / min aperture (propped)",
+                     f"{i.proppant_force:.6g} / {i.min_aperture_propped:.6g}"))  # fmt: skip
+    return rows
+
+
+def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
+    if not argv or argv[0].startswith("-"):
+        if argv and argv[0] in ("-h", "--help"):
+            print("usage: contactfx run SCENE [options] [-- PETSc options]; see `contactfx list`")
+            return 0
+        raise ValueError("missing scene name: contactfx run SCENE (see `contactfx list`)")
+    scene_cls = get_scene(argv[0])
+    if comm.rank != 0 and ("-h" in argv or "--help" in argv):
+        return 0
+    ns = vars(_scene_parser(scene_cls).parse_args(argv[1:]))
+    scene = scene_cls(scene_cls.Params(**_fields(scene_cls.Params, ns)))
+    numerics = Numerics(**_fields(Numerics, ns))
+    if comm.rank == 0 and not ns["quiet"]:
+        print(f"contactfx: {scene.name}, method {numerics.method}, {comm.size} rank(s)", flush=True)
+    try:
+        res = scene.run(numerics, comm=comm, out=ns["out"], petsc_options=petsc_options,
+                        verbose=not ns["quiet"])  # fmt: skip
+    except ConvergenceError:
+        if ns["out"] is not None:
+            _write_failed(ns["out"], scene, numerics, sys.exc_info()[1], comm)
+        raise
+    if comm.rank == 0:
+        print(table(res))
+        if res.xdmf:
+            print(f"  ParaView: {res.xdmf}")
+            print(f"  summary:  {Path(res.xdmf).parent / 'run.json'}")
+    return 0
+
+
+def _write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
+    """run.json marked failed, with the error: no half-written result presented as complete."""
+    data = {"status": "failed", "error": str(error), "scene": scene.name,
+            "parameters": dataclasses.asdict(scene.p), "numerics": dataclasses.asdict(numerics),
+            "versions": versions(), "ranks": comm.size}  # fmt: skip
+    try:
+        write_json(Path(out) / "run.json", data, comm)
+    except OSError:
+        pass

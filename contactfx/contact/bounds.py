@@ -1,0 +1,111 @@
+"""SNES-VI reference: frictionless contact with a rigid obstacle as bound constraints on the
+displacement dofs (PETSc ``vinewtonrsls``, Benson & Munson 2006,
+doi:10.1080/10556780500065382).
+
+The linearised (vertical) gap at the contact surface's dofs gives the upper bounds
+u_d <= height(x_t + u_t - offset_t) - x_d + offset_d, evaluated at the reference position
+(x_t without u_t: small deformation), re-evaluated whenever the load program moves the
+obstacle. No contact term enters the residual; the contact pressure is the reaction
+K u - b at the bounded dofs, lumped by the surface's nodal mass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import dolfinx
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.contact.method import MethodBase, Supports
+
+__all__ = ["BoundConstraints"]
+
+
+@dataclass(frozen=True)
+class BoundConstraints(MethodBase):
+    """Bound constraints on the displacement (no parameters)."""
+
+    name = "vi"
+    supports = Supports(
+        why_not={
+            "friction": "bound constraints are frictionless",
+            "mixed_up": "it bounds the displacement dofs of a displacement-only space",
+            "interfaces": "it bounds dofs, not displacement jumps",
+            "nodal_quadrature": "it has no contact integrals",
+        }
+    )
+
+    def residual(self, s):
+        return None
+
+    def pressure(self, s):
+        return None
+
+    def snes_options(self) -> dict[str, object]:
+        return {"snes_type": "vinewtonrsls"}
+
+    def attach(self, solver, problem):
+        return _Bounded(solver, problem.V, problem.contact_facets, problem.obstacle,
+                        problem.offset)  # fmt: skip
+
+    @staticmethod
+    def reaction_pressure(solver, u, mass: np.ndarray, target) -> float:
+        """The nodal contact pressure from the reaction r = b - K u at the bounded component
+        (lumped by the surface's nodal ``mass`` of ``target``'s space) into ``target``; returns
+        the total contact force."""
+        r = solver.K.createVecLeft()
+        solver.K.mult(_compat.petsc_vec(u), r)
+        r.axpy(-1.0, solver.b)
+        gdim = u.function_space.mesh.geometry.dim
+        reac = -r.getArray()[gdim - 1 :: gdim]
+        vec = _compat.petsc_vec(target)
+        pk = vec.getArray()
+        pk[:] = 0.0
+        on = mass > 0.0
+        pk[on] = np.maximum(reac[on], 0.0) / mass[on]
+        force = u.function_space.mesh.comm.allreduce(
+            float(np.sum(np.maximum(reac[on], 0.0))), op=MPI.SUM
+        )
+        r.destroy()
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        return force
+
+
+class _Bounded:
+    """The solver with the bounds of the current obstacle position (updated with the load)."""
+
+    def __init__(self, solver, V, facets, obstacle, offset) -> None:
+        self.inner, self.u, self.timer = solver, solver.u, solver.timer
+        mesh = V.mesh
+        gdim = mesh.geometry.dim
+        self.obstacle, self.offset, self.gdim = obstacle, offset, gdim
+        Vd, _ = V.sub(gdim - 1).collapse()
+        dofs = _compat.locate_dofs_topological((V.sub(gdim - 1), Vd), gdim - 1, facets)
+        self.dofs = np.asarray(dofs[0])  # indices into V's local (unrolled) dofs
+        coords = _compat.dof_coordinates(Vd)[np.asarray(dofs[1])][:, :gdim]
+        self._template = dolfinx.fem.Function(V)  # owns the memory the bounds are copied from
+        x = _compat.petsc_vec(self._template)
+        self.lower, self.upper = x.copy(), x.copy()
+        self.lower.set(PETSc.NINFINITY)
+        self.upper.set(PETSc.INFINITY)
+        keep = self.dofs < V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+        self.dofs, self.coords = self.dofs[keep], coords[keep]
+
+    def assemble_load(self) -> None:
+        offset = self.offset.value
+        t = self.coords[:, : self.gdim - 1] - offset[: self.gdim - 1]
+        bound = self.obstacle.height(t) + offset[self.gdim - 1] - self.coords[:, self.gdim - 1]
+        self.upper.getArray()[self.dofs] = np.where(np.isfinite(bound), bound, PETSc.INFINITY)
+        self.inner.set_bounds(self.lower, self.upper)
+        self.inner.assemble_load()
+
+    def solve(self):
+        return self.inner.solve()
+
+    def destroy(self) -> None:
+        self.lower.destroy()
+        self.upper.destroy()
+        self.inner.destroy()

@@ -1,0 +1,90 @@
+"""The contact-method protocol: what the driver asks of an enforcement method, and what a method
+declares it supports.
+
+A method is a frozen dataclass whose fields (made with :func:`contactfx.params.param`) are its
+parameters; they become command-line options and fields of
+:class:`contactfx.numerics.Numerics`. It writes UFL against a contact surface
+(:class:`contactfx.contact.surface.Surface`): the residual, the pressure and, with friction,
+the tangential traction. Everything else the driver needs is declared here with a default:
+
+* ``multiplier``: ``"none"`` (displacement only), ``"field"`` (a P1 multiplier solved with the
+  displacement, one mixed unknown), or ``"nodal"`` (a P1 multiplier updated between Newton
+  solves by :meth:`update`; an outer loop, see :meth:`attach`);
+* :meth:`snes_options`: PETSc options the method needs (e.g. an SNES-VI type);
+* :meth:`attach`: wrap the nonlinear solver (an outer loop, bound constraints);
+* ``supports``: the friction laws, formulations, quadratures, problem kinds and dimensions it
+  handles, with the reason for each it does not: :class:`contactfx.numerics.Numerics` and the
+  driver check a run against it and name the methods that would do.
+
+Adding a method: one module with its dataclass and one line in
+:mod:`contactfx.contact.registry`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+__all__ = ["Supports", "ContactMethod", "MethodBase"]
+
+
+@dataclass(frozen=True)
+class Supports:
+    """What a method handles. ``why_not`` maps a capability name (``friction``, ``mixed_up``,
+    ``nodal_quadrature``, ``interfaces``, ``dim1``, ``iterative``) to the reason it is not
+    supported, quoted in the error a user sees."""
+
+    friction: tuple[str, ...] = ("none",)
+    mixed_up: bool = False
+    nodal_quadrature: bool = False
+    interfaces: bool = False
+    two_body: bool = False
+    dim1: bool = True
+    iterative: bool = True
+    why_not: dict[str, str] = field(default_factory=dict)
+
+
+@runtime_checkable
+class ContactMethod(Protocol):
+    """The members the driver and the post-processing use (see the module docstring)."""
+
+    name: ClassVar[str]
+    multiplier: ClassVar[str]
+    supports: ClassVar[Supports]
+
+    def residual(self, s) -> Any: ...
+
+    def pressure(self, s) -> Any: ...
+
+    def contact_indicator(self, s) -> Any: ...
+
+    def snes_options(self) -> dict[str, object]: ...
+
+    def attach(self, solver, problem) -> Any: ...
+
+
+class MethodBase:
+    """Defaults of the protocol for the dataclass methods."""
+
+    multiplier: ClassVar[str] = "none"
+    supports: ClassVar[Supports] = Supports()
+
+    @classmethod
+    def from_options(cls, options) -> MethodBase:
+        """The method with its parameters read from ``options`` (a Numerics, by option name)."""
+        from contactfx.params import option_name
+
+        return cls(**{f.name: getattr(options, option_name(f)) for f in dataclasses.fields(cls)})
+
+    def contact_indicator(self, s):
+        """> 0 exactly where the surfaces are closed (the pressure, unless a multiplier that
+        vanishes only to solver tolerance where open needs a sharper test)."""
+        return self.pressure(s)
+
+    def snes_options(self) -> dict[str, object]:
+        return {}
+
+    def attach(self, solver, problem):
+        """The solver the load program drives (``solver`` itself unless wrapped)."""
+        return solver

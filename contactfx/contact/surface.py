@@ -1,0 +1,60 @@
+"""The contact-surface protocol: what a method may use to write its terms.
+
+A surface is where contact is enforced: the boundary of a body facing a rigid obstacle
+(:class:`contactfx.contact.gap.ContactSurface`) or the two faces of a fitted interface
+(:class:`contactfx.contact.interface.InterfaceSurface`). Both present the same members, so
+every method writes one residual for both. Conventions (docs/architecture.md): gap g >= 0 when
+apart, n the outward normal of the body whose surface is integrated, pressure p >= 0 in
+compression; ``u`` is the motion of the surface relative to its counterpart (the displacement
+against an obstacle, the oriented jump across an interface).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Protocol, runtime_checkable
+
+import ufl
+
+from contactfx.contact.laws import Friction, tangential
+
+__all__ = ["Expr", "Surface", "sigma_n", "sigma_t"]
+
+#: a UFL expression (a Function, a component of a mixed one, a test function, a Constant)
+Expr = ufl.core.expr.Expr
+
+
+def sigma_n(stress, n):
+    """Normal stress n . stress n (< 0 in compression)."""
+    return ufl.dot(n, ufl.dot(stress, n))
+
+
+def sigma_t(stress, n):
+    """Tangential traction (I - n n) stress n."""
+    return tangential(ufl.dot(stress, n), n)
+
+
+@runtime_checkable
+class Surface(Protocol):
+    """u, v: relative motion of the state and of the test functions; ds: the contact measure
+    (``ds_nodal`` the same with the vertex rule); stress / stress_test: the stress of the state
+    and of the test functions at the surface; E: modulus scaling the method parameters; h: local
+    mesh size; friction: the friction law or None; multiplier / multiplier_test: a method's
+    multiplier (None without one)."""
+
+    u: Any
+    v: Any
+    ds: ufl.Measure
+    ds_nodal: ufl.Measure | None
+    stress: Any
+    stress_test: Any
+    E: float
+    h: Any
+    friction: Friction | None
+    multiplier: Any
+    multiplier_test: Any
+
+    def gap(self, w=None) -> Any: ...
+
+    def normal(self, w=None) -> Any: ...
+
+    def slip_increment(self, n) -> Any: ...

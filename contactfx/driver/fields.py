@@ -1,0 +1,129 @@
+"""Surface-field helpers shared by every problem kind: quadrature rules, masks of surface dofs,
+conditions that confine a field to a surface, lumped nodal projections and global sums."""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contactfx import _compat
+
+__all__ = ["vertex_rule", "surface_mask", "at_points", "confine", "assemble_array", "NodalProjection",
+           "global_sum", "zero_pattern"]  # fmt: skip
+
+
+def vertex_rule(fdim: int) -> dict:
+    """Quadrature at the facet's vertices (trapezoidal rule): nodal collocation of the
+    multiplier equations, exact nodal complementarity."""
+    if fdim == 0:
+        points, weights = ((),), (1.0,)
+    elif fdim == 1:
+        points, weights = ((0.0,), (1.0,)), (0.5, 0.5)
+    else:
+        points, weights = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), (1.0 / 6.0,) * 3
+    return {
+        "quadrature_rule": "custom",
+        "quadrature_degree": 1,
+        "quadrature_points": points,
+        "quadrature_weights": weights,
+    }
+
+
+def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=()) -> np.ndarray:
+    """Bool per local (owned + ghost) dof block of the collapsed space Q: on one of the facets
+    on any rank, and not at one of the ``excluded`` (point, tolerance) pairs (crack tips)."""
+    marker = dolfinx.fem.Function(Q)
+    dofs = _compat.locate_dofs_topological(Q, fdim, facets)
+    bs = Q.dofmap.index_map_bs
+    marker.x.array.reshape(-1, bs)[dofs] = 1.0
+    vec = _compat.petsc_vec(marker)
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    on = marker.x.array.reshape(-1, bs)[:, 0] > 0.0
+    on[at_points(Q, excluded)] = False
+    return on
+
+
+def at_points(Q, points) -> np.ndarray:
+    """Local dof blocks of the collapsed space Q within the tolerance of one of the
+    (point, tolerance) pairs."""
+
+    def at(x):
+        hit = np.zeros(x.shape[1], dtype=bool)
+        for point, tol in points:
+            hit |= np.linalg.norm(x[: len(point)].T - point, axis=1) < tol
+        return hit
+
+    return dolfinx.fem.locate_dofs_geometrical(Q, at)
+
+
+def confine(Wsub, mask_of) -> list:
+    """Dirichlet conditions that fix the sub-space ``Wsub`` to zero outside the dofs that
+    ``mask_of(Q)`` marks (Q the collapsed sub-space): a field that lives on a surface only
+    (a contact multiplier, an interface enrichment)."""
+    Q, q_to_w = Wsub.collapse()
+    keep = mask_of(Q)
+    bs = Q.dofmap.index_map_bs
+    q_to_w = np.asarray(q_to_w).reshape(-1, bs)
+    if bs == 1:
+        return [_compat.dirichletbc(np.float64(0.0), q_to_w[~keep, 0].astype(np.int32), Wsub)]
+    return [
+        _compat.dirichletbc(np.float64(0.0), q_to_w[~keep, i].astype(np.int32), Wsub.sub(i))
+        for i in range(bs)
+    ]
+
+
+def assemble_array(form) -> np.ndarray:
+    """The assembled linear form's owned entries (ghost contributions accumulated)."""
+    b = _compat.assemble_vector(_compat.create_vector(form), form)
+    arr = b.getArray().copy()
+    b.destroy()
+    return arr
+
+
+class NodalProjection:
+    """Lumped L2 projection onto the nodes of a surface: target = (int f q dS) / (int q dS)
+    where the mass is > 0, 0 elsewhere. With the vertex rule it gives f's exact nodal values;
+    it serves interior-facet quantities, which cannot be interpolated cellwise."""
+
+    def __init__(self, measure, space, restrict=None) -> None:
+        q = ufl.TestFunction(space)
+        self.q = q if restrict is None else q(restrict)
+        self.measure = measure
+        shape = space.ufl_element().value_shape()
+        shape = shape() if callable(shape) else shape
+        ones = ufl.as_vector([1.0] * shape[0]) if shape else 1.0
+        self.mass = assemble_array(dolfinx.fem.form(ufl.inner(ones, self.q) * measure))
+        self.on = self.mass > 0.0
+
+    def form(self, expr):
+        """The compiled right-hand side of ``expr`` (compile once, project every step)."""
+        return dolfinx.fem.form(ufl.inner(expr, self.q) * self.measure)
+
+    def __call__(self, form, target) -> None:
+        b = assemble_array(form)
+        vec = _compat.petsc_vec(target)
+        arr = vec.getArray()
+        arr[:] = 0.0
+        arr[self.on] = b[self.on] / self.mass[self.on]
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+
+def global_sum(form, comm) -> float:
+    """A compiled functional summed over the ranks."""
+    return comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
+
+
+def zero_pattern(mesh, trial, test, measures) -> ufl.Form:
+    """A zero coupling of every component of ``trial`` with every component of ``test`` on
+    each (measure, restriction) pair: gives the bulk matrix the sparsity of the contact terms,
+    so that the contact Jacobian can be added to it."""
+    zero = dolfinx.fem.Constant(mesh, 0.0)
+    n = ufl.shape(trial)[0]
+    s_trial = sum(trial[i] for i in range(n))
+    s_test = sum(test[i] for i in range(n))
+    terms = [zero * couple(s_trial) * couple(s_test) * measure for measure, couple in measures]
+    return sum(terms[1:], terms[0])

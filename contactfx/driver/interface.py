@@ -1,0 +1,232 @@
+"""The fitted-interface problem kind: cracks, fractures and joints inside one body
+(:class:`contactfx.scenes.interface_base.InterfaceScene`).
+
+The unknown is the vector field U = (u, a) of 2 d components (d the dimension): the
+displacement is w = u + H a, with the enrichment a nonzero only at the interface's dofs and zero
+at the crack tips (see :mod:`contactfx.contact.interface`). Contact, friction, proppant floor,
+fluid pressure and joint closure are interior-facet integrals; the methods are the ones of the
+rigid-obstacle scenes, written against :class:`contactfx.contact.interface.InterfaceSurface`.
+
+Outputs: along the interface the aperture, slip, normal and tangential traction and the status
+(0 open, 1 closed / stick, 2 slip, 3 propped) as P1 fields in the XDMF file (zero away from the
+interface), as a PNG line plot (``interface.png``) against the interface coordinate s and as
+CSV (``interface.csv``); the continuous part u (``displacement``) and the enrichment a
+(``enrichment``): the faces are at u + a and u - a (XDMF stores no discontinuous fields on
+dolfinx >= 0.8).
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contactfx import _compat
+from contactfx.contact.interface import InterfaceSurface, oriented_jump
+from contactfx.contact.laws import positive_part
+from contactfx.driver.fields import (
+    NodalProjection,
+    at_points,
+    confine,
+    surface_mask,
+    vertex_rule,
+    zero_pattern,
+)
+from contactfx.driver.problem import Problem
+
+__all__ = ["InterfaceProblem", "tangent"]
+
+
+def tangent(n):
+    """The interface direction in 2D: n_I rotated by -90 degrees."""
+    return ufl.as_vector([n[1], -n[0]])
+
+
+class InterfaceProblem(Problem):
+    """A body with a fitted interface (see the module docstring)."""
+
+    components_per_dim = 2
+
+    @classmethod
+    def check(cls, scene, numerics, method) -> None:
+        if not method.supports.interfaces:
+            from contactfx.contact.registry import methods_supporting
+
+            raise ValueError(
+                f"method {method.name} is not offered on fitted interfaces ("
+                f"{method.supports.why_not.get('interfaces', 'not supported')}); use "
+                + ", ".join(methods_supporting(lambda c: c.interfaces))
+            )
+        if numerics.formulation != "displacement":
+            raise ValueError("fitted interfaces use --formulation displacement")
+
+    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+        if mesh.geometry.dim != 2:
+            raise ValueError("fitted interfaces are implemented in 2D (plane strain)")
+        self.contact_facets = facet_tags.indices[facet_tags.values == scene.interface_tag]
+        self.tol = 1e-9 * scene.length_scale()  # of point location
+        self.tips = [(np.asarray(t, dtype=float), self.tol) for t in scene.tips()]
+        # the side sign H: +1 / -1 from the cell midpoints
+        self.H = dolfinx.fem.Function(_compat.function_space(mesh, "DG", 0), name="side")
+        self.H.interpolate(lambda x: np.where(scene.side(x) >= 0.0, 1.0, -1.0))
+        super().__init__(scene, numerics, method, mesh, facet_tags)
+
+    def total(self, X):
+        """w = u + H a from X = (u, a)."""
+        d = self.gdim
+        return ufl.as_vector([X[i] + self.H * X[d + i] for i in range(d)])
+
+    def boundary_conditions(self) -> list:
+        V, d, fdim, tags = self.V, self.gdim, self.fdim, self.facet_tags
+        bcs = []
+        for tag, comp in self.scene.supports():  # they hold for the total displacement
+            facets = tags.indices[tags.values == tag]
+            for c in (comp, d + comp):
+                dofs = _compat.locate_dofs_topological(V.sub(c), fdim, facets)
+                bcs.append(_compat.dirichletbc(np.float64(0.0), dofs, V.sub(c)))
+        for point, comp in self.scene.pinned():  # removing the rigid motions
+            Q, q_to_w = V.sub(comp).collapse()
+            dofs = at_points(Q, [(np.asarray(point, dtype=float), self.tol)])
+            parent = np.asarray(q_to_w)[dofs].astype(np.int32)
+            bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
+        for i in range(d):
+            bcs += confine(V.sub(d + i), self.free_mask)
+        return bcs + self.confine_multiplier(self.tips)
+
+    def free_mask(self, Q) -> np.ndarray:
+        """On the interface and not at a tip."""
+        return surface_mask(Q, self.fdim, self.contact_facets, self.tips)
+
+    def make_surface(self) -> InterfaceSurface:
+        mesh, scene, tag = self.mesh, self.scene, self.scene.interface_tag
+        self.w, self.dw, self.v_load = (self.total(X) for X in (self.U, self.dU, self.V_test))
+        self.dS = ufl.Measure("dS", domain=mesh, subdomain_data=self.facet_tags)
+        self.dSc = self.dS(tag, metadata=self.contact_rule())
+        self.dS_fine = self.dS(tag, metadata={"quadrature_degree": 12})
+        self.dS_nodal = self.dS(tag, metadata=vertex_rule(self.fdim))
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
+        x = ufl.SpatialCoordinate(mesh)
+        origin, direction = (np.asarray(v, dtype=float) for v in scene.frame())
+        self.s_coord = (x[0] - origin[0]) * direction[0] + (x[1] - origin[1]) * direction[1]
+        self.fluid_value = scene.fluid_pressure()
+        self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
+        sigma = self.material.sigma
+        return InterfaceSurface(
+            self.w, self.v_load, self.H, self.dSc, sigma(self.w), sigma(self.v_load),
+            scene.contact_modulus(), self.h, floor=scene.floor(self.s_coord), fluid=self.fluid,
+            joint=scene.joint(), friction=self.friction,
+            u_prev=None if self.prev is None else self.total(self.previous()),
+            ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
+            multiplier=None if self.lam is None else self.lam("+"),
+            multiplier_test=None if self.lam_test is None else self.lam_test("+"),
+        )  # fmt: skip
+
+    def bulk_form(self):
+        a = ufl.inner(self.material.sigma(self.dw), ufl.sym(ufl.grad(self.v_load))) * ufl.dx
+        # zero couplings that give the matrix the pattern of the interface terms (dofs of the
+        # two cells of an interface facet; every component of a mixed unknown)
+        dS = self.dS(self.scene.interface_tag)
+        pattern = [(dS, ufl.jump), (dS, ufl.avg)]
+        if self.split:
+            pattern.append((ufl.dx, lambda f: f))
+        return a + zero_pattern(self.mesh, self.trial, self.test, pattern)
+
+    def extra_load(self, L):
+        if self.fluid is None:
+            return L
+        # the fluid pushes both faces apart
+        s = self.surface
+        return L + self.fluid * ufl.dot(s.v, s.interface_normal()) * self.dSc
+
+    # -- what the methods use ----------------------------------------------------------------
+    @property
+    def multiplier_mask(self) -> np.ndarray:
+        return self.free_mask(self.multiplier.function_space)
+
+    def nodal_update(self, expr):
+        """The nodal values of an interior-facet quantity: a vertex-rule lumped projection."""
+        proj = NodalProjection(self.dS_nodal, self.multiplier.function_space, "+")
+        form = proj.form(expr)
+        return lambda target: proj(form, target)
+
+    # -- load program --------------------------------------------------------------------------
+    def apply_load(self, t: float) -> None:
+        self.tload.value = t
+        if self.fluid is not None:
+            self.fluid.value = t * self.fluid_value
+
+    def start(self, solver) -> None:
+        """Start from the interface held together under the first load step's loads: a linear
+        solve with the jump fixed to zero (the bonded body) or, for a joint, held by its initial
+        normal stiffness (tangentially bonded). Where the interface is then in compression the
+        contact law is active at the first Newton iterate and the body stays supported (from
+        the unloaded, touching state the semi-smooth derivative of [x]_+ at x = 0 would leave a
+        part split off by the interface unsupported); where it is in tension the faces open in
+        the next iterations. Multipliers start at that state's traction."""
+        self.apply_load(1.0 / self.num.steps)
+        solver.assemble_load()
+        joint, s = self.scene.joint(), self.surface
+        spring = None
+        if joint is not None:
+            n_I = s.interface_normal()
+            t_I = tangent(n_I)
+            jd = oriented_jump(self.dw, self.H)
+            k_t = self.scene.contact_modulus() / s.h
+            spring = dolfinx.fem.form(
+                (joint.Kni * ufl.dot(jd, n_I) * ufl.dot(s.v, n_I)
+                 + k_t * ufl.dot(jd, t_I) * ufl.dot(s.v, t_I)) * self.dSc
+            )  # fmt: skip
+        n_owned = solver.owned_size
+        free = np.zeros(n_owned, dtype=bool)
+        for i in range(self.gdim if spring is None else 2 * self.gdim):
+            parent = np.asarray(self.V.sub(i).collapse()[1])
+            free[parent[parent < n_owned]] = True
+        solver.solve_linear(free, spring)
+        if self.lam is not None:
+            self._start_multiplier()
+        self._tolerances(solver)
+
+    def _start_multiplier(self) -> None:
+        s = self.surface
+        start = ufl.dot(s.stress, s.normal()) if self.mult_shape else positive_part(
+            s.effective_pressure())  # fmt: skip
+        if self.multiplier is not None:
+            self.nodal_update(start)(self.multiplier)
+            bs = self.multiplier.function_space.dofmap.index_map_bs
+            self.multiplier.x.array[~np.repeat(self.multiplier_mask, bs)] = 0.0
+            return
+        W1 = self.state.function_space.sub(1)
+        Q, q_to_w = W1.collapse()
+        lam0 = dolfinx.fem.Function(Q)
+        proj = NodalProjection(self.dS_nodal, Q, "+")
+        proj(proj.form(start), lam0)
+        self.state.x.array[np.asarray(q_to_w)] = lam0.x.array
+        self.state.x.scatter_forward()
+
+    def _tolerances(self, solver) -> None:
+        user = set(solver.user_options)
+        prefix = solver.prefix
+        if not {"snes_atol", prefix + "snes_atol"} & user:
+            # absolute tolerance a little above the round-off of the loads: the start (bonded,
+            # or the load-step predictor) can already be the solution, e.g. of a uniformly
+            # compressed joint, and rtol then cannot be met
+            solver.snes.setTolerances(atol=1e-11 * solver.b.norm())
+        if self.method.multiplier != "field" and not {"snes_stol", prefix + "snes_stol"} & user:
+            # and a Newton step below 1e-12 of the displacement is converged too (the
+            # residual's round-off floor grows with the conditioning, e.g. P2 on graded tips);
+            # not for a multiplier field, whose unknown mixes displacements and multipliers
+            solver.snes.setTolerances(stol=1e-12)
+
+    def post_processor(self):
+        from contactfx.driver.interface_post import InterfacePost
+
+        return InterfacePost(self)
+
+    def dofs(self) -> int:
+        """Free unknowns: the enrichment's fixed dofs away from the interface do not count."""
+        total = super().dofs()
+        space = self.state.function_space
+        owned = space.dofmap.index_map.size_local * space.dofmap.index_map_bs
+        fixed = sum(int(np.sum(np.asarray(_compat.bc_dofs(bc)) < owned)) for bc in self.bcs)
+        return total - self.mesh.comm.allreduce(fixed, op=MPI.SUM)

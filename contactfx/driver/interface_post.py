@@ -1,0 +1,242 @@
+"""Post-processing of a fitted interface: nodal fields along the interface, forces, errors
+against the closed forms, the gathered profile (CSV and a line plot)."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contactfx import _compat
+from contactfx.contact.laws import active
+from contactfx.driver.fields import NodalProjection, global_sum
+from contactfx.driver.interface import tangent
+from contactfx.results import InterfaceQuantities, Quantities
+
+__all__ = ["InterfacePost", "Profile", "STATUS"]
+
+#: interface status codes of the ``interface_status`` field
+STATUS = {"open": 0, "stick": 1, "slip": 2, "propped": 3}
+
+
+@dataclasses.dataclass
+class Profile:
+    """Nodal values along the interface (rank 0 holds all, sorted by s; other ranks empty):
+    coordinate s, position x (n, 2), opening (normal jump), slip (tangential jump, along the
+    interface direction), normal contact pressure p, tangential traction t (on the +side,
+    along the direction), status codes, and the proppant floor."""
+
+    s: np.ndarray
+    x: np.ndarray
+    opening: np.ndarray
+    slip: np.ndarray
+    p: np.ndarray
+    t: np.ndarray
+    status: np.ndarray
+    floor: np.ndarray
+
+    COLUMNS = "s,x,y,opening,slip,normal_traction,tangential_traction,status,proppant"
+
+    def write_csv(self, path: Path) -> None:
+        """One row per interface node, sorted by s."""
+        cols = np.column_stack([self.s, self.x, self.opening, self.slip, self.p, self.t,
+                                self.status, self.floor])  # fmt: skip
+        np.savetxt(path, cols, delimiter=",", comments="", header=self.COLUMNS)
+
+
+class InterfacePost:
+    """Nodal interface fields, forces, errors against the closed forms, the profile."""
+
+    def __init__(self, pb) -> None:
+        self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
+        mesh, s, method = pb.mesh, pb.surface, pb.method
+        self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
+        self.nodal = NodalProjection(pb.dS_nodal, self.Q1, "+")
+        t_I = tangent(s.interface_normal())
+        p = method.pressure(s)
+        closed = method.contact_indicator(s)
+        joint = s.joint
+        self.w0 = 0.0 if joint is None else joint.w0
+        quantities = {"aperture": s.opening() + self.w0, "slip": ufl.dot(s.u, t_I),
+                      "normal_traction": p, "gap": s.gap()}  # fmt: skip
+        if s.friction is not None:
+            quantities["tangential_traction"] = ufl.dot(method.tangential_traction(s), t_I)
+            quantities["slipping"] = method.slip_indicator(s)
+        if s.floor is not None:
+            quantities["proppant"] = s.floor
+        self.fields_nodal = {name: dolfinx.fem.Function(self.Q1, name=name)
+                             for name in quantities if name != "slipping"}  # fmt: skip
+        self._slipping = dolfinx.fem.Function(self.Q1)
+        self.forms = {name: self.nodal.form(expr) for name, expr in quantities.items()}
+        self.status = dolfinx.fem.Function(self.Q1, name="interface_status")
+        dSf = pb.dS_fine
+        self.force_form = dolfinx.fem.form(p * dSf)
+        self.closed_form = dolfinx.fem.form(active(closed) * dSf)
+        self.tforce_form = None
+        if s.friction is not None:
+            self.tforce_form = dolfinx.fem.form(quantities["tangential_traction"] * dSf)
+        self.propped_form = None
+        if s.floor is not None:
+            self.propped_form = dolfinx.fem.form(p * active(s.floor) * dSf)
+        self.err_forms = self._error_forms(s, p, t_I)
+        self.extra = {k: dolfinx.fem.form(v)
+                      for k, v in self.scene.extra_quantities(mesh, s.w, pb.ds).items()}  # fmt: skip
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        self.vm_expr = _compat.expression(pb.material.von_mises(s.w), DG0)
+        self.vm = dolfinx.fem.Function(DG0, name="von_mises")
+        V1 = _compat.function_space(mesh, "Lagrange", 1, (pb.gdim,))
+        self.u_out = dolfinx.fem.Function(V1, name="displacement")
+        self.a_out = dolfinx.fem.Function(V1, name="enrichment")
+        U, d = pb.U, pb.gdim
+        self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(d)]), V1)
+        self.a_expr = _compat.expression(ufl.as_vector([U[d + i] for i in range(d)]), V1)
+
+    def _error_forms(self, s, p, t_I) -> dict[str, tuple]:
+        """Errors against the closed forms, integrated with a degree-12 rule."""
+        out = {}
+        sc, dSf = self.pb.s_coord, self.pb.dS_fine
+        for name, computed, exact in (
+            ("opening", s.opening(), self.scene.exact_opening(sc)),
+            ("slip", ufl.dot(s.u, t_I), self.scene.exact_slip(sc)),
+            ("pressure", p, self.scene.exact_pressure_interface(sc)),
+        ):
+            if exact is not None:
+                out[name] = (dolfinx.fem.form((computed - exact) ** 2 * dSf),
+                             dolfinx.fem.form(exact**2 * dSf))  # fmt: skip
+        return out
+
+    def _max(self, values, op=MPI.MAX, initial=0.0) -> float:
+        reduce = np.max if op == MPI.MAX else np.min
+        return self.comm.allreduce(float(reduce(values, initial=initial)), op=op)
+
+    def evaluate(self, solver) -> Quantities:
+        for name, f in self.fields_nodal.items():
+            self.nodal(self.forms[name], f)
+        on, n = self.nodal.on, len(self.nodal.on)
+        st = self.status.x.array
+        st[:] = 0.0
+        p = self.fields_nodal["normal_traction"].x.array
+        p_max = self._max(p[:n][on])
+        closed = p > 1e-10 * max(p_max, 1e-300)
+        st[closed] = STATUS["stick"]
+        if "slipping" in self.forms:
+            self.nodal(self.forms["slipping"], self._slipping)
+            st[closed & (self._slipping.x.array > 0.5)] = STATUS["slip"]
+        if "proppant" in self.fields_nodal:
+            st[closed & (self.fields_nodal["proppant"].x.array > 0.0)] = STATUS["propped"]
+        gap = self.fields_nodal["gap"].x.array[:n][on]
+        interface = InterfaceQuantities(
+            tangential_force=0.0 if self.tforce_form is None else global_sum(self.tforce_form,
+                                                                             self.comm),
+            extra={k: global_sum(form, self.comm) for k, form in self.extra.items()},
+        )  # fmt: skip
+        if self.propped_form is not None:
+            ap = self.fields_nodal["aperture"].x.array[:n]
+            propped = on & (self.fields_nodal["proppant"].x.array[:n] > 0.0)
+            interface = dataclasses.replace(
+                interface, proppant_force=global_sum(self.propped_form, self.comm),
+                min_aperture_propped=self._max(ap[propped], MPI.MIN, np.inf))  # fmt: skip
+        return Quantities(
+            force=global_sum(self.force_form, self.comm),
+            contact_size=global_sum(self.closed_form, self.comm),
+            peak_pressure=p_max,
+            max_penetration=self.comm.allreduce(float(max(-gap.min(initial=0.0), 0.0)),
+                                                op=MPI.MAX),
+            complementarity=self._max(np.abs(gap * p[:n][on])),
+            interface=interface,
+        )  # fmt: skip
+
+    def fields(self) -> list:
+        self.u_out.interpolate(self.u_expr)
+        self.a_out.interpolate(self.a_expr)
+        self.vm.interpolate(self.vm_expr)
+        return [self.u_out, self.a_out, self.vm, *self.fields_nodal.values(), self.status]
+
+    def profile(self) -> Profile:
+        """Gather the owned interface nodes' values on rank 0, sorted by s."""
+        on = self.nodal.on
+        n = len(on)
+        owned = np.zeros(n, dtype=bool)
+        owned[: self.Q1.dofmap.index_map.size_local] = True
+        sel = owned & on
+        origin, direction = (np.asarray(v, dtype=float) for v in self.scene.frame())
+        xs = _compat.dof_coordinates(self.Q1)[:n][sel][:, :2]
+        s = (xs - origin) @ direction
+
+        def col(name):
+            f = self.fields_nodal.get(name)
+            return np.zeros(len(s)) if f is None else f.x.array[:n][sel]
+
+        local = np.column_stack([
+            s, xs, col("aperture"), col("slip"), col("normal_traction"),
+            col("tangential_traction"), self.status.x.array[:n][sel], col("proppant"),
+        ])  # fmt: skip
+        parts = self.comm.gather(local, root=0)
+        if self.comm.rank != 0:
+            return Profile(*(np.zeros(0) for _ in range(8)))
+        a = np.vstack(parts)
+        a = a[np.argsort(a[:, 0])]
+        return Profile(a[:, 0], a[:, 1:3], a[:, 3] - self.w0, a[:, 4], a[:, 5], a[:, 6],
+                       a[:, 7], a[:, 8])  # fmt: skip
+
+    def finish(self, q: Quantities, out: Path | None) -> dict:
+        """Closed-form comparisons from the gathered profile, field errors, the CSV and the
+        line plot."""
+        prof = self.profile()
+        reference: dict[str, float] = {}
+        if self.comm.rank == 0:
+            reference = self.scene.interface_reference(prof, q, self.pb.friction)
+        reference = self.comm.bcast(reference, root=0)
+        plot = None
+        if out is not None:
+            plot = out / "interface.png"
+            if self.comm.rank == 0:
+                plot_profile(prof, self.scene, plot)
+                prof.write_csv(out / "interface.csv")
+        errors = {}
+        for name, (err, norm) in self.err_forms.items():
+            e, nrm = np.sqrt(global_sum(err, self.comm)), np.sqrt(global_sum(norm, self.comm))
+            errors[f"{name}_L2"] = e
+            errors[f"{name}_L2_rel"] = e / nrm if nrm > 0.0 else e
+        return {"reference": reference, "errors": errors,
+                "plot": None if plot is None else str(plot)}  # fmt: skip
+
+
+def plot_profile(prof: Profile, scene, path: Path) -> None:
+    """Line plots along the interface: aperture and slip (with the closed forms where the
+    scene has them), normal and tangential traction, status."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, 8.0), sharex=True)
+    s = prof.s
+    ref = scene.reference_profile(s)
+    for ax, name, computed in ((axes[0], "opening", prof.opening), (axes[1], "slip", prof.slip)):
+        ax.plot(s, computed, "o-", ms=2, label=f"{name} (computed)")
+        if name == "opening" and np.any(prof.floor > 0.0):
+            ax.plot(s, prof.floor, "k--", lw=1, label="proppant thickness")
+        if name in ref:
+            ax.plot(s, ref[name], "-", lw=1, label=f"{name} (closed form)")
+        ax.set_ylabel(name)
+        ax.legend(fontsize=8)
+    ax = axes[2]
+    ax.plot(s, prof.p, "o-", ms=2, label="contact pressure")
+    ax.plot(s, prof.t, "s-", ms=2, label="tangential traction")
+    for name, code in STATUS.items():
+        sel = prof.status == code
+        if np.any(sel) and code > 0:
+            label = "closed / stick" if name == "stick" else name
+            ax.plot(s[sel], np.zeros(sel.sum()), "|", ms=8, label=label)
+    ax.set_ylabel("traction")
+    ax.set_xlabel("s (along the interface)")
+    ax.legend(fontsize=8)
+    fig.suptitle(scene.name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,332 @@
+"""The rigid-obstacle problem kind: an elastic body against an obstacle given by a signed
+distance function, moved by the load program (:class:`contactfx.scenes.base.ObstacleScene`).
+
+Unknown: the displacement u (with a P1 multiplier or the u-p pressure as second field).
+Surface: :class:`contactfx.contact.gap.ContactSurface` on the scene's contact facets.
+Post-processing: contact force, nodal pressure (lumped), contact size, penetration,
+complementarity, friction quantities, and the errors against the scene's closed forms.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.contact.gap import ContactSurface
+from contactfx.contact.laws import active, positive_part
+from contactfx.driver.fields import (
+    NodalProjection,
+    global_sum,
+    surface_mask,
+    vertex_rule,
+    zero_pattern,
+)
+from contactfx.driver.problem import Problem
+from contactfx.results import Friction, Quantities
+
+__all__ = ["ObstacleProblem"]
+
+
+class ObstacleProblem(Problem):
+    """A body against a rigid obstacle (see the module docstring)."""
+
+    @classmethod
+    def check(cls, scene, numerics, method) -> None:
+        if numerics.formulation == "mixed-up" and not scene.material().lmbda > 0.0:
+            raise ValueError(f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = "
+                             f"{scene.material().nu}")  # fmt: skip
+
+    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+        if mesh.topology.dim == 1 and not method.supports.dim1:
+            raise ValueError(f"method {method.name} needs a 2D or 3D mesh ("
+                             f"{method.supports.why_not['dim1']})")  # fmt: skip
+        self.contact_facets = facet_tags.indices[facet_tags.values == scene.contact_tag]
+        self.obstacle = scene.obstacle()
+        super().__init__(scene, numerics, method, mesh, facet_tags)
+
+    def material_of(self, mesh):
+        """The scene's material, with its modulus field for a heterogeneous body."""
+        material, modulus = self.scene.material(), self.scene.modulus(mesh)
+        return material if modulus is None else dataclasses.replace(material, modulus=modulus)
+
+    def boundary_conditions(self) -> list:
+        return self.scene.dirichlet(self.V, self.facet_tags) + self.confine_multiplier()
+
+    def make_surface(self) -> ContactSurface:
+        mesh, scene = self.mesh, self.scene
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
+        self.dsc = self.ds(scene.contact_tag, metadata=self.contact_rule())
+        self.dsc_fine = self.ds(scene.contact_tag, metadata={"quadrature_degree": 12})
+        self.offset = dolfinx.fem.Constant(mesh, np.zeros(self.gdim))
+        self.offset_prev = None
+        if self.friction is not None:
+            self.offset_prev = dolfinx.fem.Constant(mesh, np.zeros(self.gdim))
+        self.v_load = self.V_test
+        return ContactSurface(
+            self.U, self.V_test, self.dsc, self.obstacle, self.offset,
+            self.sigma(self.U, self.p), self.sigma(self.V_test, self.q),
+            scene.contact_modulus(), self.h, friction=self.friction,
+            u_prev=None if self.prev is None else self.previous(),
+            offset_prev=self.offset_prev,
+            ds_nodal=self.ds(scene.contact_tag, metadata=vertex_rule(self.fdim))
+            if self.method.multiplier == "field" else None,
+            multiplier=self.lam, multiplier_test=self.lam_test,
+        )  # fmt: skip
+
+    def sigma(self, u, p):
+        return self.material.sigma(u, p)
+
+    def bulk_form(self):
+        a = ufl.inner(self.sigma(self.dU, self.dp), ufl.sym(ufl.grad(self.V_test))) * ufl.dx
+        if self.up:
+            a += self.material.pressure_law(self.dU, self.dp, self.q) * ufl.dx
+        if self.method.multiplier == "field":
+            a += zero_pattern(self.mesh, self.trial, self.test, [(ufl.dx, lambda f: f)])
+        return a
+
+    # -- what the methods use ----------------------------------------------------------------
+    @property
+    def multiplier_mask(self) -> np.ndarray:
+        Q = self.multiplier.function_space
+        return surface_mask(Q, self.fdim, self.contact_facets)
+
+    def nodal_update(self, expr):
+        """Interpolation of ``expr`` at the multiplier's nodes."""
+        compiled = _compat.expression(expr, self.multiplier.function_space)
+        return lambda target: target.interpolate(compiled)
+
+    # -- load program --------------------------------------------------------------------------
+    def apply_load(self, t: float) -> None:
+        self.tload.value = t
+        self.offset.value[:] = self.scene.obstacle_offset(t, self.gdim)
+
+    def start(self, solver) -> None:
+        u = self.state.sub(0) if self.split else self.state
+        self.scene.initial_guess(u, 1.0 / self.num.steps)
+
+    def converged(self) -> None:
+        super().converged()
+        if self.offset_prev is not None:
+            self.offset_prev.value[:] = self.offset.value
+
+    def post_processor(self) -> ObstaclePost:
+        return ObstaclePost(self)
+
+
+class ObstaclePost:
+    """Contact force, pressure, contact size, penetration, friction quantities and field
+    errors, compiled once."""
+
+    def __init__(self, pb: ObstacleProblem) -> None:
+        self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
+        mesh, s, method, gdim = pb.mesh, pb.surface, pb.method, pb.gdim
+        self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
+        self.nodal = NodalProjection(pb.dsc, self.Q1)
+        self.pressure = dolfinx.fem.Function(self.Q1, name="contact_pressure")
+        self.gap = dolfinx.fem.Function(self.Q1, name="gap")
+        self.status = dolfinx.fem.Function(self.Q1, name="contact_status")
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        self.vm = dolfinx.fem.Function(DG0, name="von_mises")
+        self.vm_expr = _compat.expression(pb.material.von_mises(s.u, pb.p), DG0)
+        self.gap_expr = _compat.expression(s.gap(), self.Q1)
+        self.displacement = pb.state
+        if pb.split:
+            V_out, self.out_map = pb.V.collapse()
+            self.displacement = dolfinx.fem.Function(V_out, name="displacement")
+        n = s.normal()
+        p = method.pressure(s)
+        if p is None:  # bound constraints: the pressure is the reaction
+            Qk = _compat.function_space(mesh, "Lagrange", pb.num.degree)
+            self.reaction = (NodalProjection(pb.dsc, Qk), dolfinx.fem.Function(Qk))
+            self.measure_form = dolfinx.fem.form(self.status * pb.dsc)
+        else:
+            self.reaction = None
+            self.force_form = dolfinx.fem.form(p * n[gdim - 1] * pb.dsc)
+            self.p_form = self.nodal.form(p)
+            closed = method.contact_indicator(s)
+            self.measure_form = dolfinx.fem.form(active(closed) * pb.dsc_fine)
+        self.friction = None if pb.friction is None else _FrictionPost(pb, self, p, closed)
+        self.errors = _FieldErrors(pb, p, self.pressure)
+
+    def evaluate(self, solver) -> Quantities:
+        on = self.nodal.on
+        if self.reaction is None:
+            force = global_sum(self.force_form, self.comm)
+            self.nodal(self.p_form, self.pressure)
+        else:
+            proj, pk = self.reaction
+            force = self.pb.method.reaction_pressure(solver.inner, self.pb.state, proj.mass, pk)
+            self.pressure.interpolate(pk)
+        p_local = self.pressure.x.array
+        p_max = self.comm.allreduce(float(p_local.max(initial=0.0)), op=MPI.MAX)
+        st = self.status.x.array
+        st[:] = (p_local > 1e-10 * max(p_max, 1e-300)).astype(float)  # 0 open, 1 closed (stick)
+        self.gap.interpolate(self.gap_expr)
+        n = len(on)
+        gap_s, p_s = self.gap.x.array[:n][on], p_local[:n][on]
+        measure = global_sum(self.measure_form, self.comm) * self.scene.symmetry
+        friction = None
+        if self.friction is not None:
+            friction = self.friction.evaluate(measure)
+        return Quantities(
+            force=force * self.scene.symmetry,
+            contact_size=self.scene.contact_size(measure),
+            peak_pressure=p_max,
+            max_penetration=self.comm.allreduce(float(max(-gap_s.min(initial=0.0), 0.0)),
+                                                op=MPI.MAX),
+            complementarity=self.comm.allreduce(
+                float(np.max(np.abs(gap_s * p_s), initial=0.0)), op=MPI.MAX),
+            friction=friction,
+        )  # fmt: skip
+
+    def fields(self) -> list:
+        pb = self.pb
+        if pb.split:
+            self.displacement.x.array[:] = pb.state.x.array[self.out_map]
+        self.vm.interpolate(self.vm_expr)
+        out = [self.displacement, self.vm, self.pressure, self.gap, self.status]
+        if self.friction is not None:
+            out += [self.friction.traction, self.friction.slip]
+        return out
+
+    def finish(self, q: Quantities, out) -> dict:
+        """Closed-form comparisons, pointwise scores and field errors of the final state."""
+        ref = self.scene.reference(q.force)
+        reference: dict[str, float] = {}
+        if "force" in ref:
+            reference["force"] = ref["force"]
+            reference["force_rel_error"] = abs(q.force - ref["force"]) / abs(ref["force"])
+        for key, computed in (("a", q.contact_size), ("p0", q.peak_pressure)):
+            if key in ref:
+                reference.update({key: ref[key], f"{key}_computed": computed,
+                                  f"{key}_rel_error": abs(computed - ref[key]) / abs(ref[key])})
+        if "a" in ref:
+            reference["a_error_over_h"] = abs(q.contact_size - ref["a"]) / self.scene.h_contact()
+        for key, value in ref.items():
+            reference.setdefault(key, value)
+        if q.friction is not None:
+            reference.update(self.scene.friction_reference(q, self.pb.friction))
+        return {"reference": reference, "scores": self.scores(q.force),
+                "errors": self.errors.evaluate(ref)}  # fmt: skip
+
+    def scores(self, force: float) -> dict[str, float]:
+        on = self.nodal.on
+        n = len(on)
+        x = _compat.dof_coordinates(self.Q1)[:n][on]
+        p = self.pressure.x.array[:n][on]
+        local = self.scene.pressure_scores(x, p, force)
+        if self.friction is not None:
+            local.update(self.friction.scores(x, p))
+        return {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in local.items()}
+
+
+class _FrictionPost:
+    """Tangential traction and slip at the nodes, stick zone, forces, the friction excess."""
+
+    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p, closed) -> None:
+        self.pb, self.post, self.comm = pb, post, pb.mesh.comm
+        s, method, mesh, gdim = pb.surface, pb.method, pb.mesh, pb.gdim
+        V1 = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
+        self.vector = NodalProjection(pb.dsc, V1)
+        t_T = method.tangential_traction(s)
+        # the bound plus a zero that keeps the forms' arguments when mu = 0 or the threshold is
+        # 0 (UFL would simplify the bound away)
+        bound = pb.friction.bound_where(p, closed) + dolfinx.fem.Constant(mesh, 0.0)
+        slipping = method.slip_indicator(s)
+        self.traction = dolfinx.fem.Function(V1, name="tangential_traction")
+        self.slip = dolfinx.fem.Function(V1, name="slip")
+        self._increment = dolfinx.fem.Function(V1)
+        self._slipping = dolfinx.fem.Function(post.Q1)
+        self._bound = dolfinx.fem.Function(post.Q1)
+        self.increment_expr = _compat.expression(s.slip_increment(s.normal()), V1)
+        self.t_form = self.vector.form(t_T)
+        self.slip_form = post.nodal.form(slipping)
+        self.bound_nodal_form = post.nodal.form(bound)
+        self.tforce_forms = [dolfinx.fem.form(t_T[i] * pb.dsc) for i in range(gdim)]
+        t_abs = ufl.sqrt(ufl.dot(t_T, t_T))
+        self.excess_form = dolfinx.fem.form(positive_part(t_abs - bound) * pb.dsc)
+        self.bound_form = dolfinx.fem.form(bound * pb.dsc)
+        self.stick_form = dolfinx.fem.form(active(closed) * (1.0 - slipping) * pb.dsc_fine)
+
+    def evaluate(self, measure: float) -> Friction:
+        scene, comm = self.pb.scene, self.comm
+        self.vector(self.t_form, self.traction)
+        self.post.nodal(self.slip_form, self._slipping)
+        st = self.post.status.x.array
+        st[:] += (st > 0.0) & (self._slipping.x.array > 0.5)  # 2 where slipping
+        bound = global_sum(self.bound_form, comm)
+        excess = global_sum(self.excess_form, comm)
+        stick = global_sum(self.stick_form, comm) * scene.symmetry
+        self.accumulate_slip()
+        return Friction(
+            tangential_force=[global_sum(f, comm) * scene.tangential_symmetry[i]
+                              for i, f in enumerate(self.tforce_forms)],
+            bound=bound * scene.tangential_symmetry[0],
+            stick_size=scene.contact_size(stick),
+            slip_fraction=1.0 - stick / measure if measure > 0.0 else 0.0,
+            excess=excess / bound if bound > 0.0 else excess,
+        )  # fmt: skip
+
+    def accumulate_slip(self) -> None:
+        """slip += tangential slip increment of this step, on the contact boundary's nodes."""
+        self._increment.interpolate(self.increment_expr)
+        on = self.post.nodal.on
+        gdim = self.pb.gdim
+        vec = _compat.petsc_vec(self.slip)
+        arr = vec.getArray().reshape(-1, gdim)
+        inc = self._increment.x.array[: arr.size].reshape(-1, gdim)
+        arr[on] += inc[on]
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def scores(self, x, p) -> dict[str, float]:
+        on = self.post.nodal.on
+        n, gdim = len(on), self.pb.gdim
+        t = self.traction.x.array[: n * gdim].reshape(-1, gdim)[on]
+        status = self.post.status.x.array[:n][on]
+        self.post.nodal(self.bound_nodal_form, self._bound)
+        bound = self._bound.x.array[:n][on]
+        return self.pb.scene.friction_scores(x, p, t, bound, status)
+
+
+class _FieldErrors:
+    """Relative L2 error of the pressure on the contact boundary against the closed form at the
+    computed force (the method's pressure at quadrature points; the lumped nodal pressure for
+    bound constraints and nodal quadrature), integrated with a degree-12 rule; L2 and H1
+    errors of the displacement where the scene has an exact field."""
+
+    def __init__(self, pb: ObstacleProblem, p, nodal_pressure) -> None:
+        self.pb, self.comm = pb, pb.mesh.comm
+        # the nodal pressure (bound constraints, nodal quadrature): piecewise linear
+        self.p_h = p if p is not None and pb.num.quadrature == "gauss" else nodal_pressure
+        x = ufl.SpatialCoordinate(pb.mesh)
+        exact = pb.scene.exact_displacement(x)
+        self.forms = {}
+        if exact is not None:
+            e = pb.surface.u - exact
+            dxq = ufl.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
+            for key, op in (("L2", lambda f: f), ("H1", ufl.grad)):
+                self.forms[key] = (dolfinx.fem.form(ufl.inner(op(e), op(e)) * dxq),
+                                   dolfinx.fem.form(ufl.inner(op(exact), op(exact)) * dxq))  # fmt: skip
+
+    def evaluate(self, ref: dict) -> dict[str, float]:
+        out: dict[str, float] = {}
+        pb = self.pb
+        consts = {k: dolfinx.fem.Constant(pb.mesh, float(v)) for k, v in ref.items()}
+        exact = pb.scene.exact_pressure(ufl.SpatialCoordinate(pb.mesh), consts)
+        if exact is not None:
+            dsf = pb.dsc_fine
+            err = np.sqrt(global_sum(dolfinx.fem.form((self.p_h - exact) ** 2 * dsf), self.comm))
+            norm = np.sqrt(global_sum(dolfinx.fem.form(exact**2 * dsf), self.comm))
+            out.update(pressure_L2=err, pressure_L2_rel=err / norm)
+        for key, (err_form, norm_form) in self.forms.items():
+            err = np.sqrt(global_sum(err_form, self.comm))
+            norm = np.sqrt(global_sum(norm_form, self.comm))
+            out[f"displacement_{key}"] = err
+            out[f"displacement_{key}_rel"] = err / norm
+        return out

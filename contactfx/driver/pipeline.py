@@ -1,0 +1,173 @@
+"""The driver: one pipeline for every problem kind.
+
+Stages (docs/architecture.md, "Data flow"): check the request, build the mesh, set up the
+problem kind (unknowns and spaces, measures and surfaces), compile the forms, build the solver
+(the method attaches what it needs), start, run the load program (post-processing and output
+at each converged step), and record the summary. A problem kind
+(:class:`contactfx.driver.problem.Problem`) supplies its unknowns, surface, forms and
+post-processing; it has no copy of the pipeline.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from contextlib import contextmanager, nullcontext
+from pathlib import Path
+
+import dolfinx
+from mpi4py import MPI
+
+from contactfx.io.provenance import versions, write_json
+from contactfx.io.xdmf import ResultsWriter
+from contactfx.results import RunSummary, StepLog
+from contactfx.solvers.loadstep import StepRecord, run_load_program
+from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
+
+__all__ = ["run", "prepare_output"]
+
+
+def run(scene, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
+        verbose: bool = True) -> RunSummary:  # fmt: skip
+    """Solve ``scene`` with ``numerics``; write XDMF, run.json (and the kind's extra output)
+    into ``out`` when given. Raises ValueError on a request the method or the problem kind
+    does not support (before any collective), ConvergenceError when the solve fails."""
+    method = numerics.method_object()
+    scene.problem.check(scene, numerics, method)
+    scene.configure(numerics)
+    run_ = _Run(scene, numerics, method, comm, None if out is None else Path(out),
+                dict(petsc_options or {}), verbose)  # fmt: skip
+    return run_.execute()
+
+
+def prepare_output(out: Path, comm) -> None:
+    """Create the output folder and remove a previous run.json; fail on every rank alike."""
+    error = None
+    if comm.rank == 0:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+            probe = out / ".write-test"
+            probe.write_text("")
+            probe.unlink()
+            (out / "run.json").unlink(missing_ok=True)
+        except OSError as err:
+            error = f"output folder {out} is not writable: {err.strerror or err}"
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        raise ValueError(error)
+
+
+class _Run:
+    def __init__(self, scene, numerics, method, comm, out, petsc_options, verbose) -> None:
+        self.scene, self.num, self.method, self.comm = scene, numerics, method, comm
+        self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
+        self.timings: dict[str, float] = {}
+        self.prefix = f"contactfx_{scene.name.replace('-', '_')}_"
+
+    @contextmanager
+    def timed(self, phase: str):
+        t0 = time.perf_counter()
+        yield
+        self.timings[phase] = self.timings.get(phase, 0.0) + time.perf_counter() - t0
+
+    def say(self, msg: str) -> None:
+        if self.verbose and self.comm.rank == 0:
+            print(msg, flush=True)
+
+    def execute(self) -> RunSummary:
+        if self.out is not None:
+            prepare_output(self.out, self.comm)
+        with self.timed("mesh"):
+            mesh, facet_tags = self.scene.build_mesh(self.comm)
+        problem = self.scene.problem(self.scene, self.num, self.method, mesh, facet_tags)
+        with self.timed("compile"):
+            forms = problem.forms()
+            post = problem.post_processor()
+        solver = self.build_solver(problem, forms)
+        try:
+            with self.timed("initial_guess"):
+                problem.start(solver)
+            solver = self.method.attach(solver, problem)
+            steps = self.load_program(problem, solver, post)
+            extra = post.finish(steps[-1].quantities, self.out)
+        finally:
+            solver.destroy()
+        return self.record(problem, mesh, steps, extra)
+
+    # -- solver --------------------------------------------------------------------------
+    def build_solver(self, problem, forms) -> ContactSNES:
+        a, L, F_c = forms
+        options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
+        options.update(self.method.snes_options())
+        J_c = None
+        if F_c is not None:
+            J_c = dolfinx.fem.form(problem.derivative(F_c))
+            F_c = dolfinx.fem.form(F_c)
+        return ContactSNES(
+            problem.state, stiffness=a, load=L, contact_residual=F_c, contact_jacobian=J_c,
+            bcs=problem.bcs, prefix=self.prefix, options=options,
+            user_options=self.petsc_options, near_nullspace=self.num.solver == "gamg",
+        )  # fmt: skip
+
+    # -- load program ----------------------------------------------------------------------
+    def load_program(self, problem, solver, post) -> list[StepLog]:
+        """Solve at the load factors of the program; at each converged step evaluate the
+        contact quantities, write the fields and keep the step as the history of the next."""
+        steps: list[StepLog] = []
+        xdmf = None if self.out is None else self.out / f"{self.scene.name}.xdmf"
+        writer = ResultsWriter(xdmf, problem.mesh) if xdmf is not None else nullcontext()
+        with writer:
+
+            def on_step(rec: StepRecord) -> None:
+                quantities = post.evaluate(solver)
+                s = rec.stats
+                steps.append(StepLog(rec.step, rec.load, s.newton, s.ksp, s.outer,
+                                     rec.cutbacks, s.reason, quantities))  # fmt: skip
+                if xdmf is not None:
+                    with self.timed("output"):
+                        writer.write(rec.load, post.fields())
+                problem.converged()
+                self.say(_progress(steps[-1], problem.method.multiplier == "nodal"))
+
+            t0 = time.perf_counter()
+            a0 = solver.timer.assembly
+            run_load_program(solver, problem.apply_load, steps=self.num.steps, on_step=on_step)
+            total = time.perf_counter() - t0
+        self.timings["assembly"] = solver.timer.assembly
+        output = self.timings.get("output", 0.0)
+        self.timings["solve"] = total - (solver.timer.assembly - a0) - output
+        return steps
+
+    # -- record --------------------------------------------------------------------------
+    def record(self, problem, mesh, steps: list[StepLog], extra: dict) -> RunSummary:
+        summary = RunSummary(
+            scene=self.scene.name,
+            parameters=dataclasses.asdict(self.scene.p),
+            numerics=dataclasses.asdict(self.num),
+            petsc_options={k: str(v) for k, v in self.petsc_options.items()},
+            petsc_prefix=self.prefix,
+            versions=versions(),
+            ranks=self.comm.size,
+            dofs=problem.dofs(),
+            cells=mesh.topology.index_map(mesh.topology.dim).size_global,
+            h_contact=self.scene.h_contact(),
+            steps=steps,
+            timings=dict(self.timings),
+            quantities=steps[-1].quantities,
+            xdmf=None if self.out is None else str(self.out / f"{self.scene.name}.xdmf"),
+            **extra,
+        )
+        if self.out is not None:
+            write_json(self.out / "run.json", summary.to_json(), self.comm)
+        return summary
+
+
+def _progress(step: StepLog, outer: bool) -> str:
+    q = step.quantities
+    head = f"  step {step.step:3d}  load {step.load:6.3f}  newton {step.newton:3d}"
+    head += f"  outer {step.outer:3d}" if outer else ""
+    if q.interface is not None:
+        return (f"{head}  normal force {q.force:.6g}  tangential force "
+                f"{q.interface.tangential_force:.6g}")  # fmt: skip
+    tangential = "" if q.friction is None else f"  Q {q.friction.tangential_force[0]:.6g}"
+    return f"{head}  ksp {step.ksp:4d}  force {q.force:.6g}  a {q.contact_size:.6g}{tangential}"

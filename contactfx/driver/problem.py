@@ -1,0 +1,132 @@
+"""Problem kinds: what the pipeline asks of a rigid-obstacle problem, a fitted interface and
+(next) two bodies.
+
+:class:`Problem` builds what every kind shares: the unknown (the kind's displacement field,
+extended by a multiplier field for a ``"field"`` method or by the pressure of the mixed u-p
+formulation), the friction history, the nodal multiplier of a ``"nodal"`` method, and the forms
+(bulk, load, contact residual). A kind adds its unknowns' meaning, its boundary conditions and
+measures, its :class:`contactfx.contact.surface.Surface`, its load program and its
+post-processing.
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+
+from contactfx import _compat
+from contactfx.driver.fields import confine, surface_mask, vertex_rule
+
+__all__ = ["Problem"]
+
+
+class Problem:
+    """Base of the problem kinds. After construction: ``state`` (the unknown Function),
+    ``trial`` / ``test``, ``bcs``, ``surface`` and, for the methods, ``multiplier`` and
+    ``multiplier_mask`` (nodal multiplier methods)."""
+
+    #: the field count of the kind's displacement-like unknown per space dimension
+    components_per_dim = 1
+
+    @classmethod
+    def check(cls, scene, numerics, method) -> None:
+        """Raise ValueError for a request this kind cannot solve (before any collective)."""
+
+    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+        self.scene, self.num, self.method = scene, numerics, method
+        self.mesh, self.facet_tags = mesh, facet_tags
+        self.gdim = mesh.geometry.dim
+        self.fdim = mesh.topology.dim - 1
+        self.friction = numerics.friction_law()
+        self.material = self.material_of(mesh)
+        self.tload = dolfinx.fem.Constant(mesh, 0.0)
+        self.h = _compat.cell_diameter(mesh)
+        self.mult_shape = (self.gdim,) if self.friction is not None else ()
+        self._spaces()
+        self.bcs = self.boundary_conditions()
+        self.prev = None  # the last converged state: the history of friction
+        if self.friction is not None:
+            self.prev = dolfinx.fem.Function(self.state.function_space)
+        self.multiplier = None
+        if method.multiplier == "nodal":
+            space = _compat.function_space(mesh, "Lagrange", 1, self.mult_shape or None)
+            self.multiplier = dolfinx.fem.Function(space, name="multiplier")
+            self.lam = self.multiplier
+        self.surface = self.make_surface()
+
+    def material_of(self, mesh):
+        return self.scene.material()
+
+    # -- unknowns ------------------------------------------------------------------------
+    def _spaces(self) -> None:
+        """The unknown: [P_k]^(c d), or a mixed space with a P1 multiplier (``"field"``
+        methods) or the P1 pressure (mixed u-p formulation) as second field."""
+        num, mesh = self.num, self.mesh
+        n = self.components_per_dim * self.gdim
+        field = self.method.multiplier == "field"
+        self.up = num.formulation == "mixed-up"
+        self.split = field or self.up
+        if self.split:
+            W = _compat.mixed_space(mesh, num.degree, n, self.mult_shape if field else ())
+            self.V = W.sub(0)
+        else:
+            W = self.V = _compat.function_space(mesh, "Lagrange", num.degree, (n,))
+        self.state = dolfinx.fem.Function(W, name="state")
+        self.trial, self.test = ufl.TrialFunction(W), ufl.TestFunction(W)
+        if self.split:
+            (self.U, extra), (self.dU, d_extra), (self.V_test, extra_test) = (
+                ufl.split(f) for f in (self.state, self.trial, self.test)
+            )
+        else:
+            self.U, self.dU, self.V_test = self.state, self.trial, self.test
+            extra = d_extra = extra_test = None
+        self.lam, self.lam_test = (extra, extra_test) if field else (None, None)
+        self.p, self.dp, self.q = (extra, d_extra, extra_test) if self.up else (None,) * 3
+
+    def confine_multiplier(self, excluded=()) -> list:
+        """The ``"field"`` multiplier is zero away from the contact surface."""
+        if self.method.multiplier != "field":
+            return []
+        W = self.state.function_space
+        return confine(W.sub(1), lambda Q: surface_mask(Q, self.fdim, self.contact_facets,
+                                                        excluded))  # fmt: skip
+
+    def previous(self):
+        """The displacement part of the last converged state (friction history)."""
+        return ufl.split(self.prev)[0] if self.split else self.prev
+
+    # -- measures --------------------------------------------------------------------------
+    def contact_rule(self) -> dict:
+        """Gauss (degree 2k + 2) or the vertex rule (``--quadrature nodal``: the contact law at
+        the P1 nodes only, so that a curved obstacle does not over-constrain the piecewise
+        linear surface when gamma0 / the penalty is large)."""
+        if self.num.quadrature == "nodal":
+            return vertex_rule(self.fdim)
+        return {"quadrature_degree": 2 * self.num.degree + 2}
+
+    # -- forms ---------------------------------------------------------------------------
+    def forms(self):
+        """(compiled bulk bilinear form, compiled load, contact residual as UFL or None)."""
+        a = self.bulk_form()
+        L = self.scene.load(self.v_load, self.ds, self.tload)
+        if L is None:
+            L = ufl.inner(dolfinx.fem.Constant(self.mesh, np.zeros(self.gdim)), self.v_load) * ufl.dx
+        L = self.extra_load(L)
+        return dolfinx.fem.form(a), dolfinx.fem.form(L), self.method.residual(self.surface)
+
+    def derivative(self, F):
+        """The consistent Jacobian form of a residual in the state."""
+        return ufl.derivative(F, self.state, self.trial)
+
+    def extra_load(self, L):
+        return L
+
+    def converged(self) -> None:
+        """A step converged: it is the history of the next."""
+        if self.prev is not None:
+            self.prev.x.array[:] = self.state.x.array
+
+    def dofs(self) -> int:
+        imap = self.state.function_space.dofmap
+        return imap.index_map.size_global * imap.index_map_bs

@@ -1,0 +1,115 @@
+"""How a contact problem is discretised and solved: :class:`Numerics`, shared by all scenes.
+
+Its fields are the general choices (method, friction law, quadrature, degree, formulation,
+load steps, linear solver) followed by every registered method's parameters
+(:mod:`contactfx.contact.registry`), so that a new method's options appear here, on the
+command line and in run.json without further code. Whether a combination is supported is
+asked of the method (:class:`contactfx.contact.method.Supports`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+from contactfx.contact.laws import friction_law
+from contactfx.contact.registry import METHODS, method_class, methods_supporting
+from contactfx.params import option_name, param, validate
+
+__all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS"]
+
+FRICTION_LAWS = ("none", "tresca", "coulomb")
+FORMULATIONS = ("displacement", "mixed-up")
+
+
+@dataclass(frozen=True)
+class _General:
+    method: str = param("nitsche", "enforcement method", choices=tuple(METHODS))
+    friction: str = param("none", "friction law", choices=FRICTION_LAWS)
+    mu: float = param(0.0, "Coulomb friction coefficient", nonnegative=True)
+    threshold: float = param(0.0, "Tresca friction threshold (stress)", nonnegative=True)
+    quadrature: str = param("gauss", "contact integrals of nitsche / penalty: gauss (degree "
+                            "2k + 2) or nodal (at the vertices, P1 only)",
+                            choices=("gauss", "nodal"))  # fmt: skip
+    degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
+    formulation: str = param("displacement", "bulk unknowns: displacement, or mixed-up "
+                             "(Taylor-Hood P2 displacement / P1 pressure, near-incompressible "
+                             "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
+    steps: int = param(1, "load steps", positive=True)
+    solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
+
+
+def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
+    """Every registered method's parameters under their option names (first one wins)."""
+    out: dict[str, tuple[str, type, dataclasses.Field]] = {}
+    for name in METHODS:
+        for f in dataclasses.fields(method_class(name)):
+            key = option_name(f)
+            meta = {**f.metadata, "option": None}
+            out.setdefault(key, (key, f.type, dataclasses.field(default=f.default,
+                                                                metadata=meta)))  # fmt: skip
+    return list(out.values())
+
+
+def _unsupported(what: str, test, reason_key: str, method: str) -> str:
+    cls = method_class(method)
+    reason = cls.supports.why_not.get(reason_key)
+    others = methods_supporting(test)
+    return (f"{what} is not supported by method '{method}'" + (f" ({reason})" if reason else "")
+            + ("; use " + ", ".join(others) if others else ""))  # fmt: skip
+
+
+class _Checks:
+    """Validation against the method's declared support (mixed into :class:`Numerics`)."""
+
+    def __post_init__(self) -> None:
+        validate(self)
+        s = method_class(self.method).supports
+        if self.friction not in s.friction:
+            raise ValueError(_unsupported(f"friction law '{self.friction}'",
+                                          lambda c: self.friction in c.friction, "friction",
+                                          self.method))  # fmt: skip
+        if self.mu > 0.0 and self.friction != "coulomb":
+            raise ValueError(f"--mu needs --friction coulomb (got --friction {self.friction})")
+        if self.threshold > 0.0 and self.friction != "tresca":
+            raise ValueError(
+                f"--threshold needs --friction tresca (got --friction {self.friction})"
+            )
+        if self.quadrature == "nodal" and (self.degree != 1 or not s.nodal_quadrature):
+            raise ValueError(
+                "--quadrature nodal needs --degree 1 and one of the methods "
+                + ", ".join(methods_supporting(lambda c: c.nodal_quadrature))
+                + (f" (method {self.method}: {s.why_not['nodal_quadrature']})"
+                   if "nodal_quadrature" in s.why_not else "")  # fmt: skip
+            )
+        if self.solver != "lu" and not s.iterative:
+            raise ValueError(f"method {self.method} is {s.why_not['iterative']}: use --solver lu")
+        if self.formulation == "mixed-up":
+            if self.degree != 2:
+                raise ValueError("formulation mixed-up is Taylor-Hood P2/P1: use --degree 2")
+            if not s.mixed_up:
+                raise ValueError(_unsupported("formulation mixed-up", lambda c: c.mixed_up,
+                                              "mixed_up", self.method))  # fmt: skip
+            if self.solver != "lu":
+                raise ValueError("formulation mixed-up is a saddle-point system: use --solver lu")
+
+    def method_object(self):
+        """The configured contact method."""
+        return method_class(self.method).from_options(self)
+
+    def friction_law(self):
+        return friction_law(self.friction, mu=self.mu, threshold=self.threshold)
+
+
+Numerics = dataclasses.make_dataclass(
+    "Numerics",
+    [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+     for f in dataclasses.fields(_General)][:1] + _method_fields()
+    + [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+       for f in dataclasses.fields(_General)][1:],
+    bases=(_Checks,),
+    frozen=True,
+)  # fmt: skip
+Numerics.__module__ = __name__
+Numerics.__doc__ = """The numerics of a run (see the module docstring); validated on
+construction against the chosen method's declared support."""

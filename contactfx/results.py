@@ -1,0 +1,259 @@
+"""Typed results of a run: what the driver measures, what run.json holds, what the command
+line, bench, stress and the tests read.
+
+:class:`RunSummary` has named fields; :meth:`RunSummary.to_json` writes them under the run.json
+keys documented in the README (the same keys as before the summary was typed, so old readers
+keep working). Scene-specific numbers (closed-form comparisons, scores, field errors) are
+named floats in the ``reference``, ``scores`` and ``errors`` mappings; the error measures that
+bench and stress tabulate are named once, in :data:`MEASURES`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["StepLog", "Friction", "InterfaceQuantities", "Quantities", "RunSummary",
+           "MEASURES", "measure"]  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Friction quantities of a rigid-obstacle contact: tangential force per component (full
+    model), the friction bound integrated over the contact (mu P for Coulomb), the stick zone's
+    half-width / radius, the slipping fraction of the contact set, and the largest excess of
+    |t_T| over the bound (relative to the bound; 0 up to the solver tolerance)."""
+
+    tangential_force: list[float]
+    bound: float
+    stick_size: float
+    slip_fraction: float
+    excess: float
+
+
+@dataclass(frozen=True)
+class InterfaceQuantities:
+    """Fitted-interface quantities: the tangential force along the interface direction, the
+    force the proppant carries and the smallest aperture on the propped part (with a proppant
+    floor), and the scene's own integrals (e.g. the joint column's top displacement)."""
+
+    tangential_force: float
+    proppant_force: float | None = None
+    min_aperture_propped: float | None = None
+    extra: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Quantities:
+    """The contact state after a load step (full model: multiplied by the symmetry).
+
+    force: normal contact force; contact_size: contact half-width / radius (rigid obstacle) or
+    closed length (interface); peak_pressure; max_penetration (>= 0); complementarity: max |g p|
+    at the surface nodes."""
+
+    force: float
+    contact_size: float
+    peak_pressure: float
+    max_penetration: float
+    complementarity: float
+    friction: Friction | None = None
+    interface: InterfaceQuantities | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        if self.interface is None:
+            out = {"force": self.force, "contact_half_width": self.contact_size,
+                   "peak_pressure": self.peak_pressure, "max_penetration": self.max_penetration,
+                   "complementarity": self.complementarity}  # fmt: skip
+            f = self.friction
+            if f is not None:
+                out.update(tangential_force=f.tangential_force, friction_bound=f.bound,
+                           stick_size=f.stick_size, slip_fraction=f.slip_fraction,
+                           friction_excess=f.excess)  # fmt: skip
+            return out
+        i = self.interface
+        out = {"normal_force": self.force, "tangential_force": i.tangential_force,
+               "closed_length": self.contact_size, "max_penetration": self.max_penetration,
+               "max_pressure": self.peak_pressure, "complementarity": self.complementarity}  # fmt: skip
+        if i.proppant_force is not None:
+            out.update(proppant_force=i.proppant_force,
+                       min_aperture_propped=i.min_aperture_propped)  # fmt: skip
+        out.update(i.extra)
+        # the names the rigid-obstacle scenes use, for tools reading any run.json
+        out.update(force=self.force, peak_pressure=self.peak_pressure)
+        return out
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> Quantities:
+        """The final state of a run.json (:meth:`RunSummary.to_json`)."""
+        if "normal_force" not in d:
+            friction = None
+            if "friction_bound" in d:
+                friction = Friction(d["tangential_force"], d["friction_bound"], d["stick_size"],
+                                    d["slip_fraction"], d["friction_excess"])  # fmt: skip
+            return cls(d["force"], d["contact_half_width"], d["peak_pressure"],
+                       d["max_penetration"], d["complementarity"], friction=friction)  # fmt: skip
+        known = {"normal_force", "tangential_force", "closed_length", "max_penetration",
+                 "max_pressure", "complementarity", "proppant_force", "min_aperture_propped"}
+        core = {f.name for f in dataclasses.fields(RunSummary)} | {
+            "status", "newton_iterations", "ksp_iterations", "outer_iterations", "force",
+            "peak_pressure"}  # fmt: skip
+        extra = {k: v for k, v in d.items() if k not in known | core}
+        interface = InterfaceQuantities(d["tangential_force"], d.get("proppant_force"),
+                                        d.get("min_aperture_propped"), extra)  # fmt: skip
+        return cls(d["normal_force"], d["closed_length"], d["max_pressure"],
+                   d["max_penetration"], d["complementarity"], interface=interface)  # fmt: skip
+
+    def step_json(self) -> dict[str, Any]:
+        """The per-step subset written into run.json's ``steps``."""
+        if self.interface is None:
+            out = {"force": self.force, "contact_half_width": self.contact_size}
+            if self.friction is not None:
+                out.update(tangential_force=self.friction.tangential_force,
+                           stick_size=self.friction.stick_size)  # fmt: skip
+            return out
+        return {"normal_force": self.force, "tangential_force": self.interface.tangential_force}
+
+
+@dataclass(frozen=True)
+class StepLog:
+    """One converged load step: iterations, cut-backs, SNES reason and the contact state."""
+
+    step: int
+    load: float
+    newton: int
+    ksp: int
+    outer: int
+    cutbacks: int
+    reason: str
+    quantities: Quantities
+
+    def to_json(self) -> dict[str, Any]:
+        head = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)[:-1]}
+        return {**head, **self.quantities.step_json()}
+
+
+@dataclass
+class RunSummary:
+    """A completed run (what run.json holds)."""
+
+    scene: str
+    parameters: dict[str, Any]
+    numerics: dict[str, Any]
+    petsc_options: dict[str, str]
+    petsc_prefix: str
+    versions: dict[str, str]
+    ranks: int
+    dofs: int
+    cells: int
+    h_contact: float
+    steps: list[StepLog]
+    timings: dict[str, float]
+    quantities: Quantities
+    reference: dict[str, float] = field(default_factory=dict)
+    scores: dict[str, float] = field(default_factory=dict)
+    errors: dict[str, float] = field(default_factory=dict)
+    xdmf: str | None = None
+    plot: str | None = None
+
+    # -- named views of the final state ---------------------------------------------------
+    @property
+    def force(self) -> float:
+        return self.quantities.force
+
+    @property
+    def contact_size(self) -> float:
+        return self.quantities.contact_size
+
+    @property
+    def peak_pressure(self) -> float:
+        return self.quantities.peak_pressure
+
+    @property
+    def max_penetration(self) -> float:
+        return self.quantities.max_penetration
+
+    @property
+    def complementarity(self) -> float:
+        return self.quantities.complementarity
+
+    @property
+    def friction(self) -> Friction | None:
+        return self.quantities.friction
+
+    @property
+    def interface(self) -> InterfaceQuantities | None:
+        return self.quantities.interface
+
+    @property
+    def newton_iterations(self) -> int:
+        return sum(s.newton for s in self.steps)
+
+    @property
+    def ksp_iterations(self) -> int:
+        return sum(s.ksp for s in self.steps)
+
+    @property
+    def outer_iterations(self) -> int:
+        return sum(s.outer for s in self.steps)
+
+    @property
+    def cutbacks(self) -> int:
+        return sum(s.cutbacks for s in self.steps)
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> RunSummary:
+        """The summary of a run.json written by :meth:`to_json` (a child process's run; the
+        steps keep their iterations, their quantities are the final state's)."""
+        q = Quantities.from_json(d)
+        steps = [StepLog(*(s[f.name] for f in dataclasses.fields(StepLog)[:-1]), q)
+                 for s in d["steps"]]  # fmt: skip
+        names = [f.name for f in dataclasses.fields(cls)
+                 if f.name not in ("steps", "quantities") and f.name in d]  # fmt: skip
+        return cls(steps=steps, quantities=q, **{k: d[k] for k in names})
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"status": "completed"}
+        for name in ("scene", "parameters", "numerics", "petsc_options", "petsc_prefix",
+                     "versions", "ranks", "dofs", "cells", "h_contact"):  # fmt: skip
+            out[name] = getattr(self, name)
+        out.update(newton_iterations=self.newton_iterations,
+                   ksp_iterations=self.ksp_iterations, outer_iterations=self.outer_iterations,
+                   steps=[s.to_json() for s in self.steps], timings=dict(self.timings))  # fmt: skip
+        out.update(self.quantities.to_json())
+        out.update(xdmf=self.xdmf, reference=self.reference, scores=self.scores,
+                   errors=self.errors)  # fmt: skip
+        if self.interface is not None:
+            out["plot"] = self.plot
+        return out
+
+
+#: error measures against the closed forms: column -> (label, section, key). Bench tabulates
+#: all of them; stress reports the first one a run has in the order of PRIMARY.
+MEASURES: dict[str, tuple[str, str, str]] = {
+    "err_force": ("force", "reference", "force_rel_error"),
+    "err_a": ("half-width a", "reference", "a_rel_error"),
+    "err_p0": ("peak pressure p0", "reference", "p0_rel_error"),
+    "err_p_L2": ("pressure, L2 on contact", "errors", "pressure_L2_rel"),
+    "err_u_L2": ("displacement, L2", "errors", "displacement_L2_rel"),
+    "err_u_H1": ("displacement, H1 semi-norm", "errors", "displacement_H1_rel"),
+    "err_punch": ("punch pressure on |x| <= 0.8 a", "scores", "normalised_pressure_error"),
+    "err_Q": ("gross-slip force Q = mu P", "reference", "Q_rel_error"),
+    "err_opening": ("crack opening, L2 on the crack", "errors", "opening_L2_rel"),
+    "err_slip": ("crack slip, L2 on the crack", "errors", "slip_L2_rel"),
+    "err_K": ("stress intensity factor", "reference", "K_rel_error"),
+    "err_settlement": ("joint column settlement", "reference", "settlement_rel_error"),
+}
+
+#: stress's primary error, most specific first, with the short name it prints
+PRIMARY = (("K", "err_K"), ("settlement", "err_settlement"), ("opening L2", "err_opening"),
+           ("p L2", "err_p_L2"), ("punch p", "err_punch"), ("Q = mu P", "err_Q"),
+           ("force", "err_force"))  # fmt: skip
+
+
+def measure(summary: RunSummary, column: str) -> float:
+    """The error measure ``column`` of :data:`MEASURES` (nan when the run has none)."""
+    _, section, key = MEASURES[column]
+    value = getattr(summary, section).get(key)
+    return math.nan if value is None else float(value)
