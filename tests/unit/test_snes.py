@@ -1,0 +1,201 @@
+"""Unit tests of :mod:`contactfx.solvers.snes` (ContactSNES) and :mod:`contactfx.solvers.loadstep`.
+
+Problem with a known discrete root: a P1 bar (0, L) of N cells, u(0) = 0, stiffness E u' v',
+body force t F, and a cubic spring K u^3 at x = L (the nonlinear "contact" residual). P1 is
+nodally exact in 1D, so the discrete root is the exact solution u = -t F x^2 / (2 E) + c x at
+the nodes, with u_L the only real root of the condensed equation
+
+    g(u_L; t) = E u_L / L + K u_L^3 - t F L / 2 = 0
+
+(solved here by bisection). The bulk equations are linear, so Newton's iterates on the full
+system are Newton's iterates on g (the condensed residual of any iterate is g(u_L), and after
+the first step the full residual is g(u_L) in the end row only): the iteration counts are
+predicted by a scalar Newton loop with the SNES stopping test of DEFAULT_OPTIONS.
+
+Tested: the root, the iteration count, ConvergenceError with the SNES reason, destroy()
+removing the prefixed options, and run_load_program (steps, secant predictor, cut-back).
+Run at 1 and 2 ranks (values compared at the dof coordinates, reductions with allreduce).
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.solvers.loadstep import run_load_program
+from contactfx.solvers.snes import DEFAULT_OPTIONS, ContactSNES, ConvergenceError
+
+COMM = MPI.COMM_WORLD
+L, N, E, F, K = 1.0, 4, 1.0, 3.0, 4.0
+H = L / N
+RTOL, ATOL = DEFAULT_OPTIONS["snes_rtol"], DEFAULT_OPTIONS["snes_atol"]
+
+
+def g(u, t):
+    return E / L * u + K * u**3 - t * F * L / 2.0
+
+
+def root(t):
+    """Bisection on g (increasing) over [0, t F L^2 / (2 E)] (the root lies below the
+    spring-free end displacement): 200 halvings reach the last ulp."""
+    lo, hi = 0.0, t * F * L**2 / (2.0 * E)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid, t) < 0.0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def f0_from_zero(t):
+    """||F(0)||_2 of the full residual at u = 0: -b, i.e. t F h at the N - 1 interior nodes,
+    t F h / 2 at x = L, and 0 in the Dirichlet row."""
+    return t * F * H * np.sqrt(N - 1 + 0.25)
+
+
+def newton_count(u, t, f0):
+    """Newton steps on g from u until |g| < max(atol, rtol f0) (SNESConvergedDefault). In the
+    cases below the last two |g| straddle that threshold by a factor >= 2 (quadratic
+    convergence), far beyond the round-off (~1e-16) between this loop and the full system."""
+    for it in range(1, 100):
+        u -= g(u, t) / (E / L + 3.0 * K * u**2)
+        if abs(g(u, t)) < max(ATOL, RTOL * f0):
+            return it
+    raise AssertionError("scalar Newton did not converge")
+
+
+def tolerance(f0):
+    """Bound on |u - u*| at the nodes when SNES stops: |F|_2 < max(atol, rtol f0) and the
+    inverse Jacobian's entries (the Green's function of the bar fixed at 0, stiffened by the
+    spring) are <= L / E, so |u - u*|_inf <= L / E sqrt(N + 1) |F|_2; plus round-off 1e-14."""
+    return L / E * np.sqrt(N + 1) * max(ATOL, RTOL * f0) + 1e-14
+
+
+def make_solver(prefix, **kwargs):
+    """(ContactSNES, u, load factor Constant) of the bar; kwargs go to ContactSNES."""
+    mesh = _compat.create_interval(COMM, N, L)
+    V = _compat.function_space(mesh, "Lagrange", 1)
+    u, v, du = dolfinx.fem.Function(V), ufl.TestFunction(V), ufl.TrialFunction(V)
+    right = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], L))
+    tags = dolfinx.mesh.meshtags(mesh, 0, right, np.full(len(right), 2, dtype=np.int32))
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+    left = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], 0.0))
+    bc = _compat.dirichletbc(PETSc.ScalarType(0.0), _compat.locate_dofs_topological(V, 0, left), V)
+    t = dolfinx.fem.Constant(mesh, PETSc.ScalarType(1.0))
+    Fc = K * u**3 * v * ds(2)
+    solver = ContactSNES(
+        u,
+        stiffness=dolfinx.fem.form(E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx),
+        load=dolfinx.fem.form(t * F * v * ufl.dx),
+        contact_residual=dolfinx.fem.form(Fc),
+        contact_jacobian=dolfinx.fem.form(ufl.derivative(Fc, u, du)),
+        bcs=[bc],
+        prefix=prefix,
+        **kwargs,
+    )
+    return solver, u, t
+
+
+def nodal_error(u, t):
+    """max over the nodes of |u - exact discrete root at load t| (all ranks)."""
+    uL = root(t)
+    c = (uL + t * F * L**2 / (2.0 * E)) / L
+    n = u.function_space.dofmap.index_map.size_local
+    x = _compat.dof_coordinates(u.function_space)[:n, 0]
+    err = np.abs(u.x.array[:n] - (-t * F * x**2 / (2.0 * E) + c * x))
+    return COMM.allreduce(err.max(initial=0.0), op=MPI.MAX)
+
+
+def test_root_and_newton_count():
+    solver, u, t = make_solver("cfx_unit_root_")
+    solver.assemble_load()
+    stats = solver.solve()
+    solver.destroy()
+    assert stats.reason.startswith("CONVERGED_FNORM")
+    assert nodal_error(u, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+    # Newton on g from 0: the first step gives the spring-free u_L = 1.5, then g is convex and
+    # increasing, so the iterates fall monotonically onto the root (0.607), the error shrinking
+    # by >= 1/3 a step and quadratically at the end: the scalar loop needs 7 steps (<= 8), and
+    # the full system takes exactly the same ones (module docstring)
+    expected = newton_count(0.0, 1.0, f0_from_zero(1.0))
+    assert expected <= 8
+    assert stats.newton == expected
+
+
+def test_max_it_raises_with_reason():
+    assert newton_count(0.0, 1.0, f0_from_zero(1.0)) > 1  # one step is not enough
+    solver, _, _ = make_solver("cfx_unit_maxit_", options={"snes_max_it": 1})
+    solver.assemble_load()
+    with pytest.raises(ConvergenceError, match="DIVERGED_MAX_IT") as err:
+        solver.solve()
+    solver.destroy()
+    assert err.value.reason == "DIVERGED_MAX_IT"
+    assert err.value.step is None and err.value.load is None
+
+
+def test_destroy_removes_prefixed_options():
+    opts = PETSc.Options()
+    opts["cfx_other_snes_rtol"] = "0.5"  # another solver's option: must survive
+    solver, _, _ = make_solver("cfx_unit_destroy_", user_options={"snes_max_it": 7})
+    assert opts.getString("cfx_unit_destroy_snes_rtol") == str(DEFAULT_OPTIONS["snes_rtol"])
+    assert opts.getString("cfx_unit_destroy_snes_max_it") == "7"  # the user's value wins
+    assert solver.snes.getTolerances()[3] == 7
+    solver.destroy()
+    assert not [k for k in opts.getAll() if k.startswith("cfx_unit_destroy_")]
+    assert opts.getString("cfx_other_snes_rtol") == "0.5"
+    opts.delValue("cfx_other_snes_rtol")
+
+
+def test_load_program_steps():
+    solver, u, t = make_solver("cfx_unit_steps_")
+    states = []
+
+    def on_step(rec):
+        states.append(nodal_error(u, rec.load))
+
+    records = run_load_program(solver, lambda s: setattr(t, "value", s), steps=3, on_step=on_step)
+    solver.destroy()
+    loads = [1 / 3, 2 / 3, 1.0]
+    assert [r.step for r in records] == [1, 2, 3] and [r.cutbacks for r in records] == [0, 0, 0]
+    np.testing.assert_allclose([r.load for r in records], loads, rtol=1e-15)  # t_prev + 1/3
+    # starts: 0, then the secant predictors 2 u(1/3) and 2 u(2/3) - u(1/3); their bulk rows
+    # vanish (linear in the load), so ||F0|| = |g| of the predicted end value
+    r1, r2 = root(1 / 3), root(2 / 3)
+    starts = [(0.0, f0_from_zero(1 / 3)), (2 * r1, abs(g(2 * r1, 2 / 3)))]
+    starts.append((2 * r2 - r1, abs(g(2 * r2 - r1, 1.0))))
+    for err, (_, f0) in zip(states, starts, strict=True):
+        assert err < tolerance(f0)  # see tolerance()
+    counts = [newton_count(u0, s, f0) for s, (u0, f0) in zip(loads, starts, strict=True)]
+    assert [r.stats.newton for r in records] == counts
+    assert counts[2] < counts[0]  # the predictor pays off
+
+
+def test_load_program_cutback():
+    # snes_max_it = M with M < (steps from 0 to the full load) but enough from 0 to t = 1/2
+    # and from the predictor 2 u(1/2) to t = 1: one halving, then two steps
+    full = newton_count(0.0, 1.0, f0_from_zero(1.0))
+    half = newton_count(0.0, 0.5, f0_from_zero(0.5))
+    r = root(0.5)
+    second = newton_count(2 * r, 1.0, abs(g(2 * r, 1.0)))
+    m = full - 1
+    assert half <= m and second <= m
+    solver, u, t = make_solver("cfx_unit_cut_", options={"snes_max_it": m})
+    records = run_load_program(solver, lambda s: setattr(t, "value", s), steps=1)
+    assert [(r.load, r.cutbacks) for r in records] == [(0.5, 1), (1.0, 0)]
+    assert [r.stats.newton for r in records] == [half, second]
+    assert nodal_error(u, 1.0) < tolerance(abs(g(2 * r, 1.0)))  # see tolerance()
+
+    # never converging (max_it 1): 1, 1/2, 1/4 fail, ConvergenceError names step 1, load 1/4
+    # and u is back at the last converged state (here: the start, u = 0)
+    solver.destroy()
+    solver, u, t = make_solver("cfx_unit_cut1_", options={"snes_max_it": 1})
+    with pytest.raises(ConvergenceError) as err:
+        run_load_program(solver, lambda s: setattr(t, "value", s), steps=1, max_cutbacks=2)
+    solver.destroy()
+    assert (err.value.step, err.value.load, err.value.reason) == (1, 0.25, "DIVERGED_MAX_IT")
+    # owned entries restored exactly (run_load_program does not update the ghosts then)
+    assert _compat.petsc_vec(u).norm(3) == 0.0
