@@ -79,8 +79,11 @@ class _Checks:
             raise ValueError(
                 "--quadrature nodal needs --degree 1 and one of the methods "
                 + ", ".join(methods_supporting(lambda c: c.nodal_quadrature))
-                + (f" (method {self.method}: {s.why_not['nodal_quadrature']})"
-                   if "nodal_quadrature" in s.why_not else "")  # fmt: skip
+                + (
+                    f" (method {self.method}: {s.why_not['nodal_quadrature']})"
+                    if "nodal_quadrature" in s.why_not
+                    else ""
+                )  # fmt: skip
             )
         if self.solver != "lu" and not s.iterative:
             raise ValueError(f"method {self.method} is {s.why_not['iterative']}: use --solver lu")

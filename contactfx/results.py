@@ -75,7 +75,8 @@ class Quantities:
         i = self.interface
         out = {"normal_force": self.force, "tangential_force": i.tangential_force,
                "closed_length": self.contact_size, "max_penetration": self.max_penetration,
-               "max_pressure": self.peak_pressure, "complementarity": self.complementarity}  # fmt: skip
+               "max_pressure": self.peak_pressure,
+               "complementarity": self.complementarity}  # fmt: skip
         if i.proppant_force is not None:
             out.update(proppant_force=i.proppant_force,
                        min_aperture_propped=i.min_aperture_propped)  # fmt: skip
@@ -94,8 +95,16 @@ class Quantities:
                                     d["slip_fraction"], d["friction_excess"])  # fmt: skip
             return cls(d["force"], d["contact_half_width"], d["peak_pressure"],
                        d["max_penetration"], d["complementarity"], friction=friction)  # fmt: skip
-        known = {"normal_force", "tangential_force", "closed_length", "max_penetration",
-                 "max_pressure", "complementarity", "proppant_force", "min_aperture_propped"}
+        known = {
+            "normal_force",
+            "tangential_force",
+            "closed_length",
+            "max_penetration",
+            "max_pressure",
+            "complementarity",
+            "proppant_force",
+            "min_aperture_propped",
+        }
         core = {f.name for f in dataclasses.fields(RunSummary)} | {
             "status", "newton_iterations", "ksp_iterations", "outer_iterations", "force",
             "peak_pressure"}  # fmt: skip

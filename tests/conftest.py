@@ -20,7 +20,7 @@ def pytest_collection_modifyitems(config, items):
 
 def clean_env() -> dict[str, str]:
     """Environment for child processes: no MPI singleton state of the test process."""
-    from contactfx.validation.stress import child_env
+    from contactfx.io.process import child_env
 
     return child_env()
 

@@ -15,18 +15,30 @@ __all__ = ["cmd_bench"]
 def _parser() -> Parser:
     p = Parser(prog="contactfx bench", description="error against run time over refinement")
     p.add_argument("case", nargs="?", default=None, help="one case (same as --scene)")
-    p.add_argument("--scene", default=None,
-                   help=f"comma-separated cases, or all (default hertz2d): {', '.join(CASES)}")
-    p.add_argument("--method", default="nitsche,penalty,al-uzawa,al-ssn,vi",
-                   help="comma-separated method variants, e.g. nitsche,nitsche@-1,penalty@100")
+    p.add_argument(
+        "--scene",
+        default=None,
+        help=f"comma-separated cases, or all (default hertz2d): {', '.join(CASES)}",
+    )
+    p.add_argument(
+        "--method",
+        default="nitsche,penalty,al-uzawa,al-ssn,vi",
+        help="comma-separated method variants, e.g. nitsche,nitsche@-1,penalty@100",
+    )
     p.add_argument("--levels", type=int, default=3, help="refinement levels (h halves)")
     p.add_argument("--degree", default="1", help="comma-separated Lagrange degrees, e.g. 1,2")
     p.add_argument("--solver", default="lu", choices=("lu", "gamg"))
     p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNGs")
-    p.add_argument("--linear", action="store_true",
-                   help="also time one linear-elastic solve per mesh (contact / linear ratio)")
-    p.add_argument("--speedup", action="store_true",
-                   help="under mpirun, also run every case on rank 0 alone (parallel speed-up)")
+    p.add_argument(
+        "--linear",
+        action="store_true",
+        help="also time one linear-elastic solve per mesh (contact / linear ratio)",
+    )
+    p.add_argument(
+        "--speedup",
+        action="store_true",
+        help="under mpirun, also run every case on rank 0 alone (parallel speed-up)",
+    )
     return p  # fmt: skip
 
 

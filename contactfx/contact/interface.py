@@ -48,13 +48,18 @@ import ufl
 from contactfx.contact.laws import Friction, positive_part, tangential
 from contactfx.contact.surface import Expr, sigma_n, sigma_t
 
-__all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal"]
+__all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal", "tangent"]
 
 
 def oriented_jump(w, H):
     """[[w]] = w(+side) - w(-side) on facets where H changes sign (whatever dolfinx's '+' / '-'
     restriction of the facet is)."""
     return 0.5 * (H("+") - H("-")) * (w("+") - w("-"))
+
+
+def tangent(n):
+    """The interface direction in 2D: the normal n_I rotated by -90 degrees."""
+    return ufl.as_vector([n[1], -n[0]])
 
 
 def interface_normal(H, n):

@@ -11,8 +11,8 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["vertex_rule", "surface_mask", "at_points", "confine", "assemble_array", "NodalProjection",
-           "global_sum", "zero_pattern"]  # fmt: skip
+__all__ = ["vertex_rule", "surface_mask", "at_points", "confine", "assemble_array",
+           "NodalProjection", "global_sum", "zero_pattern"]  # fmt: skip
 
 
 def vertex_rule(fdim: int) -> dict:

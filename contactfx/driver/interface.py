@@ -23,7 +23,7 @@ import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.contact.interface import InterfaceSurface, oriented_jump
+from contactfx.contact.interface import InterfaceSurface, oriented_jump, tangent
 from contactfx.contact.laws import positive_part
 from contactfx.driver.fields import (
     NodalProjection,
@@ -33,14 +33,10 @@ from contactfx.driver.fields import (
     vertex_rule,
     zero_pattern,
 )
+from contactfx.driver.interface_post import InterfacePost
 from contactfx.driver.problem import Problem
 
-__all__ = ["InterfaceProblem", "tangent"]
-
-
-def tangent(n):
-    """The interface direction in 2D: n_I rotated by -90 degrees."""
-    return ufl.as_vector([n[1], -n[0]])
+__all__ = ["InterfaceProblem"]
 
 
 class InterfaceProblem(Problem):
@@ -218,9 +214,7 @@ class InterfaceProblem(Problem):
             # not for a multiplier field, whose unknown mixes displacements and multipliers
             solver.snes.setTolerances(stol=1e-12)
 
-    def post_processor(self):
-        from contactfx.driver.interface_post import InterfacePost
-
+    def post_processor(self) -> InterfacePost:
         return InterfacePost(self)
 
     def dofs(self) -> int:

@@ -12,9 +12,9 @@ import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
+from contactfx.contact.interface import tangent
 from contactfx.contact.laws import active
 from contactfx.driver.fields import NodalProjection, global_sum
-from contactfx.driver.interface import tangent
 from contactfx.results import InterfaceQuantities, Quantities
 
 __all__ = ["InterfacePost", "Profile", "STATUS"]
@@ -83,8 +83,8 @@ class InterfacePost:
         if s.floor is not None:
             self.propped_form = dolfinx.fem.form(p * active(s.floor) * dSf)
         self.err_forms = self._error_forms(s, p, t_I)
-        self.extra = {k: dolfinx.fem.form(v)
-                      for k, v in self.scene.extra_quantities(mesh, s.w, pb.ds).items()}  # fmt: skip
+        extra = self.scene.extra_quantities(mesh, s.w, pb.ds)
+        self.extra = {k: dolfinx.fem.form(v) for k, v in extra.items()}
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm_expr = _compat.expression(pb.material.von_mises(s.w), DG0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")

@@ -204,8 +204,13 @@ class ObstaclePost:
             reference["force_rel_error"] = abs(q.force - ref["force"]) / abs(ref["force"])
         for key, computed in (("a", q.contact_size), ("p0", q.peak_pressure)):
             if key in ref:
-                reference.update({key: ref[key], f"{key}_computed": computed,
-                                  f"{key}_rel_error": abs(computed - ref[key]) / abs(ref[key])})
+                reference.update(
+                    {
+                        key: ref[key],
+                        f"{key}_computed": computed,
+                        f"{key}_rel_error": abs(computed - ref[key]) / abs(ref[key]),
+                    }
+                )
         if "a" in ref:
             reference["a_error_over_h"] = abs(q.contact_size - ref["a"]) / self.scene.h_contact()
         for key, value in ref.items():
@@ -311,8 +316,8 @@ class _FieldErrors:
             e = pb.surface.u - exact
             dxq = ufl.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
             for key, op in (("L2", lambda f: f), ("H1", ufl.grad)):
-                self.forms[key] = (dolfinx.fem.form(ufl.inner(op(e), op(e)) * dxq),
-                                   dolfinx.fem.form(ufl.inner(op(exact), op(exact)) * dxq))  # fmt: skip
+                self.forms[key] = tuple(dolfinx.fem.form(ufl.inner(op(f), op(f)) * dxq)
+                                        for f in (e, exact))  # fmt: skip
 
     def evaluate(self, ref: dict) -> dict[str, float]:
         out: dict[str, float] = {}

@@ -72,7 +72,7 @@ class Problem:
             self.V = W.sub(0)
         else:
             W = self.V = _compat.function_space(mesh, "Lagrange", num.degree, (n,))
-        self.state = dolfinx.fem.Function(W, name="state")
+        self.state = dolfinx.fem.Function(W, name="state" if self.split else "displacement")
         self.trial, self.test = ufl.TrialFunction(W), ufl.TestFunction(W)
         if self.split:
             (self.U, extra), (self.dU, d_extra), (self.V_test, extra_test) = (
@@ -111,7 +111,10 @@ class Problem:
         a = self.bulk_form()
         L = self.scene.load(self.v_load, self.ds, self.tload)
         if L is None:
-            L = ufl.inner(dolfinx.fem.Constant(self.mesh, np.zeros(self.gdim)), self.v_load) * ufl.dx
+            L = (
+                ufl.inner(dolfinx.fem.Constant(self.mesh, np.zeros(self.gdim)), self.v_load)
+                * ufl.dx
+            )
         L = self.extra_load(L)
         return dolfinx.fem.form(a), dolfinx.fem.form(L), self.method.residual(self.surface)
 

@@ -226,14 +226,11 @@ class CrackSneddon(_CrackPlate):
             out["K_I"] = K
             out["K_rel_error"] = abs(K - out["K_I_exact"]) / out["K_I_exact"]
             # "no false contact": the contact force relative to the fluid force on a face
-            out["false_contact"] = abs(q.force) / (
-                2.0 * p * self.p.crack_half_length
-            )
+            out["false_contact"] = abs(q.force) / (2.0 * p * self.p.crack_half_length)
         else:
             out["contact_force_exact"] = -p * 2.0 * self.p.crack_half_length
             out["force_rel_error"] = (
-                abs(q.force - out["contact_force_exact"])
-                / (out["contact_force_exact"])
+                abs(q.force - out["contact_force_exact"]) / (out["contact_force_exact"])
             )
         return out
 
@@ -322,7 +319,6 @@ class CrackInclined(_CrackPlate):
         else:
             out["max_slip"] = K  # stick: no slip at all
         return out
-
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,5 @@
-"""Closed forms for crack-face contact and joints (plane strain; docs/verification.md sections 6, 7).
+"""Closed forms for crack-face contact and joints (plane strain; docs/verification.md
+sections 6, 7).
 
 Crack |x| < a on y = 0 in an infinite plate, in the crack's own frame. Signs: tension positive
 for stresses; pressures p, normal stresses sigma_n and effective stresses s' are positive in
@@ -33,8 +34,8 @@ doi:10.1098/rspa.1946.0077)
 
 Closed crack under compression sigma_n > 0 and shear tau with Coulomb friction mu: it sticks
 if |tau| <= mu sigma_n, otherwise it slides as a whole under the driving shear
-q = sign(tau) (|tau| - mu sigma_n) (docs/verification.md section 6). Under uniaxial compression sigma
-with the crack at beta to the plane normal to the compression, sigma_n = sigma cos^2 beta,
+q = sign(tau) (|tau| - mu sigma_n) (docs/verification.md section 6). Under uniaxial compression
+sigma with the crack at beta to the plane normal to the compression, sigma_n = sigma cos^2 beta,
 tau = sigma sin beta cos beta, so K_II = sigma sqrt(pi a) cos beta (sin beta - mu cos beta)
 when tan beta > mu. A strip of full width W with traction data raises K by the factor
 sqrt(sec(pi a / W)) (Feddersen 1966, ASTM STP 410, 77-79; Tada et al. 2000).

@@ -193,8 +193,10 @@ class ContactSNES:
         rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0)
         self._bc_rows = rows[rows < n_owned].astype(np.int32)
 
+        self.nullspace = None
         if near_nullspace and u.function_space.mesh.geometry.dim > 1:
-            self.J.setNearNullSpace(rigid_body_modes(u.function_space))
+            self.nullspace = rigid_body_modes(u.function_space)
+            self.J.setNearNullSpace(self.nullspace)
 
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
@@ -271,6 +273,8 @@ class ContactSNES:
             A.axpy(1.0, S, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             S.destroy()
         A.zeroRowsColumnsLocal(rows, diag=1.0)
+        if self.nullspace is not None:
+            A.setNearNullSpace(self.nullspace)
         b = self.b.copy()
         b.getArray()[rows] = 0.0
         x = _compat.petsc_vec(self.u)

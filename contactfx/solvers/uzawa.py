@@ -14,9 +14,9 @@ __all__ = ["Uzawa"]
 class Uzawa:
     """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
 
-    ``update`` fills the Function it is given with the multiplier's next nodal values; ``mask`` (bool per
-    local dof of that space) selects the contact boundary's nodes, elsewhere the multiplier is
-    kept at zero. The loop stops when
+    ``update`` fills the Function it is given with the multiplier's next nodal values;
+    ``mask`` (bool per local dof of that space) selects the contact boundary's nodes, elsewhere
+    the multiplier is kept at zero. The loop stops when
     max |lambda_{k+1} - lambda_k| <= tol max |lambda_{k+1}| over the contact nodes: the nodal
     constraint violation and complementarity residual are then below tol max |lambda| / r.
     On failure (inner divergence or ``max_it`` outer iterations) the multiplier of the last

@@ -27,7 +27,6 @@ import time
 import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from contactfx.results import MEASURES, measure
 
@@ -195,50 +194,31 @@ def observed_rates(rows: list[dict], column: str) -> tuple[float, float]:
 
 def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[float, int]:
     """Wall time of assembling and solving the scene's linear-elastic problem (the contact
-    boundary loaded by a uniform pressure) with MUMPS LU or GMRES + GAMG; and its dofs."""
+    boundary loaded by a uniform pressure) by the contact solver's wrapper with the same linear
+    solver (MUMPS LU or GMRES + GAMG) and no contact terms; and its dofs."""
     import dolfinx
-    import dolfinx.fem.petsc
 
     from contactfx import _compat
-    from contactfx.solvers.snes import GAMG_OPTIONS, rigid_body_modes
+    from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
 
     mesh, facet_tags = scene.build_mesh(comm)
     gdim = mesh.geometry.dim
     V = _compat.function_space(mesh, "Lagrange", degree, (gdim,))
-    material = scene.material()
     du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-    a = dolfinx.fem.form(ufl.inner(material.sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx)
+    a = dolfinx.fem.form(ufl.inner(scene.material().sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx)
     L = dolfinx.fem.form(-1.0 * v[gdim - 1] * ds(scene.contact_tag))
     bcs = scene.dirichlet(V, facet_tags)
-    u = dolfinx.fem.Function(V)
-    ksp = PETSc.KSP().create(comm)
-    prefix = "contactfx_linear_"
-    opts = PETSc.Options()
-    defaults = GAMG_OPTIONS if solver == "gamg" else {
-        "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}  # fmt: skip
-    for key, value in defaults.items():
-        opts[prefix + key] = str(value)
-    ksp.setOptionsPrefix(prefix)
     comm.barrier()
     t0 = time.perf_counter()
-    A = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
-    A.assemble()
-    if solver == "gamg":
-        A.setNearNullSpace(rigid_body_modes(V))
-    b = dolfinx.fem.petsc.assemble_vector(L)
-    dolfinx.fem.petsc.apply_lifting(b, [a], [bcs])
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    dolfinx.fem.petsc.set_bc(b, bcs)
-    ksp.setOperators(A)
-    ksp.setFromOptions()
-    ksp.solve(b, _compat.petsc_vec(u))
+    linear = ContactSNES(dolfinx.fem.Function(V), stiffness=a, load=L, bcs=bcs,
+                         prefix="contactfx_linear_", near_nullspace=solver == "gamg",
+                         options=GAMG_OPTIONS if solver == "gamg" else {})  # fmt: skip
+    linear.assemble_load()
+    linear.solve_linear(np.ones(linear.owned_size, dtype=bool))
     comm.barrier()
     elapsed = time.perf_counter() - t0
-    for obj in (ksp, A, b):
-        obj.destroy()
-    for key in defaults:
-        opts.delValue(prefix + key)
+    linear.destroy()
     return elapsed, V.dofmap.index_map.size_global * V.dofmap.index_map_bs
 
 

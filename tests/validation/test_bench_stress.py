@@ -11,8 +11,9 @@ import math
 import pytest
 from mpi4py import MPI
 
-from contactfx.validation.bench import CASES, bench_main, observed_rates, run_case
-from contactfx.validation.stress import stress_main
+from contactfx.cli.bench import cmd_bench
+from contactfx.cli.stress import cmd_stress
+from contactfx.validation.bench import CASES, observed_rates, run_case
 
 COMM = MPI.COMM_WORLD
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -45,7 +46,7 @@ def test_every_method_converges_on_default_case(case):
 def test_bench_outputs_well_formed(shared_dir):
     argv = ["--scene", "hertz2d,westergaard-full", "--method", "nitsche@1,al-ssn",
             "--levels", "2", "--out", str(shared_dir)]  # fmt: skip
-    assert bench_main(argv, {}, COMM) == 0
+    assert cmd_bench(argv, {}, COMM) == 0
     if COMM.rank == 0:
         rows = _read_csv(shared_dir / "bench.csv")
         assert len(rows) == 2 * 2 * 2  # cases x methods x levels
@@ -79,7 +80,7 @@ def test_westergaard_full_contact_rates():
 
 def test_stress_quick_rows(shared_dir):
     argv = ["--quick", "--axis", "gamma0,initial penetration,parallel", "--out", str(shared_dir)]
-    assert stress_main(argv, {}, COMM) == 0
+    assert cmd_stress(argv, {}, COMM) == 0
     if COMM.rank == 0:
         rows = _read_csv(shared_dir / "stress.csv")
         assert {r["axis"] for r in rows} == {"gamma0", "initial penetration", "parallel"}
@@ -105,7 +106,7 @@ def test_stress_quick_rows(shared_dir):
 def test_stress_time_limit_is_a_row(shared_dir):
     """A case over its time limit is a row with its reason; the command still completes."""
     argv = ["--axis", "load steps", "--time-limit", "0.01", "--out", str(shared_dir)]
-    assert stress_main(argv, {}, COMM) == 0
+    assert cmd_stress(argv, {}, COMM) == 0
     if COMM.rank == 0:
         rows = _read_csv(shared_dir / "stress.csv")
         assert len(rows) == 6

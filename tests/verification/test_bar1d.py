@@ -14,8 +14,8 @@ def test_bar_penetration_and_multiplier_exact(theta):
     exact = bar_nitsche_exact(E=1.0, L=1.0, f=1.0, g0=0.3, n=8, theta=theta, gamma0=2.0)
     # P1 reproduces the piecewise-quadratic problem's discrete solution exactly: only
     # round-off and the Newton tolerance (1e-10 relative residual) remain.
-    assert abs(result["max_penetration"] - exact["penetration"]) < 1e-10
-    assert abs(result["force"] - exact["multiplier"]) < 1e-10
+    assert abs(result.max_penetration - exact["penetration"]) < 1e-10
+    assert abs(result.force - exact["multiplier"]) < 1e-10
 
 
 def test_bar_table_values():

@@ -12,7 +12,7 @@ BLOCK = SlidingBlockParams()  # p = 10, L = 1, shift 0.02: gross slip from shift
 
 
 def _phase2(result):
-    return [s for s in result["steps"] if s["load"] > 0.5 + 1e-12]
+    return [s for s in result.steps if s.load > 0.5 + 1e-12]
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -21,18 +21,18 @@ def test_sliding_block_coulomb(method):
     res = SlidingBlock(BLOCK).run(num, verbose=False)
     P = BLOCK.pressure * BLOCK.width
     # vertical equilibrium: the contact carries p L exactly (Newton tolerance 1e-10)
-    assert res["force"] == pytest.approx(P, rel=1e-9)
+    assert res.force == pytest.approx(P, rel=1e-9)
     # gross slip: Q = mu P exactly, the traction is mu p at every slipping node
-    assert abs(res["tangential_force"][0]) == pytest.approx(num.mu * P, rel=1e-8)
-    assert res["friction_bound"] == pytest.approx(num.mu * P, rel=1e-9)
-    assert res["slip_fraction"] == pytest.approx(1.0, abs=1e-12)
-    assert res["scores"]["slip_traction_error"] < 1e-8
+    assert abs(res.friction.tangential_force[0]) == pytest.approx(num.mu * P, rel=1e-8)
+    assert res.friction.bound == pytest.approx(num.mu * P, rel=1e-9)
+    assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
+    assert res.scores["slip_traction_error"] < 1e-8
     # |t_T| <= mu p at every quadrature point: int [|t_T| - mu p]_+ = 0 up to round-off
-    assert res["friction_excess"] < 1e-10
+    assert res.friction.excess < 1e-10
     # before gross slip: Q < mu P with a stick zone, Q grows with the shift
     steps = _phase2(res)
-    q = [abs(s["tangential_force"][0]) for s in steps]
-    assert q[0] < 0.99 * num.mu * P and steps[0]["stick_size"] > 0.0
+    q = [abs(s.quantities.friction.tangential_force[0]) for s in steps]
+    assert q[0] < 0.99 * num.mu * P and steps[0].quantities.friction.stick_size > 0.0
     assert all(b >= a - 1e-9 * P for a, b in zip(q, q[1:], strict=False))
 
 
@@ -40,9 +40,9 @@ def test_sliding_block_coulomb(method):
 def test_sliding_block_tresca(method):
     num = SlidingBlock.default_numerics(method=method, friction="tresca", mu=0.0, threshold=2.0)
     res = SlidingBlock(BLOCK).run(num, verbose=False)
-    Q, bound = abs(res["tangential_force"][0]), res["friction_bound"]
+    Q, bound = abs(res.friction.tangential_force[0]), res.friction.bound
     assert bound <= 2.0 * BLOCK.width * (1 + 1e-12)
-    assert res["slip_fraction"] == pytest.approx(1.0, abs=1e-12)
+    assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
     if method != "nitsche":
         # the law is collocated at the nodes: Q = threshold x (nodal contact length), while the
         # bound integrates over the contact set between the nodes; they differ by at most the
@@ -51,7 +51,7 @@ def test_sliding_block_tresca(method):
     else:
         # gross slip at Q = threshold x (length in contact), exactly
         assert Q == pytest.approx(bound, rel=1e-8)
-        assert res["scores"]["slip_traction_error"] < 1e-8
+        assert res.scores["slip_traction_error"] < 1e-8
 
 
 @pytest.mark.parametrize("method", ["nitsche", "al-uzawa", "al-ssn"])
@@ -67,9 +67,9 @@ def test_frictionless_limit(method):
         Hertz2D.default_numerics(method=method, friction="coulomb", mu=0.0, **extra),
         verbose=False,
     )
-    for key in ("force", "contact_half_width", "peak_pressure"):
-        assert mu0[key] == pytest.approx(plain[key], rel=1e-8), key
-    assert abs(mu0["tangential_force"][0]) < 1e-9 * plain["force"]
+    for key in ("force", "contact_size", "peak_pressure"):
+        assert getattr(mu0, key) == pytest.approx(getattr(plain, key), rel=1e-8), key
+    assert abs(mu0.friction.tangential_force[0]) < 1e-9 * plain.force
 
 
 def test_cattaneo_mindlin_trend():
@@ -80,8 +80,8 @@ def test_cattaneo_mindlin_trend():
                                    mu=0.3, steps=8)  # fmt: skip
     runs = [Hertz2D(Hertz2DParams(h_contact=4e-3, shift=s)).run(num, verbose=False)
             for s in (2.5e-4, 5e-4, 3e-3)]  # fmt: skip
-    ratio = [r["reference"]["Q_over_bound"] for r in runs]
-    stick = [r["stick_size"] for r in runs]
+    ratio = [r.reference["Q_over_bound"] for r in runs]
+    stick = [r.friction.stick_size for r in runs]
     assert ratio[0] < ratio[1] < 1.0 and stick[0] > stick[1] > 0.0
     assert ratio[2] == pytest.approx(1.0, rel=1e-8) and stick[2] == 0.0
 
@@ -94,7 +94,7 @@ def test_sphere_gross_slip():
     num = Hertz3D.default_numerics(method="nitsche", theta=-1, gamma0=1.0, friction="coulomb",
                                    mu=0.3, steps=4)  # fmt: skip
     res = Hertz3D(params).run(num, verbose=False)
-    assert res["friction_bound"] == pytest.approx(0.3 * res["force"], rel=1e-9)
-    assert 0.99 * res["friction_bound"] < res["tangential_force"][0] <= res["friction_bound"]
-    assert res["slip_fraction"] == pytest.approx(1.0, abs=1e-12)
-    assert res["friction_excess"] < 1e-10
+    assert res.friction.bound == pytest.approx(0.3 * res.force, rel=1e-9)
+    assert 0.99 * res.friction.bound < res.friction.tangential_force[0] <= res.friction.bound
+    assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
+    assert res.friction.excess < 1e-10

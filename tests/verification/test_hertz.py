@@ -27,7 +27,7 @@ def _ids(num):
 @pytest.mark.parametrize("num", METHODS, ids=_ids)
 def test_hertz2d_coarse(num, degree):
     num = Numerics(**{**num.__dict__, "degree": degree})
-    ref = Hertz2D(COARSE).run(num, verbose=False)["reference"]
+    ref = Hertz2D(COARSE).run(num, verbose=False).reference
     # the contact edge is resolved to the element containing it: |a_h - a| <= h / 2
     assert ref["a_error_over_h"] <= 0.5
     # about 10 elements across a: a few percent on the peak (docs/verification.md section 1)
@@ -36,7 +36,7 @@ def test_hertz2d_coarse(num, degree):
 
 @pytest.mark.parametrize("num", METHODS[:1] + METHODS[3:], ids=_ids)
 def test_hertz2d_fine(num):
-    ref = Hertz2D(FINE).run(num, verbose=False)["reference"]
+    ref = Hertz2D(FINE).run(num, verbose=False).reference
     # about 18 elements across a: 1 % on the peak pressure
     assert ref["a_error_over_h"] <= 0.5
     assert ref["p0_rel_error"] < 0.01
@@ -49,14 +49,14 @@ def test_nitsche_and_vi_agree(degree):
     # independent enforcement (bounds at the nodes vs Nitsche at quadrature points), same mesh:
     # they agree to the discretisation error of either (a few tenths of a percent in force,
     # the contact edge to one element, the peak to 1.5 %)
-    assert vi["force"] == pytest.approx(nit["force"], rel=5e-3)
-    assert abs(vi["contact_half_width"] - nit["contact_half_width"]) <= COARSE.h_contact
-    assert vi["peak_pressure"] == pytest.approx(nit["peak_pressure"], rel=1.5e-2)
+    assert vi.force == pytest.approx(nit.force, rel=5e-3)
+    assert abs(vi.contact_size - nit.contact_size) <= COARSE.h_contact
+    assert vi.peak_pressure == pytest.approx(nit.peak_pressure, rel=1.5e-2)
 
 
 def test_hertz3d():
     result = Hertz3D(Hertz3DParams(h_contact=0.015)).run(Numerics(), verbose=False)
-    ref = result["reference"]
+    ref = result.reference
     # quarter model, about 7 tetrahedra across a = 0.1: 5 % (docs/verification.md section 1)
     assert ref["a_rel_error"] < 0.05
     assert ref["p0_rel_error"] < 0.05
@@ -70,12 +70,12 @@ def test_hertz3d():
 def test_augmented_lagrangian_hertz2d(num):
     res = Hertz2D(COARSE).run(num, verbose=False)
     nit = Hertz2D(COARSE).run(Numerics(method="nitsche"), verbose=False)
-    ref = res["reference"]
+    ref = res.reference
     # the same discretisation bounds as Nitsche (a within h/2, p0 within 3 %)
     assert ref["a_error_over_h"] <= 0.5
     assert ref["p0_rel_error"] < 0.03
     # and the same force as Nitsche on this mesh to its discretisation error
-    assert res["force"] == pytest.approx(nit["force"], rel=5e-3)
+    assert res.force == pytest.approx(nit.force, rel=5e-3)
     # the constraint holds at the nodes to solver tolerance, not O(1/r): nodal penetration
     # below 1e-9 of the indentation depth
-    assert res["max_penetration"] < 1e-9 * COARSE.depth
+    assert res.max_penetration < 1e-9 * COARSE.depth

@@ -28,7 +28,7 @@ IDS = ["nitsche1", "nitsche0", "nitsche-1", "al-uzawa", "al-ssn"]
 
 
 def _run(scene, **numerics):
-    return scene.run(scene.default_numerics(**numerics), verbose=False).data
+    return scene.run(scene.default_numerics(**numerics), verbose=False)
 
 
 # -- joint column: uniform states, exact on any mesh ---------------------------------------
@@ -37,19 +37,20 @@ def _run(scene, **numerics):
 def test_joint_column_table(numerics, s_c, p):
     scene = JointColumn(JointColumn.Params(closure_stress=s_c, fluid_pressure=p))
     data = _run(scene, **numerics)
-    ref = data["reference"]
+    ref = data.reference
     exact = joint_column(s_c, p, 10e9, 0.25, 1.0, 1e-3, 50e9, 3e-4)
     # the solution is uniform in each block: P1 represents it exactly, so the only error is
-    # the solver's (Newton to rtol 1e-10 / round-off); 1e-6 is the requirement of docs/verification.md
+    # the solver's (Newton to rtol 1e-10 / round-off); 1e-6 is the requirement of
+    # docs/verification.md section 7
     for key in ("closure", "aperture", "settlement"):
         assert ref[key] == pytest.approx(exact[key], rel=1e-6), key
     # the joint carries the effective stress: normal force = (s_c - p) L
-    assert data["normal_force"] == pytest.approx((s_c - p) * 0.5, rel=1e-9)
+    assert data.force == pytest.approx((s_c - p) * 0.5, rel=1e-9)
 
 
 def test_joint_column_any_mesh():
     scene = JointColumn(JointColumn.Params(h=0.13, width=0.7))
-    ref = _run(scene, method="nitsche")["reference"]
+    ref = _run(scene, method="nitsche").reference
     assert ref["settlement_rel_error"] < 1e-6
     assert ref["aperture_spread"] < 1e-9 * 1e-3  # uniform along the joint
 
@@ -58,19 +59,19 @@ def test_joint_column_any_mesh():
 def test_sneddon_open_no_false_contact():
     data = _run(CrackSneddon(CrackSneddon.Params(pressure=1e6)), method="nitsche")
     # p > 0 opens the whole crack: the contact force is exactly zero (no node is closed)
-    assert data["normal_force"] == 0.0 and data["closed_length"] == 0.0
+    assert data.force == 0.0 and data.contact_size == 0.0
     # opening in L2 on the crack: 0.58 % on the default mesh (h_crack = a/40, h_tip = a/400),
     # converging about as h (bench: 1.0e-2, 5.8e-3, 3.4e-3 for h_crack = a/20, a/40, a/80)
-    assert data["errors"]["opening_L2_rel"] < 0.01
+    assert data.errors["opening_L2_rel"] < 0.01
     # K_I by displacement extrapolation: 1.0 % here (0.27 % on the next finer mesh)
-    assert data["reference"]["K_rel_error"] < 0.02
+    assert data.reference["K_rel_error"] < 0.02
 
 
 def test_sneddon_opening_converges():
     errors = []
     for h in (0.1, 0.05, 0.025):
         params = CrackSneddon.Params(h_crack=h, h_tip=h / 10, h_far=20 * h, grading=6 * h)
-        errors.append(_run(CrackSneddon(params), method="nitsche")["errors"]["opening_L2_rel"])
+        errors.append(_run(CrackSneddon(params), method="nitsche").errors["opening_L2_rel"])
     rates = [math.log2(e0 / e1) for e0, e1 in zip(errors[:-1], errors[1:], strict=True)]
     # docs/verification.md: about O(h); with the tips graded the observed rates are 1.5-1.7
     assert min(rates) > 0.9, (errors, rates)
@@ -83,8 +84,8 @@ def test_sneddon_suction_closes_with_uniform_pressure(numerics):
     # the solver tolerance (the tips' multiplier of al-ssn / al-uzawa is zero: those methods
     # get the force to within the two tip elements, h_tip / a = 2.5e-3 each)
     tol = 1e-8 if numerics["method"] == "nitsche" else 6e-3
-    assert data["reference"]["force_rel_error"] < tol
-    assert data["max_penetration"] < 1e-12
+    assert data.reference["force_rel_error"] < tol
+    assert data.max_penetration < 1e-12
 
 
 # -- inclined crack under compression: K_II table ------------------------------------------
@@ -100,15 +101,16 @@ KII_TABLE = {  # docs/verification.md section 6, K_II / (sigma sqrt(pi a)) at be
 def test_inclined_crack_KII_table(mu, column, beta):
     scene = CrackInclined(CrackInclined.Params(beta=beta))
     data = _run(scene, method="nitsche", mu=mu)
-    ref = data["reference"]
+    ref = data.reference
     expected = KII_TABLE[mu][column]
     assert ref["K_II_normalised_exact"] == pytest.approx(expected, abs=5e-6)
     if expected == 0.0:
         # stick (tan 30 < 0.6): no slip anywhere, to round-off of the opening scale
         assert ref["max_slip"] < 1e-12
-        assert data["errors"]["slip_L2"] < 1e-12
+        assert data.errors["slip_L2"] < 1e-12
         return
-    # displacement extrapolation of the slip, 1.3-2.5 % on the default mesh: docs/verification.md asks 5 %
+    # displacement extrapolation of the slip, 1.3-2.5 % on the default mesh:
+    # docs/verification.md section 6 asks 5 %
     assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.05)
     # the whole crack slides: the Coulomb law |t| = mu p holds at every node (to round-off:
     # t and p are the projections at the same points)
@@ -118,13 +120,13 @@ def test_inclined_crack_KII_table(mu, column, beta):
     # error comes from the mode II singularity at the tips polluting the P1 stress average:
     # proportional to the driving shear q, 2.7-3.6 % of q / sigma_n on this mesh
     q = ref["K_II_exact"] / math.sqrt(math.pi)
-    assert data["errors"]["pressure_L2_rel"] < 0.045 * q / ref["sigma_n"]
+    assert data.errors["pressure_L2_rel"] < 0.045 * q / ref["sigma_n"]
 
 
 @pytest.mark.parametrize("numerics", CONSISTENT[2:], ids=IDS[2:])
 def test_inclined_crack_methods_agree(numerics):
     scene = CrackInclined(CrackInclined.Params(beta=45.0))
-    ref = _run(scene, mu=0.3, **numerics)["reference"]
+    ref = _run(scene, mu=0.3, **numerics).reference
     # the same discretisation of the same law: K within 0.5 % of Nitsche's 1.3 %
     assert ref["K_rel_error"] < 0.03
 
@@ -133,7 +135,7 @@ def test_inclined_crack_tresca():
     # beta 45: tau = 5 MPa; Tresca threshold 2 MPa slides the crack with q = 3 MPa
     scene = CrackInclined(CrackInclined.Params(beta=45.0))
     data = _run(scene, method="nitsche", friction="tresca", threshold=2e6, mu=0.0)
-    ref = data["reference"]
+    ref = data.reference
     assert ref["K_II_normalised_exact"] == pytest.approx(0.3, rel=1e-12)
     assert ref["K_rel_error"] < 0.05  # as the Coulomb table (1.3-2.5 % measured)
     assert ref["friction_law_error"] < 1e-9  # |t| = threshold at every sliding node
@@ -144,9 +146,9 @@ def test_propped_open_branch_is_sneddon():
     scene = ProppedFracture(ProppedFracture.Params(net_pressure=1e6))
     assert scene.p_star() < 1e6  # p* = 3.08e5
     data = _run(scene, method="nitsche")
-    assert data["proppant_force"] == 0.0  # the proppant carries nothing
-    assert data["errors"]["opening_L2_rel"] < 0.01  # Sneddon, as test_sneddon_open
-    assert data["reference"]["min_aperture_propped_over_h"] > 1.0
+    assert data.interface.proppant_force == 0.0  # the proppant carries nothing
+    assert data.errors["opening_L2_rel"] < 0.01  # Sneddon, as test_sneddon_open
+    assert data.reference["min_aperture_propped_over_h"] > 1.0
 
 
 @pytest.mark.parametrize("numerics", CONSISTENT, ids=IDS)
@@ -155,8 +157,8 @@ def test_propped_closing_branch(numerics):
     data = _run(scene, **numerics)
     # below p* the proppant carries load: more than the net suction over the propped part
     # 2 b |p_net| (the faces beyond it touch and the proppant is stiffer than the rock there)
-    assert data["proppant_force"] > 2 * 0.5 * 1e6
+    assert data.interface.proppant_force > 2 * 0.5 * 1e6
     # aperture >= h on the propped part: exactly at the nodes for the multiplier methods,
     # within Nitsche's penetration (1.4e-3 h on this mesh, O(1 / gamma0)) otherwise
     tol = 1e-9 if numerics["method"].startswith("al-") else 5e-3
-    assert data["reference"]["min_aperture_propped_over_h"] > 1.0 - tol
+    assert data.reference["min_aperture_propped_over_h"] > 1.0 - tol

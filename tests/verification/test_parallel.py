@@ -29,9 +29,9 @@ def test_serial_and_parallel_agree(scene, num):
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
     # same mesh, same discrete problem, Newton converged to a relative residual of 1e-10:
     # the partition changes only round-off
-    for key in ("force", "contact_half_width", "peak_pressure"):
-        assert parallel[key] == pytest.approx(serial[key], rel=1e-8), key
-    assert abs(parallel["newton_iterations"] - serial["newton_iterations"]) <= 1
+    for key in ("force", "contact_size", "peak_pressure"):
+        assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
+    assert abs(parallel.newton_iterations - serial.newton_iterations) <= 1
 
 
 @pytest.mark.parametrize(
@@ -49,11 +49,11 @@ def test_serial_and_parallel_agree_al_and_friction(scene, num):
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
     # Newton (and Uzawa, tolerance 1e-8 on the multiplier) converged: contact quantities
     # agree to the solver tolerance
-    for key in ("force", "contact_half_width", "peak_pressure"):
-        assert parallel[key] == pytest.approx(serial[key], rel=1e-7), key
-    if "tangential_force" in serial.data:
-        assert parallel["tangential_force"][0] == pytest.approx(
-            serial["tangential_force"][0], rel=1e-7, abs=1e-9 * serial["force"]
+    for key in ("force", "contact_size", "peak_pressure"):
+        assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-7), key
+    if serial.friction is not None:
+        assert parallel.friction.tangential_force[0] == pytest.approx(
+            serial.friction.tangential_force[0], rel=1e-7, abs=1e-9 * serial.force
         )
 
 
@@ -79,13 +79,18 @@ def test_serial_and_parallel_agree_interfaces(case):
     facets count once, the enrichment and multiplier dofs are shared consistently."""
     _, scene, overrides = case
     num = scene.default_numerics(**overrides)
-    serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False).data
-    parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False).data
+    serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
+    parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
     # Newton / Uzawa converged (rtol 1e-10, Uzawa 1e-8): equal to the solver tolerance
-    scale = max(abs(serial["normal_force"]), 1.0)
-    for key in ("normal_force", "tangential_force", "closed_length", "max_pressure"):
-        assert parallel[key] == pytest.approx(serial[key], rel=1e-7, abs=1e-9 * scale), key
-    for key, value in serial["errors"].items():
-        assert parallel["errors"][key] == pytest.approx(value, rel=1e-6, abs=1e-12), key
-    for key, value in serial["reference"].items():
-        assert parallel["reference"][key] == pytest.approx(value, rel=1e-6, abs=1e-12), key
+    scale = max(abs(serial.force), 1.0)
+    pairs = {"force": (serial.force, parallel.force),
+             "tangential force": (serial.interface.tangential_force,
+                                  parallel.interface.tangential_force),
+             "closed length": (serial.contact_size, parallel.contact_size),
+             "peak pressure": (serial.peak_pressure, parallel.peak_pressure)}  # fmt: skip
+    for key, (s, p) in pairs.items():
+        assert p == pytest.approx(s, rel=1e-7, abs=1e-9 * scale), key
+    for key, value in serial.errors.items():
+        assert parallel.errors[key] == pytest.approx(value, rel=1e-6, abs=1e-12), key
+    for key, value in serial.reference.items():
+        assert parallel.reference[key] == pytest.approx(value, rel=1e-6, abs=1e-12), key

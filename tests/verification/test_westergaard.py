@@ -11,10 +11,10 @@ from contactfx.scenes.westergaard import Westergaard, WestergaardParams
 def test_partial_contact_half_width():
     params = WestergaardParams(mean_pressure_ratio=0.5)
     result = Westergaard(params).run(Numerics(steps=2), verbose=False)
-    ref = result["reference"]
+    ref = result.reference
     assert ref["a"] == pytest.approx(0.25, rel=1e-12)  # sin^2(pi a / lambda) = 1 / 2
     # within one element of the exact a / lambda = 0.25
-    assert abs(result["contact_half_width"] - 0.25) <= params.h_contact
+    assert abs(result.contact_size - 0.25) <= params.h_contact
 
 
 @pytest.mark.parametrize("theta", [1, 0, -1])
@@ -26,7 +26,7 @@ def test_full_contact_rates(theta):
         num = Numerics(method="nitsche", theta=theta, steps=1)
         result = Westergaard(params).run(num, verbose=False)
         for key in errors:
-            errors[key].append(result["errors"][f"displacement_{key}"])
+            errors[key].append(result.errors[f"displacement_{key}"])
     rates = {k: np.polyfit(np.log(sizes), np.log(v), 1)[0] for k, v in errors.items()}
     # P1 on a smooth solution: H1 error O(h), L2 error O(h^2); 0.15 leaves room for the
     # pre-asymptotic first mesh (8 elements per half wavelength)
