@@ -16,7 +16,6 @@ import ufl
 from petsc4py import PETSc
 
 __all__ = [
-    "DOLFINX_VERSION",
     "function_space",
     "petsc_vec",
     "element_degree",
@@ -38,8 +37,7 @@ __all__ = [
     "ufl_math",
 ]
 
-DOLFINX_VERSION: tuple[int, int] = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
-_NEW = DOLFINX_VERSION >= (0, 8)
+_NEW = tuple(int(p) for p in dolfinx.__version__.split(".")[:2]) >= (0, 8)
 
 
 def function_space(mesh, family: str, degree: int, shape: tuple[int, ...] | None = None):
@@ -172,12 +170,8 @@ def mixed_space(mesh, degree: int, gdim: int, multiplier_shape: tuple[int, ...])
 
 
 # Math namespaces (sqrt, atan2, cos, sin) for closed forms written once for numpy arrays and UFL
-# expressions (contactfx.scenes.crack_fields). numpy < 2 has no atan2 alias, UFL < 2023 names
-# it atan_2.
-numpy_math = SimpleNamespace(sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin)
-ufl_math = SimpleNamespace(
-    sqrt=ufl.sqrt,
-    atan2=getattr(ufl, "atan2", None) or ufl.atan_2,
-    cos=ufl.cos,
-    sin=ufl.sin,
-)
+# expressions (contactfx.references). numpy < 2 has no atan2 alias, UFL < 2023 names it atan_2.
+numpy_math = SimpleNamespace(sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin,
+                             maximum=np.maximum)  # fmt: skip
+ufl_math = SimpleNamespace(sqrt=ufl.sqrt, atan2=getattr(ufl, "atan2", None) or ufl.atan_2,
+                           cos=ufl.cos, sin=ufl.sin, maximum=ufl.max_value)  # fmt: skip

@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import time
 
 from contactfx.params import option_name
 
-__all__ = ["Parser", "split_petsc", "petsc_dict", "add_options", "int_list"]
+__all__ = ["Parser", "split_petsc", "petsc_dict", "add_options", "int_list", "finish_table"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -70,3 +71,15 @@ def int_list(text: str) -> list[int]:
         return [int(t) for t in text.split(",") if t.strip()]
     except ValueError:
         raise ValueError(f"expected comma-separated integers, got '{text}'") from None
+
+
+def finish_table(rows: list[dict], comm, started: float, summary: str, out, write) -> None:
+    """Rank 0 prints ``summary`` (formatted with the total time) and, with an output folder,
+    writes the rows by ``write(rows, out, ranks, total)``; every rank waits for it."""
+    if comm.rank == 0:
+        total = time.perf_counter() - started
+        print(summary.format(total=total))
+        if out is not None:
+            for path in write(rows, out, comm.size, total):
+                print(f"wrote {path}")
+    comm.barrier()

@@ -6,8 +6,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from contactfx.cli.args import Parser, int_list
+from contactfx.cli.args import Parser, finish_table, int_list
 from contactfx.validation.bench import CASES, expand_methods, run_bench
+from contactfx.validation.report import write_bench
 
 __all__ = ["cmd_bench"]
 
@@ -60,13 +61,6 @@ def cmd_bench(argv: list[str], petsc_options: dict, comm) -> int:
     started = time.perf_counter()
     rows = run_bench(cases, variants, degrees, ns.levels, comm, petsc_options,
                      solver=ns.solver, linear=ns.linear, speedup=ns.speedup)  # fmt: skip
-    if comm.rank == 0:
-        total = time.perf_counter() - started
-        print(f"bench: {len(rows)} runs in {total:.0f} s on {comm.size} rank(s)")
-        if ns.out is not None:
-            from contactfx.validation.report import write_bench
-
-            for path in write_bench(rows, ns.out, comm.size, total):
-                print(f"wrote {path}")
-    comm.barrier()
+    finish_table(rows, comm, started, f"bench: {len(rows)} runs in {{total:.0f}} s on "
+                 f"{comm.size} rank(s)", ns.out, write_bench)  # fmt: skip
     return 0

@@ -5,7 +5,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from contactfx.cli.args import Parser
+from contactfx.cli.args import Parser, finish_table
+from contactfx.validation.report import write_stress
 from contactfx.validation.stress import cases, run_stress
 
 __all__ = ["cmd_stress"]
@@ -36,14 +37,7 @@ def cmd_stress(argv: list[str], petsc_options: dict, comm) -> int:
         selected = [c for c in selected if c.axis in axes]
     started = time.perf_counter()
     rows = run_stress(selected, comm, ns.time_limit)
-    if comm.rank == 0:
-        total = time.perf_counter() - started
-        failed = sum(r["status"] not in ("converged", "n/a") for r in rows)
-        print(f"stress: {len(rows)} cases, {failed} not converged, {total:.0f} s")
-        if ns.out is not None:
-            from contactfx.validation.report import write_stress
-
-            for path in write_stress(rows, ns.out, comm.size, total):
-                print(f"wrote {path}")
-    comm.barrier()
+    failed = sum(r["status"] not in ("converged", "n/a") for r in rows)
+    finish_table(rows, comm, started, f"stress: {len(rows)} cases, {failed} not converged, "
+                 "{total:.0f} s", ns.out, write_stress)  # fmt: skip
     return 0

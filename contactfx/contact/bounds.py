@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 from contactfx.contact.method import MethodBase, Supports
+from contactfx.solvers.snes import owned_size
 
 __all__ = ["BoundConstraints"]
 
@@ -91,7 +92,7 @@ class _Bounded:
         self.lower, self.upper = x.copy(), x.copy()
         self.lower.set(PETSc.NINFINITY)
         self.upper.set(PETSc.INFINITY)
-        keep = self.dofs < V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+        keep = self.dofs < owned_size(V)
         self.dofs, self.coords = self.dofs[keep], coords[keep]
 
     def assemble_load(self) -> None:

@@ -7,15 +7,15 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.laws import Friction, tangential
+from contactfx.contact.laws import tangential
 from contactfx.contact.obstacles import Obstacle
-from contactfx.contact.surface import Expr, sigma_n, sigma_t
+from contactfx.contact.surface import Expr, SurfaceData
 
 __all__ = ["ContactSurface"]
 
 
 @dataclass(frozen=True)
-class ContactSurface:
+class ContactSurface(SurfaceData):
     """Everything a method needs to write its terms on one contact boundary.
 
     u: displacement (a dolfinx Function or a UFL component of a mixed one); v: its test
@@ -26,12 +26,8 @@ class ContactSurface:
     sigma(v, q)), linear in them; E: Young's modulus of the material at the contact surface,
     used to scale the method parameters; h: local mesh size (UFL).
 
-    Friction (only when ``friction`` is not None): ``u_prev`` and ``offset_prev`` are the
-    displacement and the obstacle offset of the last converged load step; the slip increment
-    is measured from them. ``ds_nodal`` is the same boundary with the vertex (trapezoidal)
-    quadrature rule, for laws collocated at the nodes (semi-smooth Newton multipliers).
-    ``multiplier`` (and ``multiplier_test``): the augmented Lagrangian multiplier, when the
-    method has one.
+    With friction ``offset_prev`` is the obstacle offset of the last converged load step (the
+    slip is measured relative to the obstacle). The other members: :class:`SurfaceData`.
     """
 
     u: Expr
@@ -43,16 +39,7 @@ class ContactSurface:
     stress_test: Expr
     E: float
     h: Expr
-    friction: Friction | None = None
-    u_prev: Expr | None = None
     offset_prev: Expr | None = None
-    ds_nodal: ufl.Measure | None = None
-    multiplier: Expr | None = None
-    multiplier_test: Expr | None = None
-
-    @property
-    def mesh(self):
-        return self.ds.ufl_domain()
 
     def position(self, w=None):
         """Current position in the obstacle's frame, x + u - offset. For the linearised
@@ -72,9 +59,6 @@ class ContactSurface:
     def normal(self, w=None):
         """n(u) = -grad phi at x + u - offset: outward normal of the body at contact."""
         return self.obstacle.normal(self.position(w))
-
-    sigma_n = staticmethod(sigma_n)
-    sigma_t = staticmethod(sigma_t)
 
     def slip_increment(self, n):
         """Tangential displacement of the body relative to the obstacle since the last

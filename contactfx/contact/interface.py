@@ -45,8 +45,9 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.laws import Friction, positive_part, tangential
-from contactfx.contact.surface import Expr, sigma_n, sigma_t
+from contactfx.contact.laws import positive_part, tangential
+from contactfx.contact.surface import Expr, SurfaceData
+from contactfx.references import bb_closure
 
 __all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal", "tangent"]
 
@@ -85,11 +86,11 @@ class BartonBandis:
 
     def closure(self, s):
         """v = psi(s) for an effective normal stress s >= 0 (numbers or UFL)."""
-        return s * self.Vm / (self.Kni * self.Vm + s)
+        return bb_closure(s, self.Kni, self.Vm)
 
 
 @dataclass(frozen=True)
-class InterfaceSurface:
+class InterfaceSurface(SurfaceData):
     """What a method needs to write its terms on a fitted interface (see the module docstring).
 
     w, v: total displacement of the state and of the test functions (u + H a); H: the DG0 sign
@@ -112,15 +113,6 @@ class InterfaceSurface:
     floor: Expr | None = None
     fluid: Expr | None = None
     joint: BartonBandis | None = None
-    friction: Friction | None = None
-    u_prev: Expr | None = None
-    ds_nodal: ufl.Measure | None = None
-    multiplier: Expr | None = None
-    multiplier_test: Expr | None = None
-
-    @property
-    def mesh(self):
-        return self.ds.ufl_domain()
 
     # -- the ContactSurface members the methods use -----------------------------------------
     @property
@@ -178,9 +170,6 @@ class InterfaceSurface:
         if self.joint is not None:
             g = g + self.joint.closure(positive_part(self.effective_pressure()))
         return g
-
-    sigma_n = staticmethod(sigma_n)
-    sigma_t = staticmethod(sigma_t)
 
     def slip_increment(self, n):
         """Tangential jump increment since the last converged step."""

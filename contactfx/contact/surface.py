@@ -11,13 +11,14 @@ against an obstacle, the oriented jump across an interface).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import ufl
 
 from contactfx.contact.laws import Friction, tangential
 
-__all__ = ["Expr", "Surface", "sigma_n", "sigma_t"]
+__all__ = ["Expr", "Surface", "SurfaceData", "sigma_n", "sigma_t"]
 
 #: a UFL expression (a Function, a component of a mixed one, a test function, a Constant)
 Expr = ufl.core.expr.Expr
@@ -58,3 +59,25 @@ class Surface(Protocol):
     def normal(self, w=None) -> Any: ...
 
     def slip_increment(self, n) -> Any: ...
+
+
+@dataclass(frozen=True, kw_only=True)
+class SurfaceData:
+    """The members every surface carries for the methods (keyword-only): the friction law and
+    ``u_prev``, the relative motion of the last converged load step (friction only, the slip
+    increment is measured from it); ``ds_nodal``, the contact measure with the vertex
+    (trapezoidal) rule for laws collocated at the nodes; a method's ``multiplier`` and its test
+    function."""
+
+    friction: Friction | None = None
+    u_prev: Expr | None = None
+    ds_nodal: ufl.Measure | None = None
+    multiplier: Expr | None = None
+    multiplier_test: Expr | None = None
+
+    sigma_n = staticmethod(sigma_n)
+    sigma_t = staticmethod(sigma_t)
+
+    @property
+    def mesh(self):
+        return self.ds.ufl_domain()

@@ -35,6 +35,7 @@ from contactfx.driver.fields import (
 )
 from contactfx.driver.interface_post import InterfacePost
 from contactfx.driver.problem import Problem
+from contactfx.solvers.snes import owned_size
 
 __all__ = ["InterfaceProblem"]
 
@@ -173,7 +174,7 @@ class InterfaceProblem(Problem):
                 (joint.Kni * ufl.dot(jd, n_I) * ufl.dot(s.v, n_I)
                  + k_t * ufl.dot(jd, t_I) * ufl.dot(s.v, t_I)) * self.dSc
             )  # fmt: skip
-        n_owned = solver.owned_size
+        n_owned = owned_size(self.state.function_space)
         free = np.zeros(n_owned, dtype=bool)
         for i in range(self.gdim if spring is None else 2 * self.gdim):
             parent = np.asarray(self.V.sub(i).collapse()[1])
@@ -220,7 +221,6 @@ class InterfaceProblem(Problem):
     def dofs(self) -> int:
         """Free unknowns: the enrichment's fixed dofs away from the interface do not count."""
         total = super().dofs()
-        space = self.state.function_space
-        owned = space.dofmap.index_map.size_local * space.dofmap.index_map_bs
+        owned = owned_size(self.state.function_space)
         fixed = sum(int(np.sum(np.asarray(_compat.bc_dofs(bc)) < owned)) for bc in self.bcs)
         return total - self.mesh.comm.allreduce(fixed, op=MPI.SUM)

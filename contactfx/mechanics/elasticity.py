@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import ufl
 
+from contactfx.references import oedometric_modulus
+
 __all__ = ["Elastic"]
 
 
@@ -62,7 +64,7 @@ class Elastic:
     @property
     def M(self) -> float:
         """Oedometric (uniaxial-strain) modulus E (1 - nu) / ((1 + nu)(1 - 2 nu))."""
-        return self.E * (1.0 - self.nu) / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        return oedometric_modulus(self.E, self.nu)
 
     def _moduli(self):
         """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""

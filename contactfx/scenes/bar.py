@@ -1,10 +1,6 @@
-"""1D bar against a rigid wall with Nitsche contact: the exact discrete solution.
-
-Bar (0, L), E A = E, u(0) = 0, body force f, wall at x = L + g0 (u(L) <= g0). With the
-Chouly-Hild parameter gamma0' = 1 / gamma0 and N P1 elements of size h, the Nitsche solution
-penetrates by pen = gamma0' f h^2 / (2 E (1 - theta gamma0')) and its multiplier differs from
-lambda = f L / 2 - E g0 / L by 0 (theta = 1), -E pen / L (0), -2 E pen / L (-1)
-(docs/verification.md section 8; Chouly & Hild 2013, doi:10.1137/12088344X).
+"""1D bar against a rigid wall: bar (0, L), E A = E, u(0) = 0, body force f, wall at
+x = L + g0 (u(L) <= g0). With Nitsche's method its discrete solution is known exactly
+(:func:`contactfx.references.bar_nitsche_exact`, docs/verification.md section 8).
 """
 
 from __future__ import annotations
@@ -22,19 +18,9 @@ from contactfx.params import param
 from contactfx.scenes._common import fix
 from contactfx.scenes.base import ObstacleScene, SceneParams
 
-__all__ = ["Bar1D", "bar_nitsche_exact"]
+__all__ = ["Bar1D"]
 
 LEFT, RIGHT = 1, 2
-
-
-def bar_nitsche_exact(*, E, L, f, g0, n, theta, gamma0) -> dict[str, float]:
-    """Exact discrete penetration and multiplier of the P1 Nitsche bar."""
-    h = L / n
-    g_ch = 1.0 / gamma0
-    pen = g_ch * f * h**2 / (2.0 * E * (1.0 - theta * g_ch))
-    lam = f * L / 2.0 - E * g0 / L
-    shift = {1: 0.0, 0: -E * pen / L, -1: -2.0 * E * pen / L}[theta]
-    return {"penetration": pen, "multiplier": lam + shift, "multiplier_exact": lam}
 
 
 @dataclass(frozen=True)

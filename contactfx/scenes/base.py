@@ -8,6 +8,7 @@ a rigid obstacle (the interface scenes are in :mod:`contactfx.scenes.interface_b
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
 
@@ -18,13 +19,30 @@ from contactfx.contact.obstacles import Obstacle
 from contactfx.driver.obstacle import ObstacleProblem
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.numerics import Numerics
-from contactfx.params import Params
+from contactfx.params import Params, param
 from contactfx.results import RunSummary
 
-__all__ = ["SceneParams", "Scene", "ObstacleScene"]
+__all__ = ["SceneParams", "elastic", "Scene", "ObstacleScene"]
 
 #: base of every scene's parameter dataclass (validated on construction)
 SceneParams = Params
+
+
+def elastic(E0: float, nu0: float) -> type:
+    """Base of a scene's parameter dataclass whose body is one isotropic elastic material:
+    Young's modulus E and Poisson's ratio nu with the defaults E0 and nu0, checked on
+    construction (the material's own rule: E > 0, -1 < nu < 0.5)."""
+
+    @dataclass(frozen=True)
+    class ElasticParams(Params):
+        E: float = param(E0, "Young's modulus", positive=True)
+        nu: float = param(nu0, "Poisson's ratio, in (-1, 0.5)")
+
+        def __post_init__(self) -> None:
+            super().__post_init__()
+            Elastic(self.E, self.nu)
+
+    return ElasticParams
 
 
 class Scene:

@@ -8,7 +8,7 @@ The plate stands for an infinite one: its boundary carries the traction sigma n 
 
 * ``--boundary infinite`` (default): the infinite-plate closed-form stress of the load case
   where one exists (uniform remote stress plus the Westergaard field of the crack faces'
-  pressure and driving shear, :mod:`contactfx.scenes.crack_fields`), so that the finite plate
+  pressure and driving shear, :mod:`contactfx.references`), so that the finite plate
   has the infinite plate's solution and the only error is the discretisation's;
 * ``--boundary remote``: the remote stress only (a finite plate under uniform traction; the
   crack then feels the plate's width, K / K_inf = sqrt(sec(pi a / W)) for a strip).
@@ -31,13 +31,13 @@ from dataclasses import dataclass
 import numpy as np
 import ufl
 
-from contactfx._compat import ufl_math
+from contactfx import references as cf
+from contactfx._compat import numpy_math, ufl_math
 from contactfx.driver.interface_post import STATUS, Profile
 from contactfx.meshes import CrackPlateFacets, crack_plate
 from contactfx.params import param
-from contactfx.scenes import crack_fields as cf
 from contactfx.scenes._common import gmsh_mesh
-from contactfx.scenes.base import SceneParams
+from contactfx.scenes.base import elastic
 from contactfx.scenes.interface_base import InterfaceScene
 
 __all__ = ["CrackSneddon", "CrackInclined", "ProppedFracture", "stress_intensity_from_jump"]
@@ -64,9 +64,7 @@ def stress_intensity_from_jump(s, jump, a: float, E: float, nu: float,
 
 
 @dataclass(frozen=True)
-class _PlateParams(SceneParams):
-    E: float = param(10e9, "Young's modulus", positive=True)
-    nu: float = param(0.25, "Poisson's ratio, in (-1, 0.5)")
+class _PlateParams(elastic(10e9, 0.25)):
     crack_half_length: float = param(1.0, "crack half-length a", positive=True)
     plate_width: float = param(20.0, "plate width W (the square [-W/2, W/2]^2)", positive=True)
     h_crack: float = param(0.025, "element size along the crack", positive=True)
@@ -174,16 +172,10 @@ class _CrackPlate(InterfaceScene):
         dso = ds(_OUTER, metadata={"quadrature_degree": 8})
         return t * ufl.dot(ufl.dot(sigma, n), v) * dso
 
-    def _sqrt_ellipse(self, s):
-        a = self.p.crack_half_length
-        return ufl.sqrt(ufl.max_value(a**2 - s**2, 0.0))
-
     def _ellipse(self, s, load):
-        """Closed-form jump 4 load (1 - nu^2) / E sqrt(a^2 - s^2) (numpy or UFL)."""
-        scale = 4.0 * load * (1.0 - self.p.nu**2) / self.p.E
-        if isinstance(s, np.ndarray):
-            return scale * np.sqrt(np.maximum(self.p.crack_half_length**2 - s**2, 0.0))
-        return scale * self._sqrt_ellipse(s)
+        """Sneddon's jump under the face load ``load`` (numpy or UFL in s)."""
+        m = numpy_math if isinstance(s, np.ndarray) else ufl_math
+        return cf.opening(s, self.p.crack_half_length, load, self.p.E, self.p.nu, m)
 
     def _K(self, prof: Profile, jump) -> float:
         return stress_intensity_from_jump(prof.s, jump, self.p.crack_half_length, self.p.E,

@@ -17,21 +17,19 @@ from contactfx.contact.obstacles import FlatPunch, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
 from contactfx.scenes._common import fix, gmsh_mesh
-from contactfx.scenes.base import ObstacleScene, SceneParams
+from contactfx.scenes.base import ObstacleScene, elastic
 from contactfx.scenes.hertz import QuarterBlock
 
 __all__ = ["FlatPunch2D", "FlatPunch3D"]
 
 
 @dataclass(frozen=True)
-class FlatPunch2DParams(SceneParams):
+class FlatPunch2DParams(elastic(1000.0, 0.3)):
     punch_half_width: float = param(0.05, "punch half-width a", positive=True)
     edge_radius: float = param(0.002, "radius of the rounded punch edges", positive=True)
     depth: float = param(1e-4, "indentation depth", positive=True)
     half_width: float = param(1.0, "block half-width", positive=True)
     height: float = param(1.0, "block height", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(2.5e-3, "element size under the punch", positive=True)
     h_far: float = param(0.1, "element size far from the punch", positive=True)
 
@@ -69,14 +67,12 @@ class FlatPunch2D(ObstacleScene):
 
 
 @dataclass(frozen=True)
-class FlatPunch3DParams(SceneParams):
+class FlatPunch3DParams(elastic(1000.0, 0.3)):
     punch_radius: float = param(0.05, "punch radius a", positive=True)
     edge_radius: float = param(0.002, "radius of the rounded punch edge", positive=True)
     depth: float = param(1e-4, "indentation depth delta", positive=True)
     size: float = param(1.0, "edge of the quarter block", positive=True)
     height: float = param(1.0, "block height", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(0.006, "element size under the punch", positive=True)
     h_far: float = param(0.3, "element size far from the punch", positive=True)
 

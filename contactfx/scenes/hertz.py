@@ -27,20 +27,11 @@ from contactfx import _compat
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.params import param
+from contactfx.references import hertz_2d, hertz_3d
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
-from contactfx.scenes.base import ObstacleScene, SceneParams
+from contactfx.scenes.base import ObstacleScene, elastic
 
-__all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "hertz_2d", "hertz_3d"]
-
-
-def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
-    a = np.sqrt(4.0 * force * radius / (np.pi * E_star))
-    return {"a": a, "p0": 2.0 * force / (np.pi * a)}
-
-
-def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
-    a = (3.0 * force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
-    return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
+__all__ = ["Hertz2D", "Hertz3D", "QuarterBlock"]
 
 
 def _elliptic(p0, s2):
@@ -77,14 +68,12 @@ def _indenter(profile: str, radius: float) -> Obstacle:
 
 
 @dataclass(frozen=True)
-class Hertz2DParams(SceneParams):
+class Hertz2DParams(elastic(1000.0, 0.3)):
     radius: float = param(1.0, "indenter radius R", positive=True)
     profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
     depth: float = param(1.5e-3, "indentation depth (ramped over the load steps)", positive=True)
     half_width: float = param(1.0, "block half-width", positive=True)
     height: float = param(1.0, "block height", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(3e-3, "element size in the contact zone", positive=True)
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
     refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
@@ -178,14 +167,12 @@ class Hertz2D(ObstacleScene):
 
 
 @dataclass(frozen=True)
-class Hertz3DParams(SceneParams):
+class Hertz3DParams(elastic(1000.0, 0.3)):
     radius: float = param(1.0, "indenter radius R", positive=True)
     profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
     depth: float = param(0.01, "indentation depth (ramped over the load steps)", positive=True)
     size: float = param(1.0, "edge of the quarter block (x, y in [0, size])", positive=True)
     height: float = param(1.0, "block height", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(0.02, "element size in the contact zone", positive=True)
     h_far: float = param(0.3, "element size far from the contact zone", positive=True)
     refine_radius: float = param(0.15, "radius of the refined zone", positive=True)

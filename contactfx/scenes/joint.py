@@ -15,21 +15,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from contactfx import references as cf
 from contactfx.contact.interface import BartonBandis
 from contactfx.meshes import JointColumnFacets, joint_column
 from contactfx.params import param
-from contactfx.scenes import crack_fields as cf
 from contactfx.scenes._common import gmsh_mesh
-from contactfx.scenes.base import SceneParams
+from contactfx.scenes.base import elastic
 from contactfx.scenes.interface_base import InterfaceScene
 
 __all__ = ["JointColumn", "JointColumnParams"]
 
 
 @dataclass(frozen=True)
-class JointColumnParams(SceneParams):
-    E: float = param(10e9, "Young's modulus", positive=True)
-    nu: float = param(0.25, "Poisson's ratio, in (-1, 0.5)")
+class JointColumnParams(elastic(10e9, 0.25)):
     block_height: float = param(1.0, "height H of each block", positive=True)
     width: float = param(0.5, "column width L", positive=True)
     closure_stress: float = param(30e6, "compression s_c on the top", nonnegative=True)

@@ -25,17 +25,15 @@ from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
 from contactfx.scenes._common import fix_component, gmsh_mesh
-from contactfx.scenes.base import ObstacleScene, SceneParams
+from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["SlidingBlock", "SlidingBlockParams"]
 
 
 @dataclass(frozen=True)
-class SlidingBlockParams(SceneParams):
+class SlidingBlockParams(elastic(1000.0, 0.3)):
     width: float = param(1.0, "block width L", positive=True)
     height: float = param(0.5, "block height H", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     pressure: float = param(10.0, "pressure p on the bottom face (first half of the load)",
                             positive=True)  # fmt: skip
     shift: float = param(0.02, "tangential displacement of the rigid plane (second half)",

@@ -27,20 +27,18 @@ from contactfx.contact.obstacles import Obstacle, Sinusoid
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
 from contactfx.scenes._common import fix_component, gmsh_mesh
-from contactfx.scenes.base import ObstacleScene, SceneParams
+from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["Westergaard"]
 
 
 @dataclass(frozen=True)
-class WestergaardParams(SceneParams):
+class WestergaardParams(elastic(1000.0, 0.3)):
     wavelength: float = param(1.0, "wavelength lambda of the rigid sinusoid", positive=True)
     amplitude: float = param(0.01, "amplitude Delta of the sinusoid", positive=True)
     mean_pressure_ratio: float = param(0.5, "mean pressure p_m / p* (>= 1: full contact)",
                                        positive=True)  # fmt: skip
     depth_ratio: float = param(2.0, "strip depth H / lambda", positive=True)
-    E: float = param(1000.0, "Young's modulus", positive=True)
-    nu: float = param(0.3, "Poisson's ratio, in (-1, 0.5)")
     h_contact: float = param(1.0 / 64, "element size at the surface", positive=True)
     h_far: float = param(1.0 / 8, "element size at depth", positive=True)
 

@@ -30,7 +30,8 @@ from petsc4py import PETSc
 from contactfx import _compat
 
 __all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "ContactSNES",
-           "time_limit", "rigid_body_modes", "DEFAULT_OPTIONS", "GAMG_OPTIONS"]  # fmt: skip
+           "time_limit", "owned_size", "rigid_body_modes", "DEFAULT_OPTIONS",
+           "GAMG_OPTIONS"]  # fmt: skip
 
 
 class ConvergenceError(RuntimeError):
@@ -121,6 +122,11 @@ class Timer:
     assembly: float = 0.0
 
 
+def owned_size(space) -> int:
+    """Number of owned (unrolled) dofs of a function space on this rank."""
+    return space.dofmap.index_map.size_local * space.dofmap.index_map_bs
+
+
 def rigid_body_modes(V) -> PETSc.NullSpace:
     """Orthonormalised rigid-body modes of a 2D / 3D vector space (near-nullspace for AMG)."""
     mesh = V.mesh
@@ -187,8 +193,7 @@ class ContactSNES:
         self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
         self.timer.assembly += time.perf_counter() - t0
 
-        dofmap = u.function_space.dofmap
-        n_owned = dofmap.index_map.size_local * dofmap.index_map_bs
+        n_owned = owned_size(u.function_space)
         dofs = [_compat.bc_dofs(bc) for bc in self.bcs]
         rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0)
         self._bc_rows = rows[rows < n_owned].astype(np.int32)
@@ -286,11 +291,6 @@ class ContactSNES:
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         for obj in (ksp, A, b):
             obj.destroy()
-
-    @property
-    def owned_size(self) -> int:
-        """Number of owned (unrolled) dofs of the unknown on this rank."""
-        return self.K.getLocalSize()[0]
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self) -> SolveStats:

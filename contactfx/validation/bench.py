@@ -199,7 +199,7 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
     import dolfinx
 
     from contactfx import _compat
-    from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
+    from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, owned_size
 
     mesh, facet_tags = scene.build_mesh(comm)
     gdim = mesh.geometry.dim
@@ -215,7 +215,7 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
                          prefix="contactfx_linear_", near_nullspace=solver == "gamg",
                          options=GAMG_OPTIONS if solver == "gamg" else {})  # fmt: skip
     linear.assemble_load()
-    linear.solve_linear(np.ones(linear.owned_size, dtype=bool))
+    linear.solve_linear(np.ones(owned_size(V), dtype=bool))
     comm.barrier()
     elapsed = time.perf_counter() - t0
     linear.destroy()

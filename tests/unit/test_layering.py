@@ -19,7 +19,7 @@ LAYERS = [
     {"driver"},
     {"numerics"},
     {"contact", "mechanics", "solvers", "io"},
-    {"params", "results", "_compat", "meshes", "__init__"},
+    {"params", "results", "references", "_compat", "meshes", "__init__"},
 ]
 
 

@@ -2,8 +2,9 @@
 
 import pytest
 
+from contactfx.references import bar_nitsche_exact
 from contactfx.scenes import Numerics
-from contactfx.scenes.bar import Bar1D, Bar1DParams, bar_nitsche_exact
+from contactfx.scenes.bar import Bar1D, Bar1DParams
 
 
 @pytest.mark.parametrize("theta", [1, 0, -1])

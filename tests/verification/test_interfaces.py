@@ -12,8 +12,8 @@ import math
 
 import pytest
 
+from contactfx.references import joint_column
 from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
-from contactfx.scenes.crack_fields import joint_column
 from contactfx.scenes.joint import JointColumn
 
 #: methods on interfaces; Nitsche's three variants and both augmented Lagrangian ones

@@ -1,5 +1,20 @@
-"""Closed forms for crack-face contact and joints (plane strain; docs/verification.md
-sections 6, 7).
+"""The closed forms the scenes and tests compare with, each written once (docs/verification.md
+lists them with their sources): Hertz (section 1), the exact discrete Nitsche bar (section 8),
+the oedometric modulus, and crack-face contact and joints (plane strain; sections 6, 7).
+
+Hertz (Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, sections 4.2 and 5.2),
+at the load P (per unit length in 2D) with the contact modulus E*:
+
+    2D: a = sqrt(4 P R / (pi E*)),  p0 = 2 P / (pi a)
+    3D: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2), approach a^2 / R
+
+Bar (0, L), E A = E, u(0) = 0, body force f, wall at x = L + g0, N P1 elements of size h, with
+the Chouly-Hild parameter gamma0' = 1 / gamma0: the Nitsche solution penetrates by
+pen = gamma0' f h^2 / (2 E (1 - theta gamma0')) and its multiplier differs from
+lambda = f L / 2 - E g0 / L by 0 (theta = 1), -E pen / L (0), -2 E pen / L (-1)
+(Chouly & Hild 2013, doi:10.1137/12088344X).
+
+Crack faces and joints:
 
 Crack |x| < a on y = 0 in an infinite plate, in the crack's own frame. Signs: tension positive
 for stresses; pressures p, normal stresses sigma_n and effective stresses s' are positive in
@@ -61,6 +76,10 @@ import numpy as np
 from contactfx._compat import numpy_math
 
 __all__ = [
+    "hertz_2d",
+    "hertz_3d",
+    "bar_nitsche_exact",
+    "oedometric_modulus",
     "crack_perturbation_stress",
     "opening",
     "stress_intensity",
@@ -74,6 +93,31 @@ __all__ = [
     "joint_column",
     "propping_pressure",
 ]
+
+
+def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
+    a = np.sqrt(4.0 * force * radius / (np.pi * E_star))
+    return {"a": a, "p0": 2.0 * force / (np.pi * a)}
+
+
+def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
+    a = (3.0 * force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
+    return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
+
+
+def bar_nitsche_exact(*, E, L, f, g0, n, theta, gamma0) -> dict[str, float]:
+    """Exact discrete penetration and multiplier of the P1 Nitsche bar."""
+    h = L / n
+    g_ch = 1.0 / gamma0
+    pen = g_ch * f * h**2 / (2.0 * E * (1.0 - theta * g_ch))
+    lam = f * L / 2.0 - E * g0 / L
+    shift = {1: 0.0, 0: -E * pen / L, -1: -2.0 * E * pen / L}[theta]
+    return {"penetration": pen, "multiplier": lam + shift, "multiplier_exact": lam}
+
+
+def oedometric_modulus(E, nu):
+    """Uniaxial-strain modulus M = E (1 - nu) / ((1 + nu)(1 - 2 nu))."""
+    return E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
 
 
 def _griffith(x, y, a, m):
@@ -106,9 +150,10 @@ def crack_perturbation_stress(x, y, a, p, q, m: Any = numpy_math):
 
 
 def opening(s, a, load, E, nu, m: Any = numpy_math):
-    """Face displacement jump 4 load (1 - nu^2) / E sqrt(a^2 - s^2) at |s| <= a (Sneddon):
-    the opening u_y(0+) - u_y(0-) for load = p, the slip u_x(0+) - u_x(0-) for load = q."""
-    return 4.0 * load * (1.0 - nu**2) / E * m.sqrt(a**2 - s**2)
+    """Face displacement jump 4 load (1 - nu^2) / E sqrt(a^2 - s^2) at |s| <= a (Sneddon), 0
+    beyond: the opening u_y(0+) - u_y(0-) for load = p, the slip u_x(0+) - u_x(0-) for
+    load = q."""
+    return 4.0 * load * (1.0 - nu**2) / E * m.sqrt(m.maximum(a**2 - s**2, 0.0))
 
 
 def stress_intensity(load, a):
@@ -165,7 +210,7 @@ def joint_column(s_c, p, E, nu, H, w0, Kni, Vm) -> dict[str, Any]:
     aperture w0), top compression s_c, fluid pressure p on the faces: the closure v at
     s' = s_c - p, the aperture w0 - v, the oedometric modulus M = E (1 - nu) / ((1 + nu)
     (1 - 2 nu)) and the top settlement 2 H s_c / M + v."""
-    M = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    M = oedometric_modulus(E, nu)
     closure = bb_closure(s_c - p, Kni, Vm)
     return {
         "closure": closure,

@@ -1,11 +1,11 @@
-"""Unit tests of :mod:`contactfx.scenes.crack_fields`: the Westergaard crack field satisfies
+"""Unit tests of :mod:`contactfx.references`: the Westergaard crack field satisfies
 equilibrium, compatibility, the face conditions, decay and the tip asymptotics; its strains
 integrate to Sneddon's opening and slip; the tables of docs/verification.md sections 6 and 7.
 
 Run at 1 and 2 ranks::
 
-    python3 -m pytest tests/unit/test_crack_fields.py
-    mpirun -n 2 python3 -m mpi4py -m pytest tests/unit/test_crack_fields.py
+    python3 -m pytest tests/unit/test_references.py
+    mpirun -n 2 python3 -m mpi4py -m pytest tests/unit/test_references.py
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import ufl
 from mpi4py import MPI
 
 from contactfx._compat import ufl_math
-from contactfx.scenes.crack_fields import (
+from contactfx.references import (
     bb_closure,
     bb_stiffness,
     bb_stress,
