@@ -52,6 +52,12 @@ BAD = [
     (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
     (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),
     (["run", "hertz2d", "--quadrature", "nodal", "--degree", "2"], "--quadrature nodal needs"),
+    # a method's own options come from its parameters (contactfx/contact/compliance.py)
+    (["run", "hertz2d", "--method", "compliance", "--exponent", "0"], "--exponent must be > 0"),
+    (
+        ["run", "hertz2d", "--method", "compliance", "--friction", "coulomb", "--mu", "0.3"],
+        "friction law 'coulomb' is not supported by method 'compliance'",
+    ),
     (["bench", "--scene", "nosuch"], "unknown bench case 'nosuch'"),
     (["bench", "--method", "magic"], "unknown method 'magic'"),
     (["bench", "--method", "penalty@x"], "'x' is not a number"),

@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
         return _dispatch(argv[0], argv[1:], petsc_options, comm)
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2, message printed)
         return int(exc.code or 0)
-    except Exception as exc:  # noqa: BLE001 - every error becomes one line and a status
+    except Exception as exc:  # every error becomes one line and a status
         from contactfx.solvers.snes import ConvergenceError
 
         if isinstance(exc, ValueError | OSError | ConvergenceError):

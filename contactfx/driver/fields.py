@@ -93,8 +93,7 @@ class NodalProjection:
         q = ufl.TestFunction(space)
         self.q = q if restrict is None else q(restrict)
         self.measure = measure
-        shape = space.ufl_element().value_shape()
-        shape = shape() if callable(shape) else shape
+        shape = q.ufl_shape
         ones = ufl.as_vector([1.0] * shape[0]) if shape else 1.0
         self.mass = assemble_array(dolfinx.fem.form(ufl.inner(ones, self.q) * measure))
         self.on = self.mass > 0.0

@@ -49,14 +49,8 @@ def run_load_program(
     try:
         while t_prev < 1.0 - 1e-12:
             t = min(1.0, t_prev + dt)
-            if older is not None and t_prev > t_older:
-                factor = (t - t_prev) / (t_prev - t_older)
-                previous.copy(x)
-                x.axpy(factor, previous)
-                x.axpy(-factor, older)
-            else:
-                previous.copy(x)
-            x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+            factor = 0.0 if older is None else (t - t_prev) / (t_prev - t_older)
+            _predict(x, previous, older, factor)
             apply_load(t)
             solver.assemble_load()
             try:
@@ -90,6 +84,16 @@ def run_load_program(
         if older is not None:
             older.destroy()
     return records
+
+
+def _predict(x: PETSc.Vec, previous: PETSc.Vec, older, factor: float) -> None:
+    """x = previous + factor (previous - older): the secant extrapolation of the last two
+    converged states (previous alone before the second step)."""
+    previous.copy(x)
+    if older is not None:
+        x.axpy(factor, previous)
+        x.axpy(-factor, older)
+    x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
 
 def _restore(previous: PETSc.Vec, x: PETSc.Vec) -> None:
