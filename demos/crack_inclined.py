@@ -78,14 +78,12 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.crack import CrackInclined
+from contactfx.validation.residual import random_state, relative_difference
 
 sliding = CrackInclined(CrackInclined.Params(beta=45.0, sigma=10e6))
 num = sliding.default_numerics(method="nitsche", theta=1, gamma0=10.0, friction="coulomb", mu=0.3)
@@ -122,31 +120,17 @@ def coulomb_nitsche_residual(s, theta, gamma0, mu):
 
 # -
 
-# The check that it is what the run assembles: build the problem as `scene.run` does, take an
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take an
 # arbitrary state (random nodal values) and compare the assembled vectors.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
-mesh, facet_tags = sliding.build_mesh(MPI.COMM_WORLD)
-problem = sliding.problem(sliding, num, method, mesh, facet_tags)
+problem = setup(sliding, num)
 problem.apply_load(1.0)
 random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - coulomb_nitsche_residual(s, num.theta, num.gamma0, num.mu))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, coulomb_nitsche_residual(s, num.theta, num.gamma0, num.mu))
 # -
 
 # Solve: the sliding crack with both methods (the Nitsche run writes its output, with the slip

@@ -83,14 +83,12 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.crack import CrackSneddon
+from contactfx.validation.residual import random_state, relative_difference
 
 pressurised = CrackSneddon(CrackSneddon.Params(pressure=1e6))
 num = pressurised.default_numerics(method="nitsche", theta=1, gamma0=10.0)
@@ -118,32 +116,18 @@ def crack_nitsche_residual(s, theta, gamma0):
 
 # -
 
-# The check that it is what the run assembles: build the problem as `scene.run` does, apply the
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
 # fluid pressure, take an arbitrary state (random nodal values of $u$ and $a$) and compare the
 # assembled vectors.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
-mesh, facet_tags = pressurised.build_mesh(MPI.COMM_WORLD)
-problem = pressurised.problem(pressurised, num, method, mesh, facet_tags)
+problem = setup(pressurised, num)
 problem.apply_load(1.0)
 random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - crack_nitsche_residual(s, num.theta, num.gamma0))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, crack_nitsche_residual(s, num.theta, num.gamma0))
 # -
 
 # Solve the pressurised crack, writing the XDMF file (fields `displacement` $u$ and `enrichment`

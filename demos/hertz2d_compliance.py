@@ -69,15 +69,13 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from contactfx.contact.registry import METHODS
+from contactfx.driver import setup
 from contactfx.scenes.hertz import Hertz2D
+from contactfx.validation.residual import random_state, relative_difference
 
 scene = Hertz2D(Hertz2D.Params(radius=1.0, depth=1.5e-3, E=1000.0, nu=0.3))
 kappa0 = 10.0
@@ -98,38 +96,23 @@ def compliance_residual(s, kappa0, m):
 
 # -
 
-# The check that this is what the run assembles: build the problem as `scene.run` does, put the
+# The check that this is what the run assembles: build the problem `scene.run` solves (`setup`), put the
 # indenter at its final depth, take an arbitrary state (random nodal values) and compare the
 # assembled residual vectors, for $m = 1.5$ and, at $m = 1$, with the penalty method's.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
 num = scene.default_numerics(method="compliance", penalty=kappa0, exponent=1.5)
 method = num.method_object()  # NormalCompliance(kappa0=10.0, exponent=1.5)
-mesh, facet_tags = scene.build_mesh(MPI.COMM_WORLD)
-problem = scene.problem(scene, num, method, mesh, facet_tags)
+problem = setup(scene, num)
 problem.apply_load(1.0)
 random_state(problem.state, scene.p.depth)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - compliance_residual(s, num.penalty, num.exponent))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, compliance_residual(s, num.penalty, num.exponent))
 penalty_method = scene.default_numerics(method="penalty", penalty=kappa0).method_object()
 F_pen = penalty_method.residual(s)
-mismatch_pen = assembled_norm(F_pen - compliance_residual(s, num.penalty, 1.0))
-mismatch_pen /= assembled_norm(F_pen)
+mismatch_pen = relative_difference(F_pen, compliance_residual(s, num.penalty, 1.0))
 if MPI.COMM_WORLD.rank == 0:
     print(f"method.residual vs the formula (m = 1.5): relative difference {mismatch:.1e}")
     print(f"penalty's residual vs the formula (m = 1): relative difference {mismatch_pen:.1e}")

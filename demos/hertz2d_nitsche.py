@@ -71,14 +71,12 @@
 # only what is named.
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.hertz import Hertz2D
+from contactfx.validation.residual import random_state, relative_difference
 
 scene = Hertz2D(Hertz2D.Params(radius=1.0, depth=1.5e-3, E=1000.0, nu=0.3))
 num = scene.default_numerics(method="nitsche", theta=1, gamma0=10.0)
@@ -106,32 +104,18 @@ def nitsche_residual(s, theta, gamma0):
 
 # -
 
-# This is the residual the run uses: build the problem as `scene.run` does, put the indenter at
+# This is the residual the run uses: build the problem `scene.run` solves (`setup`), put the indenter at
 # its final depth, take an arbitrary state (random nodal values) and compare the assembled
 # vectors of `method.residual(s)` and of the formula above.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
-mesh, facet_tags = scene.build_mesh(MPI.COMM_WORLD)
-problem = scene.problem(scene, num, method, mesh, facet_tags)
+problem = setup(scene, num)
 problem.apply_load(1.0)
 random_state(problem.state, scene.p.depth)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - nitsche_residual(s, num.theta, num.gamma0))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, nitsche_residual(s, num.theta, num.gamma0))
 # -
 
 # Solve. `scene.run` returns a `contactfx.results.RunSummary`: named fields for the contact

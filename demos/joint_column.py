@@ -77,14 +77,12 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.joint import JointColumn
+from contactfx.validation.residual import random_state, relative_difference
 
 
 def column(s_c, p_f):
@@ -115,33 +113,19 @@ def uzawa_residual(s, r0, Kni, Vm):
 
 # -
 
-# The check that it is what the run assembles: build the problem as `scene.run` does, apply the
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
 # loads, take an arbitrary state (random nodal values of the displacement and the multiplier)
 # and compare the assembled vectors.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
-mesh, facet_tags = scene.build_mesh(MPI.COMM_WORLD)
-problem = scene.problem(scene, num, method, mesh, facet_tags)
+problem = setup(scene, num)
 problem.apply_load(1.0)
 random_state(problem.state, 1e-4)
 random_state(problem.multiplier, 30e6)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - uzawa_residual(s, num.r0, scene.p.Kni, scene.p.Vm))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, uzawa_residual(s, num.r0, scene.p.Kni, scene.p.Vm))
 # -
 
 # Solve the three load cases with both methods; the output of the last run is in

@@ -76,14 +76,12 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
-import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.crack import ProppedFracture
+from contactfx.validation.residual import random_state, relative_difference
 
 
 def fracture(p_net):
@@ -119,31 +117,18 @@ def al_ssn_residual(s, r0):
 
 # -
 
-# The check that it is what the run assembles: build the problem as `scene.run` does, take an
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take an
 # arbitrary state (random nodal values of the displacement and the multiplier) and compare
 # the assembled vectors.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
-mesh, facet_tags = closing.build_mesh(MPI.COMM_WORLD)
-problem = closing.problem(closing, num, method, mesh, facet_tags)
+problem = setup(closing, num)
 problem.apply_load(1.0)
 random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - al_ssn_residual(s, num.r0)) / assembled_norm(F_run)
+mismatch = relative_difference(F_run, al_ssn_residual(s, num.r0))
 # -
 
 # Solve above and below $p^*$; each run writes its output (`interface.png` shows the aperture

@@ -69,14 +69,13 @@
 # ## Implementation
 
 # +
-import dolfinx
-import dolfinx.fem.petsc
 import numpy as np
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
+from contactfx.driver import setup
 from contactfx.scenes.westergaard import Westergaard
+from contactfx.validation.residual import random_state, relative_difference
 
 
 def scene_at(h):
@@ -107,33 +106,19 @@ def nitsche_residual(s, theta, gamma0):
 
 # -
 
-# The check that it is what the run assembles: build the problem as `scene.run` does, apply the
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
 # full load, take an arbitrary state (random nodal values) and compare the assembled vectors.
 
 
 # +
-def assembled_norm(F):
-    b = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(F))
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    return b.norm()
-
-
-def random_state(f, scale):
-    n = f.function_space.dofmap.index_map.size_local * f.function_space.dofmap.index_map_bs
-    f.x.array[:n] = scale * np.random.default_rng(7).uniform(-1.0, 1.0, n)
-    f.x.scatter_forward()
-
-
 scene = scene_at(1 / 16)
 method = num.method_object()
-mesh, facet_tags = scene.build_mesh(MPI.COMM_WORLD)
-problem = scene.problem(scene, num, method, mesh, facet_tags)
+problem = setup(scene, num)
 problem.apply_load(1.0)
 random_state(problem.state, scene.p.amplitude)
 s = problem.surface
 F_run = method.residual(s)
-mismatch = assembled_norm(F_run - nitsche_residual(s, num.theta, num.gamma0))
-mismatch /= assembled_norm(F_run)
+mismatch = relative_difference(F_run, nitsche_residual(s, num.theta, num.gamma0))
 if MPI.COMM_WORLD.rank == 0:
     print(f"load steps {num.steps}")
     print(f"method.residual vs the formula: relative difference {mismatch:.1e}")

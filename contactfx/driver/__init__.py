@@ -1,5 +1,6 @@
-"""The driver: one pipeline (:func:`run`) for every problem kind."""
+"""The driver: one pipeline (:func:`run`) for every problem kind; :func:`setup` builds a
+problem without solving it."""
 
-from contactfx.driver.pipeline import run
+from contactfx.driver.pipeline import run, setup
 
-__all__ = ["run"]
+__all__ = ["run", "setup"]

@@ -24,7 +24,7 @@ from contactfx.results import RunSummary, StepLog
 from contactfx.solvers.loadstep import StepRecord, run_load_program
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
 
-__all__ = ["run", "prepare_output"]
+__all__ = ["run", "setup", "prepare_output"]
 
 
 def run(scene, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
@@ -32,12 +32,27 @@ def run(scene, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
     """Solve ``scene`` with ``numerics``; write XDMF, run.json (and the kind's extra output)
     into ``out`` when given. Raises ValueError on a request the method or the problem kind
     does not support (before any collective), ConvergenceError when the solve fails."""
-    method = numerics.method_object()
-    scene.problem.check(scene, numerics, method)
-    scene.configure(numerics)
+    method = _checked_method(scene, numerics)
     run_ = _Run(scene, numerics, method, comm, None if out is None else Path(out),
                 dict(petsc_options or {}), verbose)  # fmt: skip
     return run_.execute()
+
+
+def setup(scene, numerics, comm=MPI.COMM_WORLD):
+    """The problem that :func:`run` solves, built (mesh, unknowns, surface) and not solved:
+    to look at its forms (e.g. the contact residual ``method.residual(problem.surface)``)."""
+    method = _checked_method(scene, numerics)
+    mesh, facet_tags = scene.build_mesh(comm)
+    return scene.problem(scene, numerics, method, mesh, facet_tags)
+
+
+def _checked_method(scene, numerics):
+    """The method of ``numerics``, checked against the scene's problem kind (before any
+    collective); the scene reads the numerics' physical choices."""
+    method = numerics.method_object()
+    scene.problem.check(scene, numerics, method)
+    scene.configure(numerics)
+    return method
 
 
 def prepare_output(out: Path, comm) -> None:
