@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from contactfx.cli.args import Parser, add_options
+from contactfx.contact.registry import method_class
 from contactfx.io.provenance import versions, write_json
 from contactfx.numerics import Numerics
 from contactfx.results import RunSummary
@@ -49,7 +50,8 @@ def cmd_list() -> int:
 def table(res: RunSummary) -> str:
     """The summary printed after a run."""
     t, ref, num = res.timings, res.reference, res.numerics
-    method = num["method"] + (f" theta={num['theta']}" if num["method"] == "nitsche" else "")
+    key = method_class(num["method"]).sweep[0]
+    method = num["method"] + (f" {key}={num[key]}" if key else "")
     kind = "P2/P1 mixed u-p" if num["formulation"] == "mixed-up" else f"P{num['degree']}"
     rows = [
         ("scene", res.scene),

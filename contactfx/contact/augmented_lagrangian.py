@@ -93,6 +93,7 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
                           positive=True)  # fmt: skip
     al_max_it: int = param(100, "al-uzawa maximal outer iterations", positive=True)
     name = "al-uzawa"
+    sweep = ("r0", ())
     multiplier = "nodal"
     supports = Supports(
         friction=_FRICTION, mixed_up=True, interfaces=True, dim1=False,
@@ -144,6 +145,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     ncp: str = param("min", "al-ssn complementarity function: min (Alart-Curnier) or fb "
                      "(Fischer-Burmeister)", choices=("min", "fb"))  # fmt: skip
     name = "al-ssn"
+    sweep = ("r0", ())
     multiplier = "field"
     supports = Supports(
         friction=_FRICTION, interfaces=True, iterative=False,

@@ -33,6 +33,7 @@ class NormalCompliance(MethodBase):
     exponent: float = param(2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m",
                             positive=True)  # fmt: skip
     name = "compliance"
+    sweep = ("exponent", (1.0, 1.5, 2.0))
     supports = Supports(mixed_up=True, nodal_quadrature=True, interfaces=True,
                         why_not={"friction": "it is a frictionless law"})  # fmt: skip
 

@@ -12,6 +12,7 @@ the tangential traction. Everything else the driver needs is declared here with 
   solves by :meth:`update`; an outer loop, see :meth:`attach`);
 * :meth:`snes_options`: PETSc options the method needs (e.g. an SNES-VI type);
 * :meth:`attach`: wrap the nonlinear solver (an outer loop, bound constraints);
+* ``sweep``: the option that distinguishes its variants in bench and stress tables;
 * ``supports``: the friction laws, formulations, quadratures, problem kinds and dimensions it
   handles, with the reason for each it does not: :class:`contactfx.numerics.Numerics` and the
   driver check a run against it and name the methods that would do.
@@ -69,6 +70,9 @@ class MethodBase:
 
     multiplier: ClassVar[str] = "none"
     supports: ClassVar[Supports] = Supports()
+    #: the option that tells the method's variants apart, and the values ``contactfx bench
+    #: --method NAME`` runs ("": none)
+    sweep: ClassVar[tuple[str, tuple]] = ("", ())
 
     @classmethod
     def from_options(cls, options) -> MethodBase:

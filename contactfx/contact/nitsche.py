@@ -46,6 +46,7 @@ class Nitsche(MethodBase):
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
     gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
     name = "nitsche"
+    sweep = ("theta", (1, 0, -1))
     supports = Supports(friction=("none", "tresca", "coulomb"), mixed_up=True,
                         nodal_quadrature=True, interfaces=True)  # fmt: skip
 

@@ -28,6 +28,7 @@ class Penalty(MethodBase):
     kappa0: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True,
                           option="penalty")  # fmt: skip
     name = "penalty"
+    sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
         mixed_up=True, nodal_quadrature=True, interfaces=True,
         why_not={"friction": "its stick traction needs the tangential traction history"},

@@ -28,6 +28,9 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from contactfx.contact.registry import METHODS, method_class
+from contactfx.numerics import Numerics
+from contactfx.params import option_name
 from contactfx.results import MEASURES, measure
 
 __all__ = ["CASES", "MEASURES", "run_bench", "expand_methods", "method_label",
@@ -74,36 +77,34 @@ CASES: dict[str, BenchCase] = {
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
 }
 
-PENALTIES = (10.0, 100.0, 1000.0)
-
 #: relative errors below this are round-off (e.g. the force under force control): no rate
 ROUNDOFF = 1e-10
 
 
 def method_label(o: dict) -> str:
-    """The label of a method variant given as Numerics overrides: the method and the
-    parameter that distinguishes its variants (theta, gamma0, the penalty, r0), and the nodal
-    quadrature; bench and stress name their rows with it."""
-    m = o.get("method", "nitsche")
-    if m == "nitsche":
-        label = f"nitsche({o.get('theta', 1)})"
-        label += f" g0={o['gamma0']:g}" if "gamma0" in o else ""
-    elif m in ("penalty", "compliance"):
-        label = f"{m}({o.get('penalty', 10.0):g})"
-    elif "r0" in o:
-        label = f"{m}({o['r0']:g})"
-    else:
-        label = m
+    """The label of a method variant given as Numerics overrides: the method with the value of
+    the option that tells its variants apart (``sweep``), its other parameters given, and the
+    nodal quadrature; bench and stress name their rows with it."""
+    cls = method_class(o.get("method", "nitsche"))
+    key, _ = cls.sweep
+    label = cls.name + (f"({_short(o[key])})" if key in o else "")
+    for f in dataclasses.fields(cls):
+        name = option_name(f)
+        if name in o and name != key:
+            label += f" {name}={_short(o[name])}"
     return label + (" nodal" if o.get("quadrature") == "nodal" else "")
 
 
-def expand_methods(spec: str) -> list[tuple[str, dict]]:
-    """'nitsche,penalty@100,al-ssn' -> [(label, Numerics overrides), ...]. ``nitsche`` expands
-    to theta = 1, 0, -1 and ``penalty`` to three parameters; ``name@value`` picks one (theta
-    for nitsche, the penalty factor for penalty / compliance, r0 for the augmented Lagrangian);
-    a ``+nodal`` suffix integrates the contact terms at the nodes (``--quadrature nodal``)."""
-    from contactfx.contact.registry import METHODS
+def _short(value) -> str:
+    return f"{value:g}" if isinstance(value, int | float) else str(value)
 
+
+def expand_methods(spec: str) -> list[tuple[str, dict]]:
+    """'nitsche,penalty@100,al-ssn' -> [(label, Numerics overrides), ...]. A method name
+    expands to the values of its ``sweep`` (nitsche: theta = 1, 0, -1; penalty: three penalty
+    factors; compliance: three exponents); ``name@value`` picks one value of that option (for
+    the augmented Lagrangian, r0); a ``+nodal`` suffix integrates the contact terms at the
+    nodes (``--quadrature nodal``)."""
     out: list[dict] = []
     for token in filter(None, (t.strip() for t in spec.split(","))):
         token, nodal = token.removesuffix("+nodal"), token.endswith("+nodal")
@@ -115,14 +116,11 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
         except ValueError:
             raise ValueError(f"--method {token}: '{value}' is not a number") from None
         extra = {"quadrature": "nodal"} if nodal else {}
-        if name == "nitsche":
-            thetas = (1, 0, -1) if number is None else (int(number),)
-            out += [{"method": name, "theta": t, **extra} for t in thetas]
-        elif name in ("penalty", "compliance"):
-            values = PENALTIES if number is None and name == "penalty" else (number or 10.0,)
-            out += [{"method": name, "penalty": k, **extra} for k in values]
-        elif number is not None:
-            out.append({"method": name, "r0": number, **extra})
+        key, defaults = method_class(name).sweep
+        values = defaults if number is None else (number,)
+        if key and values:
+            kind = type(getattr(Numerics(), key))
+            out += [{"method": name, key: kind(v), **extra} for v in values]
         else:
             out.append({"method": name, **extra})
     if not out:
