@@ -62,67 +62,59 @@ class Quantities:
     interface: InterfaceQuantities | None = None
 
     def to_json(self) -> dict[str, Any]:
+        """The run.json keys of the final state (interfaces: also under the rigid-obstacle names
+        force and peak_pressure, for tools reading any run.json)."""
         if self.interface is None:
-            out = {"force": self.force, "contact_half_width": self.contact_size,
-                   "peak_pressure": self.peak_pressure, "max_penetration": self.max_penetration,
-                   "complementarity": self.complementarity}  # fmt: skip
-            f = self.friction
-            if f is not None:
-                out.update(tangential_force=f.tangential_force, friction_bound=f.bound,
-                           stick_size=f.stick_size, slip_fraction=f.slip_fraction,
-                           friction_excess=f.excess)  # fmt: skip
-            return out
+            return {**_keys(self, _OBSTACLE), **_keys(self.friction, _FRICTION)}
         i = self.interface
-        out = {"normal_force": self.force, "tangential_force": i.tangential_force,
-               "closed_length": self.contact_size, "max_penetration": self.max_penetration,
-               "max_pressure": self.peak_pressure,
-               "complementarity": self.complementarity}  # fmt: skip
-        if i.proppant_force is not None:
-            out.update(proppant_force=i.proppant_force,
-                       min_aperture_propped=i.min_aperture_propped)  # fmt: skip
-        out.update(i.extra)
-        # the names the rigid-obstacle scenes use, for tools reading any run.json
-        out.update(force=self.force, peak_pressure=self.peak_pressure)
-        return out
+        return {**_keys(self, _INTERFACE), **_keys(i, _INTERFACE_PARTS), **i.extra,
+                "force": self.force, "peak_pressure": self.peak_pressure}  # fmt: skip
+
+    def step_json(self) -> dict[str, Any]:
+        """The per-step subset written into run.json's ``steps``."""
+        if self.interface is None:
+            return {**_keys(self, _OBSTACLE, 2), **_keys(self.friction, _FRICTION, 2)}
+        return {**_keys(self, _INTERFACE, 1), **_keys(self.interface, _INTERFACE_PARTS, 1)}
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> Quantities:
         """The final state of a run.json (:meth:`RunSummary.to_json`)."""
         if "normal_force" not in d:
-            friction = None
-            if "friction_bound" in d:
-                friction = Friction(d["tangential_force"], d["friction_bound"], d["stick_size"],
-                                    d["slip_fraction"], d["friction_excess"])  # fmt: skip
-            return cls(d["force"], d["contact_half_width"], d["peak_pressure"],
-                       d["max_penetration"], d["complementarity"], friction=friction)  # fmt: skip
-        known = {
-            "normal_force",
-            "tangential_force",
-            "closed_length",
-            "max_penetration",
-            "max_pressure",
-            "complementarity",
-            "proppant_force",
-            "min_aperture_propped",
-        }
-        core = {f.name for f in dataclasses.fields(RunSummary)} | {
-            "status", "newton_iterations", "ksp_iterations", "outer_iterations", "force",
-            "peak_pressure"}  # fmt: skip
-        extra = {k: v for k, v in d.items() if k not in known | core}
-        interface = InterfaceQuantities(d["tangential_force"], d.get("proppant_force"),
-                                        d.get("min_aperture_propped"), extra)  # fmt: skip
-        return cls(d["normal_force"], d["closed_length"], d["max_pressure"],
-                   d["max_penetration"], d["complementarity"], interface=interface)  # fmt: skip
+            friction = Friction(**_attrs(d, _FRICTION)) if "friction_bound" in d else None
+            return cls(**_attrs(d, _OBSTACLE), friction=friction)
+        known = {f.name for f in dataclasses.fields(RunSummary)} | set(_OBSTACLE) | set(
+            _INTERFACE) | set(_INTERFACE_PARTS) | {"status", "newton_iterations",
+            "ksp_iterations", "outer_iterations", "plot"}  # fmt: skip
+        extra = {k: v for k, v in d.items() if k not in known}
+        interface = InterfaceQuantities(**_attrs(d, _INTERFACE_PARTS), extra=extra)
+        return cls(**_attrs(d, _INTERFACE), interface=interface)
 
-    def step_json(self) -> dict[str, Any]:
-        """The per-step subset written into run.json's ``steps``."""
-        if self.interface is None:
-            out = {"force": self.force, "contact_half_width": self.contact_size}
-            if self.friction is not None:
-                out.update(tangential_force=self.friction.tangential_force,
-                           stick_size=self.friction.stick_size)  # fmt: skip
-            return out
-        return {"normal_force": self.force, "tangential_force": self.interface.tangential_force}
+
+#: run.json key -> attribute, for each part of the state (the keys the README documents)
+_OBSTACLE = {"force": "force", "contact_half_width": "contact_size",
+             "peak_pressure": "peak_pressure", "max_penetration": "max_penetration",
+             "complementarity": "complementarity"}  # fmt: skip
+_FRICTION = {"tangential_force": "tangential_force", "stick_size": "stick_size",
+             "friction_bound": "bound", "slip_fraction": "slip_fraction",
+             "friction_excess": "excess"}  # fmt: skip
+_INTERFACE = {"normal_force": "force", "closed_length": "contact_size",
+              "max_pressure": "peak_pressure", "max_penetration": "max_penetration",
+              "complementarity": "complementarity"}  # fmt: skip
+_INTERFACE_PARTS = {"tangential_force": "tangential_force", "proppant_force": "proppant_force",
+                    "min_aperture_propped": "min_aperture_propped"}  # fmt: skip
+
+
+def _keys(obj, table: dict[str, str], n: int | None = None) -> dict:
+    """{key: obj.attribute} over the table's first n entries (None values left out)."""
+    if obj is None:
+        return {}
+    items = list(table.items())[:n]
+    return {k: getattr(obj, a) for k, a in items if getattr(obj, a) is not None}
+
+
+def _attrs(d: dict, table: dict[str, str]) -> dict:
+    """{attribute: d[key]} for the table's keys present in d."""
+    return {a: d[k] for k, a in table.items() if k in d}
 
 
 @dataclass(frozen=True)
