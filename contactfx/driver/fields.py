@@ -12,7 +12,7 @@ from petsc4py import PETSc
 from contactfx import _compat
 
 __all__ = ["vertex_rule", "surface_mask", "at_points", "confine", "assemble_array",
-           "NodalProjection", "global_sum", "zero_pattern"]  # fmt: skip
+           "NodalProjection", "nodal_contact", "global_sum", "zero_pattern"]  # fmt: skip
 
 
 def vertex_rule(fdim: int) -> dict:
@@ -109,6 +109,18 @@ class NodalProjection:
         arr[:] = 0.0
         arr[self.on] = b[self.on] / self.mass[self.on]
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+
+def nodal_contact(p: np.ndarray, gap: np.ndarray, on: np.ndarray, comm):
+    """(peak pressure, closed, max penetration, max |g p|) from the nodal pressure and gap
+    (local arrays of a P1 field) at the surface nodes ``on``; closed marks the local nodes
+    where p > 1e-10 of the peak."""
+    n = len(on)
+    p_s, g_s = p[:n][on], gap[:n][on]
+    peak = comm.allreduce(float(np.max(p_s, initial=0.0)), op=MPI.MAX)
+    penetration = comm.allreduce(max(0.0, -float(g_s.min(initial=0.0))), op=MPI.MAX)
+    complementarity = comm.allreduce(float(np.max(np.abs(g_s * p_s), initial=0.0)), op=MPI.MAX)
+    return peak, p > 1e-10 * max(peak, 1e-300), penetration, complementarity
 
 
 def global_sum(form, comm) -> float:

@@ -14,7 +14,7 @@ from mpi4py import MPI
 from contactfx import _compat
 from contactfx.contact.interface import tangent
 from contactfx.contact.laws import active
-from contactfx.driver.fields import NodalProjection, global_sum
+from contactfx.driver.fields import NodalProjection, global_sum, nodal_contact
 from contactfx.results import InterfaceQuantities, Quantities
 
 __all__ = ["InterfacePost", "Profile", "STATUS"]
@@ -109,26 +109,21 @@ class InterfacePost:
                              dolfinx.fem.form(exact**2 * dSf))  # fmt: skip
         return out
 
-    def _max(self, values, op=MPI.MAX, initial=0.0) -> float:
-        reduce = np.max if op == MPI.MAX else np.min
-        return self.comm.allreduce(float(reduce(values, initial=initial)), op=op)
-
     def evaluate(self, solver) -> Quantities:
         for name, f in self.fields_nodal.items():
             self.nodal(self.forms[name], f)
         on, n = self.nodal.on, len(self.nodal.on)
         st = self.status.x.array
         st[:] = 0.0
-        p = self.fields_nodal["normal_traction"].x.array
-        p_max = self._max(p[:n][on])
-        closed = p > 1e-10 * max(p_max, 1e-300)
+        peak, closed, penetration, complementarity = nodal_contact(
+            self.fields_nodal["normal_traction"].x.array, self.fields_nodal["gap"].x.array, on,
+            self.comm)  # fmt: skip
         st[closed] = STATUS["stick"]
         if "slipping" in self.forms:
             self.nodal(self.forms["slipping"], self._slipping)
             st[closed & (self._slipping.x.array > 0.5)] = STATUS["slip"]
         if "proppant" in self.fields_nodal:
             st[closed & (self.fields_nodal["proppant"].x.array > 0.0)] = STATUS["propped"]
-        gap = self.fields_nodal["gap"].x.array[:n][on]
         interface = InterfaceQuantities(
             tangential_force=0.0 if self.tforce_form is None else global_sum(self.tforce_form,
                                                                              self.comm),
@@ -139,16 +134,16 @@ class InterfacePost:
             propped = on & (self.fields_nodal["proppant"].x.array[:n] > 0.0)
             interface = dataclasses.replace(
                 interface, proppant_force=global_sum(self.propped_form, self.comm),
-                min_aperture_propped=self._max(ap[propped], MPI.MIN, np.inf))  # fmt: skip
+                min_aperture_propped=self.comm.allreduce(float(np.min(ap[propped], initial=np.inf)),
+                                                         op=MPI.MIN))  # fmt: skip
         return Quantities(
             force=global_sum(self.force_form, self.comm),
             contact_size=global_sum(self.closed_form, self.comm),
-            peak_pressure=p_max,
-            max_penetration=self.comm.allreduce(float(max(-gap.min(initial=0.0), 0.0)),
-                                                op=MPI.MAX),
-            complementarity=self._max(np.abs(gap * p[:n][on])),
+            peak_pressure=peak,
+            max_penetration=penetration,
+            complementarity=complementarity,
             interface=interface,
-        )  # fmt: skip
+        )
 
     def fields(self) -> list:
         self.u_out.interpolate(self.u_expr)

@@ -23,6 +23,7 @@ from contactfx.contact.laws import active, positive_part
 from contactfx.driver.fields import (
     NodalProjection,
     global_sum,
+    nodal_contact,
     surface_mask,
     vertex_rule,
     zero_pattern,
@@ -163,13 +164,10 @@ class ObstaclePost:
             proj, pk = self.reaction
             force = self.pb.method.reaction_pressure(solver.inner, self.pb.state, proj.mass, pk)
             self.pressure.interpolate(pk)
-        p_local = self.pressure.x.array
-        p_max = self.comm.allreduce(float(p_local.max(initial=0.0)), op=MPI.MAX)
-        st = self.status.x.array
-        st[:] = (p_local > 1e-10 * max(p_max, 1e-300)).astype(float)  # 0 open, 1 closed (stick)
         self.gap.interpolate(self.gap_expr)
-        n = len(on)
-        gap_s, p_s = self.gap.x.array[:n][on], p_local[:n][on]
+        peak, closed, penetration, complementarity = nodal_contact(
+            self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
+        self.status.x.array[:] = closed  # 0 open, 1 closed (stick)
         measure = global_sum(self.measure_form, self.comm) * self.scene.symmetry
         friction = None
         if self.friction is not None:
@@ -177,13 +175,11 @@ class ObstaclePost:
         return Quantities(
             force=force * self.scene.symmetry,
             contact_size=self.scene.contact_size(measure),
-            peak_pressure=p_max,
-            max_penetration=self.comm.allreduce(float(max(-gap_s.min(initial=0.0), 0.0)),
-                                                op=MPI.MAX),
-            complementarity=self.comm.allreduce(
-                float(np.max(np.abs(gap_s * p_s), initial=0.0)), op=MPI.MAX),
+            peak_pressure=peak,
+            max_penetration=penetration,
+            complementarity=complementarity,
             friction=friction,
-        )  # fmt: skip
+        )
 
     def fields(self) -> list:
         pb = self.pb

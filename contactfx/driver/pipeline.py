@@ -15,7 +15,6 @@ import time
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
-import dolfinx
 from mpi4py import MPI
 
 from contactfx.io.provenance import versions, write_json
@@ -111,13 +110,9 @@ class _Run:
 
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem, forms) -> ContactSNES:
-        a, L, F_c = forms
+        a, L, F_c, J_c = forms
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
         options.update(self.method.snes_options())
-        J_c = None
-        if F_c is not None:
-            J_c = dolfinx.fem.form(problem.derivative(F_c))
-            F_c = dolfinx.fem.form(F_c)
         return ContactSNES(
             problem.state, stiffness=a, load=L, contact_residual=F_c, contact_jacobian=J_c,
             bcs=problem.bcs, prefix=self.prefix, options=options,

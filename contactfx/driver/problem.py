@@ -107,7 +107,8 @@ class Problem:
 
     # -- forms ---------------------------------------------------------------------------
     def forms(self):
-        """(compiled bulk bilinear form, compiled load, contact residual as UFL or None)."""
+        """Compiled: the bulk bilinear form, the load, the contact residual and its consistent
+        Jacobian (None, None for a method without contact terms)."""
         a = self.bulk_form()
         L = self.scene.load(self.v_load, self.ds, self.tload)
         if L is None:
@@ -116,11 +117,12 @@ class Problem:
                 * ufl.dx
             )
         L = self.extra_load(L)
-        return dolfinx.fem.form(a), dolfinx.fem.form(L), self.method.residual(self.surface)
-
-    def derivative(self, F):
-        """The consistent Jacobian form of a residual in the state."""
-        return ufl.derivative(F, self.state, self.trial)
+        F = self.method.residual(self.surface)
+        compiled = [dolfinx.fem.form(a), dolfinx.fem.form(L)]
+        if F is None:
+            return (*compiled, None, None)
+        J = ufl.derivative(F, self.state, self.trial)
+        return (*compiled, dolfinx.fem.form(F), dolfinx.fem.form(J))
 
     def extra_load(self, L):
         return L
