@@ -17,6 +17,8 @@ dolfinx >= 0.8).
 
 from __future__ import annotations
 
+import functools
+
 import dolfinx
 import numpy as np
 import ufl
@@ -137,13 +139,17 @@ class InterfaceProblem(Problem):
         return L + self.fluid * ufl.dot(s.v, s.interface_normal()) * self.dSc
 
     # -- what the methods use ----------------------------------------------------------------
-    @property
+    @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
         return self.free_mask(self.multiplier.function_space)
 
+    @functools.cached_property
+    def _multiplier_projection(self) -> NodalProjection:
+        return NodalProjection(self.dS_nodal, self.multiplier.function_space, "+")
+
     def nodal_update(self, expr):
         """The nodal values of an interior-facet quantity: a vertex-rule lumped projection."""
-        proj = NodalProjection(self.dS_nodal, self.multiplier.function_space, "+")
+        proj = self._multiplier_projection
         form = proj.form(expr)
         return lambda target: proj(form, target)
 

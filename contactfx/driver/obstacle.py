@@ -10,6 +10,7 @@ complementarity, friction quantities, and the errors against the scene's closed 
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import dolfinx
 import numpy as np
@@ -92,7 +93,7 @@ class ObstacleProblem(Problem):
         return a
 
     # -- what the methods use ----------------------------------------------------------------
-    @property
+    @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
         Q = self.multiplier.function_space
         return surface_mask(Q, self.fdim, self.contact_facets)
