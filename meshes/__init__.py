@@ -17,8 +17,12 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
     )
     top = data.facet_tags.find(RectangleFacets.TOP)
 
-Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,joint-column} ...
---out mesh.msh``.
+Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.two_body`: the
+bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
+:func:`spheres`, :func:`punch_foundation`.
+
+Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,joint-column,
+stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation} ... --out mesh.msh``.
 """
 
 from contactfx.meshes._build import Builder, MeshData, MshInfo, build, write_msh
@@ -26,6 +30,23 @@ from contactfx.meshes.box import BoxCells, BoxFacets, box
 from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
+from contactfx.meshes.two_body import (
+    CylindersCells,
+    CylindersFacets,
+    PunchFoundationCells,
+    PunchFoundationFacets,
+    SpheresCells,
+    SpheresFacets,
+    StackedBlocksCells,
+    StackedBlocksFacets,
+    StackedBoxesCells,
+    StackedBoxesFacets,
+    cylinders,
+    punch_foundation,
+    spheres,
+    stacked_blocks,
+    stacked_boxes,
+)
 
 __all__ = [
     "BoxCells",
@@ -33,16 +54,31 @@ __all__ = [
     "Builder",
     "CrackPlateCells",
     "CrackPlateFacets",
+    "CylindersCells",
+    "CylindersFacets",
     "JointColumnCells",
     "JointColumnFacets",
     "MeshData",
     "MshInfo",
+    "PunchFoundationCells",
+    "PunchFoundationFacets",
     "RectangleCells",
     "RectangleFacets",
+    "SpheresCells",
+    "SpheresFacets",
+    "StackedBlocksCells",
+    "StackedBlocksFacets",
+    "StackedBoxesCells",
+    "StackedBoxesFacets",
     "box",
     "build",
     "crack_plate",
+    "cylinders",
     "joint_column",
+    "punch_foundation",
     "rectangle",
+    "spheres",
+    "stacked_blocks",
+    "stacked_boxes",
     "write_msh",
 ]

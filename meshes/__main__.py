@@ -9,6 +9,12 @@ Examples::
     python3 -m contactfx.meshes crack-plate --half-width 1 --crack-half-length 0.2 --angle 30 \
         --h-crack 0.005 --h-far 0.1 --split-at -0.1 0.1 --out crack.msh
     python3 -m contactfx.meshes joint-column --width 1 --block-height 1 --h 0.05 --out joint.msh
+    python3 -m contactfx.meshes stacked-blocks --width 1 --h-lower 0.5 --h-upper 0.5 --h1 0.05 \\
+        --ratio 0.7 --offset 0.3 --out blocks.msh
+    python3 -m contactfx.meshes cylinders --radius-lower 2 --radius-upper 1 --h-contact 0.01 \\
+        --h-far 0.1 --refine 0.1 --ratio 0.6 --out cylinders.msh
+    python3 -m contactfx.meshes punch-foundation --width 3 --depth 2 --b 1 --rho 0.25 \\
+        --h-punch 0.8 --h-contact 0.01 --h-far 0.2 --refine 0.05 --ratio 1.3 --out punch.msh
 
 Invalid parameters print a one-line error to stderr and exit with code 2.
 """
@@ -26,6 +32,13 @@ from contactfx.meshes.box import box
 from contactfx.meshes.crack_plate import crack_plate
 from contactfx.meshes.joint_column import joint_column
 from contactfx.meshes.rectangle import rectangle
+from contactfx.meshes.two_body import (
+    cylinders,
+    punch_foundation,
+    spheres,
+    stacked_blocks,
+    stacked_boxes,
+)
 
 __all__ = ["main"]
 
@@ -53,6 +66,38 @@ def _add_output(parser: argparse.ArgumentParser) -> None:
     """Add the model name and the output file."""
     parser.add_argument("--name", help="gmsh model name (default: the output file's stem)")
     parser.add_argument("--out", type=Path, required=True, help="output .msh file")
+
+
+def _add_two_body(parser: argparse.ArgumentParser) -> None:
+    """Add the size ratio and the offset of the two-body geometries."""
+    parser.add_argument(
+        "--ratio", type=float, required=True, help="element size of body 2 / body 1 at the contact"
+    )
+    parser.add_argument(
+        "--offset",
+        type=float,
+        default=0.0,
+        help="shift of body 2's contact nodes, fraction of an element in [0, 1) (0)",
+    )
+
+
+def _add_stacked(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--width", type=float, required=True, metavar="W")
+    parser.add_argument("--upper-width", type=float, metavar="W", help="default: --width")
+    parser.add_argument("--h-lower", type=float, required=True, metavar="H", help="height")
+    parser.add_argument("--h-upper", type=float, required=True, metavar="H", help="height")
+    parser.add_argument("--h1", type=float, required=True, metavar="H", help="lower mesh size")
+    _add_two_body(parser)
+    _add_output(parser)
+
+
+def _add_graded_two_body(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--h-contact", type=float, required=True, metavar="H")
+    parser.add_argument("--h-far", type=float, required=True, metavar="H")
+    parser.add_argument("--refine", type=float, required=True, metavar="D")
+    _add_grading(parser)
+    _add_two_body(parser)
+    _add_output(parser)
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -97,6 +142,32 @@ def _parser() -> argparse.ArgumentParser:
     joint.add_argument("--block-height", type=float, required=True, metavar="H")
     joint.add_argument("--h", type=float, required=True, metavar="H")
     _add_output(joint)
+
+    blocks = geometries.add_parser(
+        "stacked-blocks", help="2D: two blocks touching along y = 0, non-matching meshes"
+    )
+    _add_stacked(blocks)
+    boxes = geometries.add_parser(
+        "stacked-boxes", help="3D: two boxes touching along z = 0, non-matching meshes"
+    )
+    _add_stacked(boxes)
+    for name, help_text in (
+        ("cylinders", "2D: quarter model of two cylinders touching at the origin"),
+        ("spheres", "3D: eighth model of two spheres touching at the origin"),
+    ):
+        round_bodies = geometries.add_parser(name, help=help_text)
+        round_bodies.add_argument("--radius-lower", type=float, required=True, metavar="R")
+        round_bodies.add_argument("--radius-upper", type=float, required=True, metavar="R")
+        _add_graded_two_body(round_bodies)
+    punch = geometries.add_parser(
+        "punch-foundation", help="2D: half model of a rounded flat punch on a block"
+    )
+    punch.add_argument("--width", type=float, required=True, metavar="W", help="block half width")
+    punch.add_argument("--depth", type=float, required=True, metavar="D", help="block depth")
+    punch.add_argument("--b", type=float, required=True, metavar="B", help="punch half width")
+    punch.add_argument("--rho", type=float, required=True, metavar="R", help="edge radius")
+    punch.add_argument("--h-punch", type=float, required=True, metavar="H", help="punch height")
+    _add_graded_two_body(punch)
     return parser
 
 
@@ -126,8 +197,32 @@ def main(argv: Sequence[str] | None = None) -> int:
             angle=args.angle, h_crack=args.h_crack, h_far=args.h_far, grading=args.grading,
             split_at=tuple(args.split_at),
         )  # fmt: skip
-    else:
+    elif args.geometry == "joint-column":
         builder = partial(joint_column, width=args.width, block_height=args.block_height, h=args.h)
+    elif args.geometry in ("stacked-blocks", "stacked-boxes"):
+        if args.geometry == "stacked-boxes":
+            gdim, cells = 3, "tetrahedra"
+        builder = partial(
+            stacked_blocks if gdim == 2 else stacked_boxes,
+            width=args.width, h_lower=args.h_lower, h_upper=args.h_upper, h1=args.h1,
+            ratio=args.ratio, offset=args.offset, upper_width=args.upper_width,
+        )  # fmt: skip
+    elif args.geometry in ("cylinders", "spheres"):
+        if args.geometry == "spheres":
+            gdim, cells = 3, "tetrahedra"
+        builder = partial(
+            cylinders if gdim == 2 else spheres,
+            radius_lower=args.radius_lower, radius_upper=args.radius_upper,
+            h_contact=args.h_contact, h_far=args.h_far, refine=args.refine,
+            ratio=args.ratio, offset=args.offset, grading=args.grading,
+        )  # fmt: skip
+    else:
+        builder = partial(
+            punch_foundation,
+            width=args.width, depth=args.depth, b=args.b, rho=args.rho, h_punch=args.h_punch,
+            h_contact=args.h_contact, h_far=args.h_far, refine=args.refine,
+            ratio=args.ratio, offset=args.offset, grading=args.grading,
+        )  # fmt: skip
     try:
         info = write_msh(builder, gdim, args.out, args.name or args.out.stem)
     except (ValueError, OSError) as exc:
