@@ -37,6 +37,8 @@ class _General:
                              "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
+    search_update: str = param("step", "two-body contact search: once per load step, or at "
+                               "every Newton iteration", choices=("step", "newton"))  # fmt: skip
 
 
 def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:

@@ -32,11 +32,12 @@ __all__ = ["Supports", "ContactMethod", "MethodBase"]
 
 @dataclass(frozen=True)
 class Supports:
-    """What a method handles. ``why_not`` maps a capability name (``friction``, ``mixed_up``,
-    ``nodal_quadrature``, ``interfaces``, ``dim1``, ``iterative``) to the reason it is not
+    """What a method handles. ``why_not`` maps a capability name (``friction``, ``obstacles``,
+    ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``dim1``, ``iterative``) to the reason it is not
     supported, quoted in the error a user sees."""
 
     friction: tuple[str, ...] = ("none",)
+    obstacles: bool = True
     mixed_up: bool = False
     nodal_quadrature: bool = False
     interfaces: bool = False
@@ -88,6 +89,12 @@ class MethodBase:
 
     def snes_options(self) -> dict[str, object]:
         return {}
+
+    def coupling(self, pair):
+        """The terms between two separately meshed bodies
+        (:class:`contactfx.contact.coupling.Coupling`) of a contact ``pair``
+        (:class:`contactfx.contact.pair.ContactPair`); only methods that support two bodies."""
+        raise NotImplementedError(f"method {self.name} has no two-body coupling")
 
     def attach(self, solver, problem):
         """The solver the load program drives (``solver`` itself unless wrapped)."""

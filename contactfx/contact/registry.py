@@ -16,6 +16,7 @@ METHODS: dict[str, str] = {
     "vi": "contactfx.contact.bounds:BoundConstraints",
     "al-uzawa": "contactfx.contact.augmented_lagrangian:AugmentedLagrangianUzawa",
     "al-ssn": "contactfx.contact.augmented_lagrangian:AugmentedLagrangianSSN",
+    "mortar": "contactfx.contact.mortar:Mortar",
 }
 
 

@@ -32,7 +32,7 @@ from contactfx.driver.fields import (
 from contactfx.driver.problem import Problem
 from contactfx.results import Friction, Quantities
 
-__all__ = ["ObstacleProblem"]
+__all__ = ["ObstacleProblem", "closed_form_errors"]
 
 
 class ObstacleProblem(Problem):
@@ -40,6 +40,9 @@ class ObstacleProblem(Problem):
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
+        if not method.supports.obstacles:
+            raise ValueError(f"method {method.name} is not offered against rigid obstacles ("
+                             f"{method.supports.why_not.get('obstacles', '')})")  # fmt: skip
         if numerics.formulation == "mixed-up" and not scene.material().lmbda > 0.0:
             raise ValueError(f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = "
                              f"{scene.material().nu}")  # fmt: skip
@@ -121,6 +124,30 @@ class ObstacleProblem(Problem):
         return ObstaclePost(self)
 
 
+def closed_form_errors(scene, q: Quantities) -> dict[str, float]:
+    """The scene's closed forms at the computed force (``scene.reference``) with the relative
+    errors of the computed force, contact size ``a`` and peak pressure ``p0``."""
+    ref = scene.reference(q.force)
+    reference: dict[str, float] = {}
+    if "force" in ref:
+        reference["force"] = ref["force"]
+        reference["force_rel_error"] = abs(q.force - ref["force"]) / abs(ref["force"])
+    for key, computed in (("a", q.contact_size), ("p0", q.peak_pressure)):
+        if key in ref:
+            reference.update(
+                {
+                    key: ref[key],
+                    f"{key}_computed": computed,
+                    f"{key}_rel_error": abs(computed - ref[key]) / abs(ref[key]),
+                }
+            )
+    if "a" in ref:
+        reference["a_error_over_h"] = abs(q.contact_size - ref["a"]) / scene.h_contact()
+    for key, value in ref.items():
+        reference.setdefault(key, value)
+    return reference
+
+
 class ObstaclePost:
     """Contact force, pressure, contact size, penetration, friction quantities and field
     errors, compiled once."""
@@ -194,28 +221,11 @@ class ObstaclePost:
 
     def finish(self, q: Quantities, out) -> dict:
         """Closed-form comparisons, pointwise scores and field errors of the final state."""
-        ref = self.scene.reference(q.force)
-        reference: dict[str, float] = {}
-        if "force" in ref:
-            reference["force"] = ref["force"]
-            reference["force_rel_error"] = abs(q.force - ref["force"]) / abs(ref["force"])
-        for key, computed in (("a", q.contact_size), ("p0", q.peak_pressure)):
-            if key in ref:
-                reference.update(
-                    {
-                        key: ref[key],
-                        f"{key}_computed": computed,
-                        f"{key}_rel_error": abs(computed - ref[key]) / abs(ref[key]),
-                    }
-                )
-        if "a" in ref:
-            reference["a_error_over_h"] = abs(q.contact_size - ref["a"]) / self.scene.h_contact()
-        for key, value in ref.items():
-            reference.setdefault(key, value)
+        reference = closed_form_errors(self.scene, q)
         if q.friction is not None:
             reference.update(self.scene.friction_reference(q, self.pb.friction))
         return {"reference": reference, "scores": self.scores(q.force),
-                "errors": self.errors.evaluate(ref)}  # fmt: skip
+                "errors": self.errors.evaluate(self.scene.reference(q.force))}  # fmt: skip
 
     def scores(self, force: float) -> dict[str, float]:
         on = self.nodal.on

@@ -127,6 +127,10 @@ class Problem:
     def extra_load(self, L):
         return L
 
+    def coupling(self):
+        """The solver's two-body coupling (:mod:`contactfx.contact.coupling`), or None."""
+        return None
+
     def converged(self) -> None:
         """A step converged: it is the history of the next."""
         if self.prev is not None:

@@ -35,12 +35,14 @@ class Elastic:
     E: Young's modulus (stress units, > 0); nu: Poisson's ratio in (-1, 0.5). modulus: optional
     field of Young's modulus over the mesh (a UFL expression, e.g. a DG0 Function) that replaces
     E in the stress of a heterogeneous (layered) body; E stays the reference modulus of the
-    closed forms, and the properties mu, lmbda, E_star, M are its floats.
+    closed forms, and the properties mu, lmbda, E_star, M are its floats. poisson: optional field
+    of Poisson's ratio (bodies of different materials in one mesh), likewise.
     """
 
     E: float
     nu: float
     modulus: object = None
+    poisson: object = None
 
     def __post_init__(self) -> None:
         if not self.E > 0.0:
@@ -69,7 +71,7 @@ class Elastic:
     def _moduli(self):
         """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""
         E = self.E if self.modulus is None else self.modulus
-        nu = self.nu
+        nu = self.nu if self.poisson is None else self.poisson
         return E, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
 
     def sigma(self, u, p=None):
@@ -96,7 +98,8 @@ class Elastic:
         if d == 1:
             return abs(s[0, 0])
         if d == 2:  # plane strain: add sigma_zz = nu (sigma_xx + sigma_yy), = -p when mixed
-            szz = self.nu * (s[0, 0] + s[1, 1]) if p is None else -p
+            nu = self.nu if self.poisson is None else self.poisson
+            szz = nu * (s[0, 0] + s[1, 1]) if p is None else -p
             dev = s - (s[0, 0] + s[1, 1] + szz) / 3.0 * ufl.Identity(2)
             j2 = 0.5 * (ufl.inner(dev, dev) + (szz - (s[0, 0] + s[1, 1] + szz) / 3.0) ** 2)
         else:

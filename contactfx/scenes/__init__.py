@@ -10,6 +10,7 @@ from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.sliding_block import SlidingBlock
+from contactfx.scenes.two_body import HertzCylinders, PatchTest
 from contactfx.scenes.westergaard import Westergaard
 
 __all__ = ["SCENES", "get_scene", "Scene", "Numerics"]
@@ -28,6 +29,8 @@ SCENES: dict[str, type[Scene]] = {
         CrackInclined,
         ProppedFracture,
         JointColumn,
+        PatchTest,
+        HertzCylinders,
     )
 }
 

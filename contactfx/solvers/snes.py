@@ -174,12 +174,14 @@ class ContactSNES:
         options: Mapping[str, object] | None = None,
         user_options: Mapping[str, object] | None = None,
         near_nullspace: bool = False,
+        coupling=None,
     ) -> None:
         self.u = u
         self.comm = u.function_space.mesh.comm
         self.bcs = list(bcs)
         self._a_c = contact_jacobian
         self._F_c = contact_residual
+        self.coupling = coupling
         self.prefix = prefix
         self.user_options = dict(user_options or {})
         self.timer = Timer()
@@ -189,6 +191,8 @@ class ContactSNES:
         self.load_form = load
         self.b = _compat.create_vector(load)
         self.J = self.K.duplicate(copy=True)
+        if coupling is not None:  # couplings between the bodies' dofs appear with the search
+            self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
         self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
         self.timer.assembly += time.perf_counter() - t0
@@ -253,13 +257,20 @@ class ContactSNES:
         if self._F_c is not None:
             _compat.assemble_vector(self.fc, self._F_c)
             F.axpy(1.0, self.fc)
+        if self.coupling is not None:
+            if self.coupling.search_each_newton:
+                self.coupling.update(self.u.x.array)
+            self.coupling.residual(x, F)
         dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
         self.timer.assembly += time.perf_counter() - t0
 
     def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
         t0 = time.perf_counter()
         self._sync(x)
-        self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        if self.coupling is not None:
+            self.coupling.jacobian(x, self.K, J)
+        else:
+            self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         if self._a_c is not None:
             _compat.assemble_matrix(self.Jc, self._a_c)
             J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
@@ -299,6 +310,8 @@ class ContactSNES:
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
         self._late = False
+        if self.coupling is not None:  # the search of this load step
+            self.coupling.update(self.u.x.array)
         try:
             self.snes.solve(None, x)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash

@@ -1,0 +1,186 @@
+"""Contact pairs between separately meshed bodies: the two surfaces, their current
+configuration, and the search for the opposite surface across ranks.
+
+A *side* is one body's contact surface on this rank: its owned facets (segments in 2D,
+triangles in 3D) of a P1 vector space, each with the local and global node (dof block)
+indices of its vertices, ordered so that the facet's normal (:func:`facet_normals`) points out
+of the body. The current configuration is x = X + u at the vertices.
+
+Search across ranks (:func:`gather_near`): every rank publishes the bounding box of the
+region it searches (its slave facets in the current configuration, enlarged by the search
+radius); every rank sends each other rank the master facets (current coordinates and global
+node indices) that meet that box; candidates are then found in a bounding-box tree of the
+received facets (:class:`contactfx._compat.FacetTree`, dolfinx.geometry). The cost is one
+``alltoall`` of the facets near each rank's slave region: at 1 rank nothing is sent, at p
+ranks each master facet is sent to the ranks whose slave region it meets (usually one or
+two), never the whole surface to everybody.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from mpi4py import MPI
+
+from contactfx import _compat
+
+__all__ = ["Side", "Facets", "ContactPair", "side_of", "facet_normals", "gather_near",
+           "owners"]  # fmt: skip
+
+
+@dataclass
+class Facets:
+    """Facets in the current configuration: ``x`` (m, d, gdim) vertex coordinates and
+    ``nodes`` (m, d) global node (dof block) indices."""
+
+    x: np.ndarray
+    nodes: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.nodes)
+
+    def diameter(self) -> float:
+        """The largest edge length (0 for no facet)."""
+        if len(self) == 0:
+            return 0.0
+        d = self.x.shape[1]
+        edges = [np.linalg.norm(self.x[:, i] - self.x[:, (i + 1) % d], axis=1)
+                 for i in range(d if d > 2 else 1)]  # fmt: skip
+        return float(np.max(edges))
+
+
+@dataclass
+class Side:
+    """One body's contact surface on this rank (owned facets). ``local`` (m, d): local node
+    indices of the vertices (of the P1 vector space's index map), ``nodes`` (m, d): their
+    global indices, ``X`` (m, d, gdim): reference coordinates."""
+
+    tag: int
+    local: np.ndarray
+    nodes: np.ndarray
+    X: np.ndarray
+
+    def current(self, u: np.ndarray) -> Facets:
+        """The facets at x = X + u; ``u`` the local (owned + ghost) array, blocked (n, gdim)."""
+        return Facets(self.X + u[self.local], self.nodes)
+
+    def __len__(self) -> int:
+        return len(self.local)
+
+
+def side_of(V, facet_tags, tag: int) -> Side:
+    """The owned facets tagged ``tag`` of the P1 vector space V, oriented outwards."""
+    mesh = V.mesh
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
+    mesh.topology.create_connectivity(fdim, tdim)
+    mesh.topology.create_connectivity(fdim, 0)
+    mesh.topology.create_connectivity(tdim, 0)
+    n_owned = mesh.topology.index_map(fdim).size_local
+    facets = facet_tags.indices[facet_tags.values == tag]
+    facets = facets[facets < n_owned]
+    f2c = mesh.topology.connectivity(fdim, tdim)
+    f2v = mesh.topology.connectivity(fdim, 0)
+    c2v = mesh.topology.connectivity(tdim, 0)
+    gdim = mesh.geometry.dim
+    X = _compat.dof_coordinates(V)[:, :gdim]
+    d = fdim + 1
+    local = np.zeros((len(facets), d), dtype=np.int64)
+    inward = np.zeros((len(facets), gdim))
+    for i, f in enumerate(facets):
+        cell = f2c.links(f)[0]
+        vertices = f2v.links(f)
+        cell_vertices = c2v.links(cell)
+        dofs = V.dofmap.cell_dofs(cell)
+        # P1: the cell's dofs follow its vertices
+        local[i] = [dofs[np.flatnonzero(cell_vertices == v)[0]] for v in vertices]
+        inward[i] = X[dofs].mean(axis=0)
+    Xf = X[local]
+    normals = facet_normals(Xf)
+    flip = np.einsum("ij,ij->i", normals, inward - Xf.mean(axis=1)) > 0.0
+    local[flip, :2] = local[flip, 1::-1]
+    imap = V.dofmap.index_map
+    nodes = np.asarray(imap.local_to_global(local.ravel().astype(np.int32)), dtype=np.int64)
+    return Side(tag, local, nodes.reshape(local.shape), X[local])
+
+
+def facet_normals(x: np.ndarray) -> np.ndarray:
+    """Unit normals of facets (m, d, gdim): (t_y, -t_x) for a segment with t = x1 - x0
+    (outward for a body on the left of t), (x1 - x0) x (x2 - x0) normalised for a triangle."""
+    if x.shape[1] == 2:
+        t = x[:, 1] - x[:, 0]
+        n = np.stack([t[:, 1], -t[:, 0]], axis=1)
+    else:
+        n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def _boxes_meet(lo: np.ndarray, hi: np.ndarray, box: np.ndarray) -> np.ndarray:
+    return np.all((hi >= box[0]) & (lo <= box[1]), axis=1)
+
+
+def gather_near(comm, master: Facets, region: Facets, radius: float) -> Facets:
+    """The master facets of every rank that meet this rank's ``region`` (its bounding box
+    enlarged by ``radius``), in rank order. Collective."""
+    gdim = master.x.shape[2]
+    if len(region):
+        box = np.stack([region.x.min(axis=(0, 1)) - radius, region.x.max(axis=(0, 1)) + radius])
+    else:
+        box = np.stack([np.full(gdim, np.inf), np.full(gdim, -np.inf)])
+    boxes = comm.allgather(box)
+    if comm.size == 1:
+        keep = _boxes_meet(master.x.min(axis=1), master.x.max(axis=1), boxes[0])
+        return Facets(master.x[keep], master.nodes[keep])
+    lo, hi = master.x.min(axis=1), master.x.max(axis=1)
+    sends = []
+    for b in boxes:
+        keep = _boxes_meet(lo, hi, b)
+        sends.append((master.x[keep], master.nodes[keep]))
+    received = comm.alltoall(sends)
+    d = master.x.shape[1]
+    x = np.concatenate([r[0] for r in received]).reshape(-1, d, gdim)
+    nodes = np.concatenate([r[1] for r in received]).reshape(-1, d)
+    return Facets(x, nodes)
+
+
+def owners(imap, comm) -> np.ndarray:
+    """The first global index of every rank's owned range (and the total), for
+    ``np.searchsorted(ranges, i, side='right') - 1`` = the owner of global index i."""
+    start = imap.local_range[0]
+    return np.array(comm.allgather(start) + [imap.size_global], dtype=np.int64)
+
+
+def global_max(comm, value: float) -> float:
+    return comm.allreduce(value, op=MPI.MAX)
+
+
+@dataclass
+class ContactPair:
+    """A (slave, master) pair of contact surfaces of one mesh's bodies, the node layout of the
+    displacement, the modulus E that scales the methods' parameters, the search policy, and
+    the search's counters (number of searches, wall time)."""
+
+    layout: object
+    slave: Side
+    master: Side
+    E: float
+    search_each_newton: bool = False
+    searches: int = 0
+    search_time: float = 0.0
+    radius: float = field(default=0.0)
+
+    def search(self, slave: Facets, master: Facets):
+        """The master facets near this rank's slave facets (from every rank) and the candidate
+        pairs (slave facet, near master facet) whose boxes, enlarged by the search radius (the
+        largest facet of either surface), meet. Collective."""
+        t0 = time.perf_counter()
+        comm = self.layout.comm
+        self.radius = global_max(comm, max(slave.diameter(), master.diameter()))
+        near = gather_near(comm, master, slave, self.radius)
+        tree = _compat.FacetTree(near.x, self.radius)
+        pairs = tree.collide(_compat.FacetTree(slave.x, 0.0))
+        self.searches += 1
+        self.search_time += time.perf_counter() - t0
+        return near, pairs

@@ -1,0 +1,154 @@
+"""The two-body problem kind: separately meshed elastic bodies in one dolfinx mesh (they share
+no node), a material per body, and a contact pair (slave surface, master surface) enforced by
+a two-body method's coupling (:mod:`contactfx.contact.coupling`).
+
+Unknown: the P1 displacement of all bodies. Surface: the pair's two sides
+(:class:`contactfx.contact.pair.ContactPair`). Post-processing: the contact force of the pair,
+the nodal pressure and gap on the slave surface, the contact size, penetration and
+complementarity, and the errors against the scene's closed forms.
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contactfx import _compat
+from contactfx.contact.coupling import NodeLayout
+from contactfx.contact.pair import ContactPair, side_of
+from contactfx.driver.fields import nodal_contact
+from contactfx.driver.obstacle import closed_form_errors
+from contactfx.driver.problem import Problem
+from contactfx.results import Quantities
+
+__all__ = ["TwoBodyProblem", "TwoBodyPost"]
+
+
+class TwoBodyProblem(Problem):
+    """Bodies in contact through a pair of non-matching surfaces (see the module docstring)."""
+
+    @classmethod
+    def check(cls, scene, numerics, method) -> None:
+        from contactfx.contact.registry import methods_supporting
+
+        if not method.supports.two_body:
+            raise ValueError(
+                f"method {method.name} is not offered between two meshed bodies ("
+                f"{method.supports.why_not.get('two_body', 'not implemented')}); use "
+                + ", ".join(methods_supporting(lambda c: c.two_body))
+            )
+        if numerics.degree != 1:
+            raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
+        if numerics.formulation != "displacement":
+            raise ValueError("two-body contact uses --formulation displacement")
+        if scene.slave_tag == scene.master_tag:
+            raise ValueError("the slave and master surfaces of a contact pair must differ")
+
+    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+        self.contact_facets = facet_tags.indices[facet_tags.values == scene.slave_tag]
+        super().__init__(scene, numerics, method, mesh, facet_tags)
+
+    def material_of(self, mesh):
+        return self.scene.body_material(mesh)
+
+    def boundary_conditions(self) -> list:
+        return self.scene.dirichlet(self.V, self.facet_tags)
+
+    def make_surface(self):
+        mesh, scene, comm = self.mesh, self.scene, self.mesh.comm
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
+        self.v_load = self.V_test
+        for tag, what in ((scene.slave_tag, "slave"), (scene.master_tag, "master")):
+            count = comm.allreduce(int(np.sum(self.facet_tags.values == tag)), op=MPI.SUM)
+            if count == 0:
+                raise ValueError(f"the {what} surface (facet tag {tag}) has no facet")
+        self.layout = NodeLayout(self.V)
+        self.pair = ContactPair(
+            self.layout, side_of(self.V, self.facet_tags, scene.slave_tag),
+            side_of(self.V, self.facet_tags, scene.master_tag), scene.contact_modulus(),
+            search_each_newton=self.num.search_update == "newton",
+        )  # fmt: skip
+        return None
+
+    def coupling(self):
+        if not hasattr(self, "_coupling"):
+            self._coupling = self.method.coupling(self.pair)
+        return self._coupling
+
+    def bulk_form(self):
+        eps = ufl.sym(ufl.grad(self.V_test))
+        return ufl.inner(self.material.sigma(self.dU), eps) * ufl.dx
+
+    # -- load program ------------------------------------------------------------------------
+    def apply_load(self, t: float) -> None:
+        self.tload.value = t
+        self.scene.set_load(t)
+
+    def start(self, solver) -> None:
+        """From the undeformed state (the Dirichlet values are set by the solve)."""
+
+    def post_processor(self) -> TwoBodyPost:
+        return TwoBodyPost(self)
+
+
+class TwoBodyPost:
+    """The contact state of the pair on the slave nodes, and the fields for ParaView."""
+
+    def __init__(self, pb: TwoBodyProblem) -> None:
+        self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
+        mesh = pb.mesh
+        self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
+        self.pressure = dolfinx.fem.Function(self.Q1, name="contact_pressure")
+        self.gap = dolfinx.fem.Function(self.Q1, name="gap")
+        self.status = dolfinx.fem.Function(self.Q1, name="contact_status")
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        self.vm = dolfinx.fem.Function(DG0, name="von_mises")
+        self.vm_expr = _compat.expression(pb.material.von_mises(pb.state), DG0)
+        self.start = pb.layout.start
+        self.x = _compat.dof_coordinates(self.Q1)
+
+    def evaluate(self, solver) -> Quantities:
+        nodes, D, lam, gap = self.pb.coupling().nodal()
+        local = (nodes - self.start).astype(np.int64)
+        on = np.zeros(self.pb.layout.n_owned, dtype=bool)
+        on[local] = True
+        for f, values in ((self.pressure, lam), (self.gap, gap)):
+            f.x.array[:] = 0.0
+            f.x.array[local] = values
+            f.x.scatter_forward()
+        peak, closed, penetration, complementarity = nodal_contact(
+            self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
+        self.status.x.array[:] = closed
+        sym = self.scene.symmetry
+        force = self.comm.allreduce(float(np.sum(D * lam)), op=MPI.SUM) * sym
+        measure = self.comm.allreduce(float(np.sum(D[closed[local]])), op=MPI.SUM) * sym
+        size = self.scene.contact_size(measure)
+        x = self.x[local][closed[local]]
+        x_all = np.concatenate(self.comm.allgather(x))
+        p_all = np.concatenate(self.comm.allgather(lam[closed[local]]))
+        edge = self.scene.contact_edge(x_all, p_all)
+        return Quantities(
+            force=force,
+            contact_size=size if edge is None else edge,
+            peak_pressure=peak,
+            max_penetration=penetration,
+            complementarity=complementarity,
+        )
+
+    def fields(self) -> list:
+        self.vm.interpolate(self.vm_expr)
+        return [self.pb.state, self.vm, self.pressure, self.gap, self.status]
+
+    def finish(self, q: Quantities, out) -> dict:
+        reference = closed_form_errors(self.scene, q)
+        x = _compat.dof_coordinates(self.Q1)
+        nodes, _, lam, _ = self.pb.coupling().nodal()
+        local = (nodes - self.start).astype(np.int64)
+        scores = self.scene.pressure_scores(x[local], lam, q.force)
+        scores = {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in scores.items()}
+        pair = self.pb.pair
+        scores["searches"] = pair.searches
+        scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
+        return {"reference": reference, "scores": scores, "errors": {}}

@@ -1,0 +1,176 @@
+"""Two-body scenes: the mortar patch test and Hertz contact of two elastic cylinders
+(docs/verification.md section 10).
+
+``patch-test``: two stacked blocks with non-matching meshes (element size ratio ``ratio``, the
+upper block's contact nodes shifted by ``offset`` of an element), pressure q on the top, the
+lower block on rollers at its bottom, both blocks on rollers at x = 0, free to expand
+laterally elsewhere. The exact state is the uniform stress sigma_yy = -q (sigma_xx = 0) in both
+bodies and the uniform contact pressure q; a mortar method with exact segment-based
+integration reproduces it to round-off for any ratio and either slave side (the partition of
+unity sum_k M_jk = D_j).
+
+``hertz-cylinders``: two cylinders of radii R1 (upper), R2 (lower), quarter model with the
+symmetry plane x = 0, pressed together by the prescribed approach ``depth`` of the upper
+body's flat top. At the computed force P per unit length (full model),
+
+    a = sqrt(4 P R / (pi E*)),   p0 = 2 P / (pi a),
+    1/R = 1/R1 + 1/R2,   1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
+
+(Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, section 4.2).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import dolfinx
+import numpy as np
+
+from contactfx import _compat
+from contactfx.meshes import (
+    CylindersCells,
+    CylindersFacets,
+    StackedBlocksCells,
+    StackedBlocksFacets,
+    cylinders,
+    stacked_blocks,
+)
+from contactfx.params import param
+from contactfx.references import hertz_2d
+from contactfx.scenes._common import fix_component
+from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
+
+__all__ = ["PatchTest", "HertzCylinders"]
+
+
+def _component_value(V, facet_tags, tag: int, component: int, value):
+    """u_component = value (a Constant) on the facets tagged ``tag``."""
+    sub = V.sub(component)
+    facets = facet_tags.indices[facet_tags.values == tag]
+    dofs = _compat.locate_dofs_topological(sub, V.mesh.topology.dim - 1, facets)
+    return _compat.dirichletbc(value, dofs, sub)
+
+
+@dataclass(frozen=True)
+class PatchTestParams(two_elastic(1000.0, 0.3)):
+    width: float = param(1.0, "width of the blocks", positive=True)
+    height: float = param(0.5, "height of each block", positive=True)
+    h: float = param(0.1, "element size of the lower block", positive=True)
+    ratio: float = param(0.7, "element size of the upper block / h", positive=True)
+    offset: float = param(0.3, "shift of the upper block's contact nodes (fraction of its "
+                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    pressure: float = param(1.0, "pressure q on the top of the upper block", positive=True)
+
+
+class PatchTest(TwoBodyScene):
+    name = "patch-test"
+    summary = ("two stacked blocks with non-matching meshes under uniform pressure; exact: "
+               "uniform stress and contact pressure")  # fmt: skip
+    Params = PatchTestParams
+    cells = {"lower": StackedBlocksCells.LOWER, "upper": StackedBlocksCells.UPPER}
+    surfaces = {"lower": StackedBlocksFacets.LOWER_TOP, "upper": StackedBlocksFacets.UPPER_BOTTOM}
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(stacked_blocks, width=p.width, h_lower=p.height,
+                                    h_upper=p.height, h1=p.h, ratio=p.ratio,
+                                    offset=p.offset)  # fmt: skip
+        return self.mesh_of(comm, builder, 2)
+
+    def h_contact(self) -> float:
+        return self.p.h
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = StackedBlocksFacets
+        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
+                fix_component(V, facet_tags, f.LOWER_LEFT, 0),
+                fix_component(V, facet_tags, f.UPPER_LEFT, 0)]  # fmt: skip
+
+    def load(self, v, ds, t):
+        return -self.p.pressure * t * v[1] * ds(StackedBlocksFacets.UPPER_TOP)
+
+    def contact_size(self, measure: float) -> float:
+        return measure
+
+    def reference(self, force: float) -> dict[str, float]:
+        """The exact contact force q * width and the uniform pressure q (as p0)."""
+        return {"force": self.p.pressure * self.p.width, "p0": self.p.pressure}
+
+    def pressure_scores(self, x, p, force):
+        """Largest relative deviation of the nodal contact pressure from q."""
+        q = self.p.pressure
+        return {"pressure_deviation": float(np.max(np.abs(p - q), initial=0.0)) / q}
+
+    def exact_stress(self):
+        """The exact stress (uniform): sigma_yy = -q, the rest zero."""
+        return np.array([[0.0, 0.0], [0.0, -self.p.pressure]])
+
+
+@dataclass(frozen=True)
+class HertzCylindersParams(two_elastic(1000.0, 0.3)):
+    R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
+    R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
+    depth: float = param(5e-3, "approach of the upper body's top (ramped over the load "
+                         "steps)", positive=True)  # fmt: skip
+    h_contact: float = param(2e-3, "element size of the lower body in the contact zone",
+                             positive=True)  # fmt: skip
+    h_far: float = param(0.1, "element size far from the contact zone", positive=True)
+    refine: float = param(0.08, "radius of the refined zone around the first contact point",
+                          positive=True)  # fmt: skip
+    ratio: float = param(0.75, "element size of the upper body / that of the lower",
+                         positive=True)  # fmt: skip
+    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
+                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+
+
+class HertzCylinders(TwoBodyScene):
+    name = "hertz-cylinders"
+    summary = "two elastic cylinders pressed together (quarter model); reference Hertz a, p0"
+    Params = HertzCylindersParams
+    cells = {"lower": CylindersCells.LOWER, "upper": CylindersCells.UPPER}
+    surfaces = {"lower": CylindersFacets.LOWER_CONTACT, "upper": CylindersFacets.UPPER_CONTACT}
+    symmetry = 2.0
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
+                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
+                                    ratio=p.ratio, offset=p.offset)  # fmt: skip
+        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = CylindersFacets
+        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
+                fix_component(V, facet_tags, f.LOWER_SYMMETRY, 0),
+                fix_component(V, facet_tags, f.UPPER_SYMMETRY, 0),
+                _component_value(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
+
+    def set_load(self, t: float) -> None:
+        self.push.value = -t * self.p.depth
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+        """The contact half-width from the slave nodes x (all ranks) with pressure p > 0: the
+        zero of the straight line through (x, p^2) at the two outermost closed nodes (near the
+        edge of a smooth contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a
+        - x)); a lumped measure of the closed nodes would err by up to h / 2."""
+        closed = p > 0.0
+        if np.count_nonzero(closed) < 2:
+            return None
+        order = np.argsort(x[closed, 0])
+        (x1, x2), (p1, p2) = x[closed, 0][order][-2:], p[closed][order][-2:]
+        if not p1 > p2:
+            return float(x2)
+        return float(x2 + p2**2 * (x2 - x1) / (p1**2 - p2**2))
+
+    def E_star(self) -> float:
+        m = self.materials()
+        return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())
+
+    def R(self) -> float:
+        return 1.0 / (1.0 / self.p.R_upper + 1.0 / self.p.R_lower)
+
+    def reference(self, force: float) -> dict[str, float]:
+        return hertz_2d(force, self.R(), self.E_star())
