@@ -188,9 +188,8 @@ class FacetTree:
     """
 
     def __init__(self, coords: np.ndarray, padding: float) -> None:
-        from mpi4py import MPI
-
         import dolfinx.geometry as geo
+        from mpi4py import MPI
 
         m, d, gdim = coords.shape
         self.size = m

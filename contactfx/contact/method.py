@@ -33,8 +33,8 @@ __all__ = ["Supports", "ContactMethod", "MethodBase"]
 @dataclass(frozen=True)
 class Supports:
     """What a method handles. ``why_not`` maps a capability name (``friction``, ``obstacles``,
-    ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``dim1``, ``iterative``) to the reason it is not
-    supported, quoted in the error a user sees."""
+    ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``dim1``, ``iterative``)
+    to the reason it is not supported, quoted in the error a user sees."""
 
     friction: tuple[str, ...] = ("none",)
     obstacles: bool = True

@@ -48,7 +48,7 @@ from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.method import MethodBase, Supports
-from contactfx.contact.pair import Facets, facet_normals, gather_near, owners
+from contactfx.contact.pair import Facets, facet_normals, owners
 from contactfx.contact.projection import gauss_segment, segment_overlaps
 from contactfx.params import param, validate
 
