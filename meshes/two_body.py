@@ -9,7 +9,7 @@ per cell tag, and both contact surfaces are exterior facets. This is the setting
 segment-to-segment methods, which couple non-matching contact surfaces (M. A. Puso,
 T. A. Laursen, A mortar segment-to-segment contact method for large deformation solid mechanics,
 Comput. Methods Appl. Mech. Engrg. 193 (2004) 601-629; P. Wriggers, Computational Contact
-Mechanics, 2nd ed., Springer 2006, doi:10.1007/978-3-540-32609-0, ch. 9).
+Mechanics, 2nd ed., Springer 2006, doi:10.1007/978-3-540-32609-0).
 
 Body 1 (the lower body, the block, the foundation) has the element size ``h`` at the contact
 (``h1`` or ``h_contact``), body 2 (the upper body, the punch) the size ``ratio * h``. Non-matching
@@ -24,8 +24,8 @@ curve with its size field, starting at l0. Body 2's contact nodes near x = 0 the
 (k + offset) * h2 instead of k * h2, shifted by offset * h2 modulo h2, while the first element
 stays between 0.5 h2 and 1.5 h2 long. In 3D the two contact edges of body 2 through the origin
 (along x and along y) are split; the frontal surface mesher then places the interior nodes of
-body 2's contact face differently too. With ratio = 1 and offset = 0 the straight contact
-surfaces of :func:`stacked_blocks` have coinciding (but distinct) nodes.
+body 2's contact face differently too. With ratio = 1, offset = 0 and upper_width = width the
+contact edges of :func:`stacked_blocks` have pairwise coinciding (but distinct) nodes.
 
 Mesh sizes per body: each body gets its own graded size field (see
 :func:`contactfx.meshes._build.set_graded_size`), restricted to the body and its boundary
@@ -705,7 +705,7 @@ def punch_foundation(
         model, [edge_end, *top_corners, flat_points[0]]
     )
     punch = _surface(model, [*flat, rounded, punch_side, punch_top, punch_symmetry])
-    occ.remove([(0, centre)])
+    occ.remove([(0, centre)])  # the arc's centre is no vertex of the punch: no free point
     occ.synchronize()
     if offset > 0:
         model.mesh.setTransfiniteCurve(flat[0], 2)

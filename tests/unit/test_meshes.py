@@ -1,6 +1,7 @@
 """Unit tests of :mod:`contactfx.meshes`: exact measures, graded sizes, validation, command line.
 
-Run at 1 and 2 ranks::
+The two-body geometries (:mod:`contactfx.meshes.two_body`) are also checked for disjoint bodies
+(no shared vertex) and non-matching contact nodes. Run at 1 and 2 ranks::
 
     python3 -m pytest tests/unit/test_meshes.py
     mpirun -n 2 python3 -m mpi4py -m pytest tests/unit/test_meshes.py
@@ -27,17 +28,33 @@ from contactfx.meshes import (
     Builder,
     CrackPlateCells,
     CrackPlateFacets,
+    CylindersCells,
+    CylindersFacets,
     JointColumnCells,
     JointColumnFacets,
     MeshData,
+    PunchFoundationCells,
+    PunchFoundationFacets,
     RectangleCells,
     RectangleFacets,
+    SpheresCells,
+    SpheresFacets,
+    StackedBlocksCells,
+    StackedBlocksFacets,
+    StackedBoxesCells,
+    StackedBoxesFacets,
     box,
     build,
     crack_plate,
+    cylinders,
     joint_column,
+    punch_foundation,
     rectangle,
+    spheres,
+    stacked_blocks,
+    stacked_boxes,
 )
+from contactfx.meshes.two_body import offset_length
 
 RECTANGLE = dict(
     x0=-2.0,
@@ -73,6 +90,45 @@ CRACK_PLATE = dict(
     split_at=(0.1, -0.25),
 )
 JOINT_COLUMN = dict(width=0.5, block_height=0.4, h=0.05)
+STACKED_BLOCKS = dict(
+    width=1.0, h_lower=0.5, h_upper=0.3, h1=0.1, ratio=0.7, offset=0.3, upper_width=0.8
+)
+STACKED_BOXES = dict(
+    width=1.0, h_lower=0.5, h_upper=0.4, h1=0.2, ratio=0.7, offset=0.3, upper_width=0.8
+)
+CYLINDERS = dict(
+    radius_lower=2.0,
+    radius_upper=1.0,
+    h_contact=0.01,
+    h_far=0.1,
+    refine=0.1,
+    ratio=0.6,
+    offset=0.4,
+    grading=0.3,
+)
+PUNCH_FOUNDATION = dict(
+    width=3.0,
+    depth=2.0,
+    b=1.0,
+    rho=0.25,
+    h_punch=0.8,
+    h_contact=0.01,
+    h_far=0.2,
+    refine=0.05,
+    ratio=1.3,
+    offset=0.7,
+    grading=0.3,
+)
+SPHERES = dict(
+    radius_lower=1.5,
+    radius_upper=1.0,
+    h_contact=0.05,
+    h_far=0.25,
+    refine=0.1,
+    ratio=0.7,
+    offset=0.3,
+    grading=1.0,
+)
 
 
 @pytest.fixture(scope="module")
@@ -96,16 +152,45 @@ def joint_column_mesh() -> MeshData:
     return build(MPI.COMM_WORLD, partial(joint_column, **JOINT_COLUMN), gdim=2, name="joint")
 
 
-def _measure(data: MeshData, tag: int | None = None, integral: str = "ds") -> float:
-    """Global measure of the mesh (``tag`` None) or of the facets tagged ``tag``.
+@pytest.fixture(scope="module")
+def stacked_blocks_mesh() -> MeshData:
+    builder = partial(stacked_blocks, **STACKED_BLOCKS)
+    return build(MPI.COMM_WORLD, builder, gdim=2, name="stacked_blocks")
 
-    ``integral`` "ds" for boundary facets, "dS" for interior facets (cracks, joints).
+
+@pytest.fixture(scope="module")
+def stacked_boxes_mesh() -> MeshData:
+    return build(MPI.COMM_WORLD, partial(stacked_boxes, **STACKED_BOXES), gdim=3, name="boxes")
+
+
+@pytest.fixture(scope="module")
+def cylinders_mesh() -> MeshData:
+    return build(MPI.COMM_WORLD, partial(cylinders, **CYLINDERS), gdim=2, name="cylinders")
+
+
+@pytest.fixture(scope="module")
+def punch_foundation_mesh() -> MeshData:
+    builder = partial(punch_foundation, **PUNCH_FOUNDATION)
+    return build(MPI.COMM_WORLD, builder, gdim=2, name="punch")
+
+
+@pytest.fixture(scope="module")
+def spheres_mesh() -> MeshData:
+    return build(MPI.COMM_WORLD, partial(spheres, **SPHERES), gdim=3, name="spheres")
+
+
+def _measure(data: MeshData, tag: int | None = None, integral: str = "ds") -> float:
+    """Global measure of the mesh (``tag`` None), of the facets or of the cells tagged ``tag``.
+
+    ``integral`` "ds" for boundary facets, "dS" for interior facets (cracks, joints), "dx" for
+    cells (the bodies of the two-body geometries).
     """
     mesh = data.mesh
     if tag is None:
         measure = ufl.dx(domain=mesh)
     else:
-        measure = ufl.Measure(integral, domain=mesh, subdomain_data=data.facet_tags)(tag)
+        tags = data.cell_tags if integral == "dx" else data.facet_tags
+        measure = ufl.Measure(integral, domain=mesh, subdomain_data=tags)(tag)
     local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(1.0 * measure))
     return mesh.comm.allreduce(local, op=MPI.SUM)
 
@@ -174,8 +259,11 @@ def _check_interior_facets_integrated_once(data: MeshData, boundary_length: floa
     assert interior == pytest.approx(all_edges - boundary_length, rel=1e-12)
 
 
-def _cell_sizes(data: MeshData) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Mean edge length and midpoint of every cell of the mesh, gathered on all ranks.
+def _cell_sizes(
+    data: MeshData, tag: int | None = None
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Mean edge length and midpoint of every cell of the mesh (or of the cells tagged ``tag``),
+    gathered on all ranks.
 
     The mean edge length is what a gmsh size field prescribes.
     """
@@ -184,7 +272,9 @@ def _cell_sizes(data: MeshData) -> tuple[npt.NDArray[np.float64], npt.NDArray[np
     num_owned = mesh.topology.index_map(tdim).size_local
     # dolfinx 0.5 stores the geometry dofmap as an AdjacencyList, later versions as an array.
     dofmap = mesh.geometry.dofmap
-    nodes = np.asarray(getattr(dofmap, "array", dofmap)).reshape(-1, tdim + 1)[:num_owned]
+    nodes = np.asarray(getattr(dofmap, "array", dofmap)).reshape(-1, tdim + 1)
+    cells = np.arange(num_owned) if tag is None else data.cell_tags.find(tag)
+    nodes = nodes[cells[cells < num_owned]]
     vertices = mesh.geometry.x[nodes]
     edges = [
         np.linalg.norm(vertices[:, i] - vertices[:, j], axis=1)
@@ -393,6 +483,308 @@ def test_joint_column(joint_column_mesh: MeshData) -> None:
     assert p["h"] / 1.5 <= sizes.min() and sizes.max() <= 1.5 * p["h"]
 
 
+def _body_vertices(data: MeshData, body: int) -> npt.NDArray[np.int32]:
+    """Local indices of the vertices of the local (owned and ghost) cells tagged ``body``."""
+    mesh = data.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, 0)
+    cell_vertices = mesh.topology.connectivity(tdim, 0).array.reshape(-1, tdim + 1)
+    return np.unique(cell_vertices[data.cell_tags.find(body)])
+
+
+def _check_separate_bodies(data: MeshData, lower: int, upper: int) -> None:
+    """The two bodies share no vertex: on each rank (local indices) and globally.
+
+    The cell tags cover every local cell, ghosts included, so every local vertex is in one of
+    the two sets.
+    """
+    mesh = data.mesh
+    lower_vertices, upper_vertices = _body_vertices(data, lower), _body_vertices(data, upper)
+    assert np.intersect1d(lower_vertices, upper_vertices).size == 0
+    index_map = mesh.topology.index_map(0)
+    num_local = index_map.size_local + index_map.num_ghosts
+    assert lower_vertices.size + upper_vertices.size == num_local
+    comm = mesh.comm
+    lower_global, upper_global = (
+        np.unique(np.concatenate(comm.allgather(index_map.local_to_global(v))))
+        for v in (lower_vertices, upper_vertices)
+    )
+    assert lower_global.size > 0 and upper_global.size > 0
+    assert np.intersect1d(lower_global, upper_global).size == 0
+    assert lower_global.size + upper_global.size == index_map.size_global
+
+
+def _tagged_vertices(data: MeshData, tag: int) -> npt.NDArray[np.float64]:
+    """Coordinates of the vertices of the facets tagged ``tag``, gathered on all ranks, unique."""
+    mesh = data.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, 0)
+    facet_vertices = mesh.topology.connectivity(tdim - 1, 0).array.reshape(-1, tdim)
+    local = _vertex_coordinates(mesh)[np.unique(facet_vertices[data.facet_tags.find(tag)])]
+    return np.unique(np.concatenate(mesh.comm.allgather(local)), axis=0)
+
+
+def _coincident(
+    points: npt.NDArray[np.float64], others: npt.NDArray[np.float64]
+) -> npt.NDArray[np.bool_]:
+    """Which of ``points`` coincide (to 1e-10) with one of ``others``."""
+    gaps = np.linalg.norm(points[:, None, :] - others[None, :, :], axis=2)
+    return gaps.min(axis=1) <= 1e-10
+
+
+def _check_non_matching(
+    data: MeshData, lower: int, upper: int, max_coincident: int | None = None
+) -> None:
+    """At most ``max_coincident`` (default: half) of the nodes of the upper contact surface
+    coincide with nodes of the lower one."""
+    lower_nodes, upper_nodes = _tagged_vertices(data, lower), _tagged_vertices(data, upper)
+    if max_coincident is None:
+        max_coincident = upper_nodes.shape[0] // 2
+    coincident = _coincident(upper_nodes, lower_nodes)
+    assert 0 < coincident.sum() <= max_coincident, coincident.sum()
+
+
+def _arc_edges(
+    ends: npt.NDArray[np.float64], centre: tuple[float, float], radius: float
+) -> npt.NDArray[np.float64]:
+    """The edges (n, 2, 3) of ``ends`` whose two end points lie on the circle (to 1e-12 R)."""
+    distance = np.linalg.norm(ends[..., :2] - np.asarray(centre), axis=2)
+    return ends[np.all(np.abs(distance - radius) <= 1e-12 * radius, axis=1)]
+
+
+def _check_quarter_arc(data: MeshData, tag: int, centre: tuple[float, float], radius: float):
+    """The edges tagged ``tag`` that lie on the circle approximate a quarter arc; returns the
+    global area between the arc and its chords (sum of the circular segments).
+
+    Every node is on the circle (gmsh places curve nodes on the exact OCC arc), so the chords
+    subtend angles theta_i = 2 asin(c_i / 2R) that add up to pi / 2 to round-off, and the
+    polygon misses the circular segments R^2 (theta_i - sin theta_i) / 2 exactly. Bound on the
+    chord sum: c = 2R sin(theta / 2) >= R theta (1 - theta^2 / 24), so the relative length
+    deficit is at most theta_max^2 / 24; with chords c <= 1.5 h_far (gmsh curve elements within
+    [0.7, 1.4] h), theta_max = 2 asin(0.75 h_far / R).
+    """
+    comm = data.mesh.comm
+    chords = _lengths(_arc_edges(_facet_vertices(data, tag), centre, radius))
+    angles = 2 * np.arcsin(chords / (2 * radius))
+    total_angle = comm.allreduce(angles.sum(), op=MPI.SUM)
+    assert total_angle == pytest.approx(0.5 * math.pi, rel=1e-10)
+    segments = comm.allreduce((radius**2 * (angles - np.sin(angles)) / 2).sum(), op=MPI.SUM)
+    return comm.allreduce(chords.sum(), op=MPI.SUM), segments
+
+
+def _arc_bounds(exact: float, radius: float, h_far: float, order: float) -> tuple[float, float]:
+    """[exact (1 - theta_max^2 / order), exact]: the polygon is inscribed in the arc.
+
+    order 24 for arc lengths (see _check_quarter_arc); 6 for the area of a quarter disk: the
+    missing segments sum to at most R^2 theta_max^2 / 12 * (pi / 2) (theta - sin theta <=
+    theta^3 / 6), i.e. theta_max^2 / 6 of pi R^2 / 4.
+    """
+    theta_max = 2 * math.asin(min(1.0, 0.75 * h_far / radius))
+    return exact * (1 - theta_max**2 / order), exact * (1 + 1e-12)
+
+
+def test_stacked_blocks(stacked_blocks_mesh: MeshData) -> None:
+    p, data = STACKED_BLOCKS, stacked_blocks_mesh
+    w, wu, hl, hu = p["width"], p["upper_width"], p["h_lower"], p["h_upper"]
+    cells, facets = StackedBlocksCells, StackedBlocksFacets
+    assert set(np.unique(data.cell_tags.values)) <= {cells.LOWER, cells.UPPER}
+    _check_boundary_tagged_once(data)
+    # Straight-sided triangles tile the blocks exactly: only round-off remains.
+    assert _measure(data, cells.LOWER, "dx") == pytest.approx(w * hl, rel=1e-12)
+    assert _measure(data, cells.UPPER, "dx") == pytest.approx(wu * hu, rel=1e-12)
+    lengths = {
+        facets.LOWER_BOTTOM: w, facets.LOWER_RIGHT: hl, facets.LOWER_TOP: w,
+        facets.LOWER_LEFT: hl, facets.UPPER_BOTTOM: wu, facets.UPPER_RIGHT: hu,
+        facets.UPPER_TOP: wu, facets.UPPER_LEFT: hu,
+    }  # fmt: skip
+    for tag, length in lengths.items():
+        assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
+    _check_separate_bodies(data, cells.LOWER, cells.UPPER)
+    _check_non_matching(data, facets.LOWER_TOP, facets.UPPER_BOTTOM)
+    # The offset: the first upper contact node after x = 0 is at l0.
+    upper_nodes = _tagged_vertices(data, facets.UPPER_BOTTOM)
+    l0 = offset_length(p["offset"], p["ratio"] * p["h1"])
+    assert np.sort(upper_nodes[:, 0])[1] == pytest.approx(l0, rel=1e-12)
+    # Uniform sizes per body (2D frontal-Delaunay edges within about [0.7, 1.4] h).
+    for body, h in ((cells.LOWER, p["h1"]), (cells.UPPER, p["ratio"] * p["h1"])):
+        sizes, _ = _cell_sizes(data, body)
+        assert h / 1.5 <= sizes.min() and sizes.max() <= 1.5 * h, body.name
+
+
+@pytest.mark.parametrize(("ratio", "offset"), [(1.0, 0.0), (1.0, 0.5)])
+def test_stacked_blocks_equal_sizes(ratio: float, offset: float) -> None:
+    """Equal sizes: without offset the contact nodes coincide pairwise but stay distinct
+    vertices (``gmshio.model_to_mesh`` does not merge nodes by coordinates); the offset alone
+    makes them non-matching."""
+    p = dict(STACKED_BLOCKS, ratio=ratio, offset=offset, upper_width=STACKED_BLOCKS["width"])
+    data = build(MPI.COMM_WORLD, partial(stacked_blocks, **p), gdim=2, name="equal")
+    facets = StackedBlocksFacets
+    _check_separate_bodies(data, StackedBlocksCells.LOWER, StackedBlocksCells.UPPER)
+    lower_nodes = _tagged_vertices(data, facets.LOWER_TOP)
+    upper_nodes = _tagged_vertices(data, facets.UPPER_BOTTOM)
+    coincident = _coincident(upper_nodes, lower_nodes)
+    if offset == 0.0:
+        assert lower_nodes.shape == upper_nodes.shape and np.all(coincident)
+    else:
+        # only the corners x = 0 and x = width, and possibly a few nodes where the shift has
+        # drifted by a whole element
+        assert coincident.sum() <= 0.25 * upper_nodes.shape[0]
+
+
+def test_stacked_boxes(stacked_boxes_mesh: MeshData) -> None:
+    p, data = STACKED_BOXES, stacked_boxes_mesh
+    w, wu, hl, hu = p["width"], p["upper_width"], p["h_lower"], p["h_upper"]
+    cells, facets = StackedBoxesCells, StackedBoxesFacets
+    _check_boundary_tagged_once(data)
+    # Straight-sided tetrahedra tile the boxes exactly: only round-off remains.
+    assert _measure(data, cells.LOWER, "dx") == pytest.approx(w * w * hl, rel=1e-12)
+    assert _measure(data, cells.UPPER, "dx") == pytest.approx(wu * wu * hu, rel=1e-12)
+    areas = {
+        facets.LOWER_X0: w * hl, facets.LOWER_X1: w * hl, facets.LOWER_Y0: w * hl,
+        facets.LOWER_Y1: w * hl, facets.LOWER_BOTTOM: w * w, facets.LOWER_TOP: w * w,
+        facets.UPPER_X0: wu * hu, facets.UPPER_X1: wu * hu, facets.UPPER_Y0: wu * hu,
+        facets.UPPER_Y1: wu * hu, facets.UPPER_BOTTOM: wu * wu, facets.UPPER_TOP: wu * wu,
+    }  # fmt: skip
+    for tag, area in areas.items():
+        assert _measure(data, tag) == pytest.approx(area, rel=1e-12), tag.name
+    _check_separate_bodies(data, cells.LOWER, cells.UPPER)
+    _check_non_matching(data, facets.LOWER_TOP, facets.UPPER_BOTTOM)
+
+
+def test_cylinders(cylinders_mesh: MeshData) -> None:
+    p, data = CYLINDERS, cylinders_mesh
+    r1, r2, h_far = p["radius_upper"], p["radius_lower"], p["h_far"]
+    cells, facets = CylindersCells, CylindersFacets
+    _check_boundary_tagged_once(data)
+    for tag, length in ((facets.LOWER_BOTTOM, r2), (facets.LOWER_SYMMETRY, r2),
+                        (facets.UPPER_TOP, r1), (facets.UPPER_SYMMETRY, r1)):  # fmt: skip
+        assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
+    for body, contact, centre, radius in (
+        (cells.LOWER, facets.LOWER_CONTACT, (0.0, -r2), r2),
+        (cells.UPPER, facets.UPPER_CONTACT, (0.0, r1), r1),
+    ):
+        chords, segments = _check_quarter_arc(data, contact, centre, radius)
+        # every contact edge is on the arc
+        assert _measure(data, contact) == pytest.approx(chords, rel=1e-12)
+        low, high = _arc_bounds(0.5 * math.pi * radius, radius, h_far, 24)
+        assert low <= chords <= high, contact.name
+        area = _measure(data, body, "dx")
+        # Exact: the quarter disk minus the circular segments cut off by the chords.
+        assert area == pytest.approx(0.25 * math.pi * radius**2 - segments, rel=1e-10)
+        low, high = _arc_bounds(0.25 * math.pi * radius**2, radius, h_far, 6)
+        assert low <= area <= high, body.name
+    _check_separate_bodies(data, cells.LOWER, cells.UPPER)
+    # The arcs only touch at the origin.
+    _check_non_matching(data, facets.LOWER_CONTACT, facets.UPPER_CONTACT, max_coincident=1)
+
+
+def test_cylinders_sizes(cylinders_mesh: MeshData) -> None:
+    p, data = CYLINDERS, cylinders_mesh
+    for body, h in ((CylindersCells.LOWER, p["h_contact"]),
+                    (CylindersCells.UPPER, p["ratio"] * p["h_contact"])):  # fmt: skip
+        sizes, midpoints = _cell_sizes(data, body)
+        distance = np.linalg.norm(midpoints[:, :2], axis=1)
+        graded = p["refine"] + (p["h_far"] - h) / p["grading"]
+        _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
+
+
+def test_punch_foundation(punch_foundation_mesh: MeshData) -> None:
+    p, data = PUNCH_FOUNDATION, punch_foundation_mesh
+    w, depth, b, rho, hp = p["width"], p["depth"], p["b"], p["rho"], p["h_punch"]
+    cells, facets = PunchFoundationCells, PunchFoundationFacets
+    _check_boundary_tagged_once(data)
+    assert _measure(data, cells.BLOCK, "dx") == pytest.approx(w * depth, rel=1e-12)
+    lengths = {
+        facets.BLOCK_TOP: w, facets.BLOCK_RIGHT: depth, facets.BLOCK_BOTTOM: w,
+        facets.BLOCK_SYMMETRY: depth, facets.PUNCH_SIDE: hp - rho, facets.PUNCH_TOP: b,
+        facets.PUNCH_SYMMETRY: hp,
+    }  # fmt: skip
+    for tag, length in lengths.items():
+        assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
+    # The contact facets: the flat face (edges on y = 0) and the rounded edge (on the circle).
+    comm = data.mesh.comm
+    ends = _facet_vertices(data, facets.PUNCH_CONTACT)
+    flat = np.all(np.abs(ends[..., 1]) <= 1e-14, axis=1)
+    assert comm.allreduce(_lengths(ends[flat]).sum(), op=MPI.SUM) == pytest.approx(b - rho)
+    centre = (b - rho, rho)
+    assert _arc_edges(ends[~flat], centre, rho).shape == ends[~flat].shape
+    chords, segments = _check_quarter_arc(data, facets.PUNCH_CONTACT, centre, rho)
+    assert _measure(data, facets.PUNCH_CONTACT) == pytest.approx(b - rho + chords, rel=1e-12)
+    low, high = _arc_bounds(0.5 * math.pi * rho, rho, p["h_far"], 24)
+    assert low <= chords <= high
+    # The punch: the rectangle b x h_punch minus the corner outside the rounded edge, minus the
+    # circular segments cut off by the chords of the rounded edge (exact).
+    exact = b * hp - rho**2 * (1 - math.pi / 4)
+    assert _measure(data, cells.PUNCH, "dx") == pytest.approx(exact - segments, rel=1e-10)
+    _check_separate_bodies(data, cells.BLOCK, cells.PUNCH)
+    _check_non_matching(data, facets.BLOCK_TOP, facets.PUNCH_CONTACT)
+    upper_nodes = _tagged_vertices(data, facets.PUNCH_CONTACT)
+    l0 = offset_length(p["offset"], p["ratio"] * p["h_contact"])
+    assert np.sort(upper_nodes[:, 0])[1] == pytest.approx(l0, rel=1e-12)
+
+
+def test_punch_foundation_sizes(punch_foundation_mesh: MeshData) -> None:
+    p, data = PUNCH_FOUNDATION, punch_foundation_mesh
+    for body, h in ((PunchFoundationCells.BLOCK, p["h_contact"]),
+                    (PunchFoundationCells.PUNCH, p["ratio"] * p["h_contact"])):  # fmt: skip
+        sizes, midpoints = _cell_sizes(data, body)
+        along = np.maximum(midpoints[:, 0] - p["b"], 0.0)
+        distance = np.hypot(along, midpoints[:, 1])
+        graded = p["refine"] + (p["h_far"] - h) / p["grading"]
+        _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
+
+
+def test_spheres(spheres_mesh: MeshData) -> None:
+    """Eighth balls. Bound: a chord triangle with circumradius rho lies in a plane at the
+    distance sqrt(R^2 - rho^2) from the centre, inside its circumdisk, so within the shell
+    R - delta <= |x - c| <= R, delta = R - sqrt(R^2 - rho^2). The polyhedral body lies inside
+    the (convex) eighth ball and contains its part |x - c| <= R - delta, so its volume is within
+    [V (1 - 3 delta / R), V]. The radial projection onto the sphere maps the chord triangles
+    onto the eighth sphere; the area element scales by r^3 / (d R^2) with R - delta <= d <= r
+    <= R, so the contact area is within [A (1 - 3 delta / R), A R / (R - delta)]. The flat
+    quarter disks: as in 2D, within theta_max^2 / 6 below pi R^2 / 4.
+    """
+    p, data = SPHERES, spheres_mesh
+    r1, r2 = p["radius_upper"], p["radius_lower"]
+    cells, facets = SpheresCells, SpheresFacets
+    comm = data.mesh.comm
+    _check_boundary_tagged_once(data)
+    mesh = data.mesh
+    mesh.topology.create_connectivity(2, 0)
+    face_vertices = mesh.topology.connectivity(2, 0).array.reshape(-1, 3)
+    coordinates = _vertex_coordinates(mesh)
+    for body, contact, flats, centre, radius in (
+        (cells.LOWER, facets.LOWER_CONTACT, (facets.LOWER_BOTTOM, facets.LOWER_X0,
+         facets.LOWER_Y0), (0.0, 0.0, -r2), r2),
+        (cells.UPPER, facets.UPPER_CONTACT, (facets.UPPER_TOP, facets.UPPER_X0,
+         facets.UPPER_Y0), (0.0, 0.0, r1), r1),
+    ):  # fmt: skip
+        triangles = coordinates[face_vertices[data.facet_tags.find(contact)]]
+        # every contact node is on the sphere
+        distance = np.linalg.norm(triangles - np.asarray(centre), axis=2)
+        assert np.all(np.abs(distance - radius) <= 1e-12 * radius)
+        a, b, c = (
+            np.linalg.norm(triangles[:, i] - triangles[:, j], axis=1)
+            for i, j in ((0, 1), (1, 2), (2, 0))
+        )
+        doubled_area = np.linalg.norm(
+            np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
+        )
+        rho = comm.allreduce((a * b * c / (2 * doubled_area)).max(initial=0.0), op=MPI.MAX)
+        delta = radius - math.sqrt(radius**2 - rho**2)
+        volume, exact_volume = _measure(data, body, "dx"), math.pi * radius**3 / 6
+        assert exact_volume * (1 - 3 * delta / radius) <= volume <= exact_volume, body.name
+        area, exact_area = _measure(data, contact), math.pi * radius**2 / 2
+        assert exact_area * (1 - 3 * delta / radius) <= area, contact.name
+        assert area <= exact_area * radius / (radius - delta), contact.name
+        for flat in flats:
+            low, high = _arc_bounds(0.25 * math.pi * radius**2, radius, p["h_far"], 6)
+            assert low <= _measure(data, flat) <= high, flat.name
+    _check_separate_bodies(data, cells.LOWER, cells.UPPER)
+    # The spheres only touch at the origin.
+    _check_non_matching(data, facets.LOWER_CONTACT, facets.UPPER_CONTACT, max_coincident=1)
+
+
 @pytest.mark.parametrize(
     ("builder", "gdim", "message"),
     [
@@ -419,6 +811,54 @@ def test_joint_column(joint_column_mesh: MeshData) -> None:
         ),
         (partial(crack_plate, **dict(CRACK_PLATE, h_far=0.01)), 2, "h_crack must be <= h_far"),
         (partial(joint_column, **dict(JOINT_COLUMN, h=0.0)), 2, "h must be > 0, got 0.0"),
+        (
+            partial(stacked_blocks, **dict(STACKED_BLOCKS, width=math.nan)),
+            2,
+            "width must be finite, got nan",
+        ),
+        (partial(stacked_blocks, **dict(STACKED_BLOCKS, ratio=0.0)), 2, "ratio must be > 0"),
+        (
+            partial(stacked_blocks, **dict(STACKED_BLOCKS, upper_width=1.5)),
+            2,
+            "upper_width must be <= width",
+        ),
+        (
+            partial(stacked_blocks, **dict(STACKED_BLOCKS, offset=1.0)),
+            2,
+            r"offset must be in \[0, 1\), got 1.0",
+        ),
+        (
+            partial(stacked_blocks, **dict(STACKED_BLOCKS, h1=0.5, upper_width=0.4)),
+            2,
+            "offset: the first element of the upper block's bottom edge",
+        ),
+        (partial(stacked_boxes, **dict(STACKED_BOXES, h1=-0.1)), 3, "h1 must be > 0"),
+        (
+            partial(cylinders, **dict(CYLINDERS, ratio=20.0)),
+            2,
+            r"ratio \* h_contact must be <= h_far",
+        ),
+        (
+            partial(cylinders, **dict(CYLINDERS, radius_upper=0.0)),
+            2,
+            "radius_upper must be > 0",
+        ),
+        (partial(cylinders, **dict(CYLINDERS, offset=-0.1)), 2, r"offset must be in \[0, 1\)"),
+        (partial(punch_foundation, **dict(PUNCH_FOUNDATION, rho=1.0)), 2, "rho must be < b"),
+        (
+            partial(punch_foundation, **dict(PUNCH_FOUNDATION, b=3.5, rho=0.1)),
+            2,
+            "b must be < width",
+        ),
+        (
+            partial(
+                punch_foundation, **dict(PUNCH_FOUNDATION, h_contact=0.1, rho=0.95, h_punch=1.0)
+            ),
+            2,
+            "offset: the first element of the punch's flat face",
+        ),
+        (partial(spheres, **dict(SPHERES, refine=0.0)), 3, "refine must be > 0"),
+        (partial(spheres, **dict(SPHERES, h_far=0.01)), 3, "h_contact must be <= h_far"),
     ],
 )
 def test_invalid_parameter_raises_on_every_rank(builder: Builder, gdim: int, message: str) -> None:
@@ -472,3 +912,55 @@ def test_command_line_interior_facets(tmp_path, args: list[str]) -> None:
     assert text.startswith("$MeshFormat\n4.1")
     name = "crack" if args[0] == "crack-plate" else "joint"
     assert f'1 5 "{name}"' in text  # the interior physical group, tag 5
+
+
+@pytest.mark.serial_only
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs a subprocess; serial only")
+@pytest.mark.parametrize(
+    ("args", "cells", "group"),
+    [
+        (
+            ["stacked-blocks", "--width", "1", "--h-lower", "0.5", "--h-upper", "0.3",
+             "--h1", "0.1", "--ratio", "0.7", "--offset", "0.3"],
+            "triangles", '1 5 "upper_bottom"',
+        ),
+        (
+            ["stacked-boxes", "--width", "1", "--h-lower", "0.5", "--h-upper", "0.3",
+             "--h1", "0.25", "--ratio", "0.7", "--upper-width", "0.5"],
+            "tetrahedra", '2 11 "upper_bottom"',
+        ),
+        (
+            ["cylinders", "--radius-lower", "2", "--radius-upper", "1", "--h-contact", "0.02",
+             "--h-far", "0.2", "--refine", "0.1", "--ratio", "0.6", "--offset", "0.5"],
+            "triangles", '1 4 "upper_contact"',
+        ),
+        (
+            ["spheres", "--radius-lower", "2", "--radius-upper", "1", "--h-contact", "0.1",
+             "--h-far", "0.4", "--refine", "0.1", "--ratio", "0.6"],
+            "tetrahedra", '2 5 "upper_contact"',
+        ),
+        (
+            ["punch-foundation", "--width", "3", "--depth", "2", "--b", "1", "--rho", "0.25",
+             "--h-punch", "0.8", "--h-contact", "0.02", "--h-far", "0.3", "--refine", "0.05",
+             "--ratio", "1.3"],
+            "triangles", '1 5 "punch_contact"',
+        ),
+    ],
+    ids=["stacked-blocks", "stacked-boxes", "cylinders", "spheres", "punch-foundation"],
+)  # fmt: skip
+def test_command_line_two_body(tmp_path, args: list[str], cells: str, group: str) -> None:
+    out = tmp_path / "mesh.msh"
+    command = [sys.executable, "-m", "contactfx.meshes", *args, "--out", str(out)]
+    done = subprocess.run(command, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert str(out) in done.stdout and cells in done.stdout
+    text = out.read_text()
+    assert text.startswith("$MeshFormat\n4.1")
+    assert group in text  # the contact surface's physical group
+
+    bad = [*command[:-2], "--offset", "1.5", "--out", str(tmp_path / "bad.msh")]
+    done = subprocess.run(bad, capture_output=True, text=True)
+    assert done.returncode == 2
+    assert done.stderr.strip() == (
+        "python3 -m contactfx.meshes: error: offset must be in [0, 1), got 1.5"
+    )
