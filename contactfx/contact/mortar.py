@@ -281,6 +281,12 @@ class MortarCoupling:
             obj.destroy()
 
     # -- what the post-processing reads ----------------------------------------------------
+    def force(self) -> float:
+        """The normal contact force sum_j D_j lambda_j of the pair."""
+        from mpi4py import MPI
+
+        return self.comm.allreduce(float(np.sum(self.D * self.lam)), op=MPI.SUM)
+
     def nodal(self):
         """Owned contact nodes: (global node, weight D_j, pressure lambda_j, gap g_j)."""
         return self.nodes, self.D, self.lam, self.gap

@@ -45,10 +45,13 @@ class Nitsche(MethodBase):
 
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
     gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
+    sides: str = param("biased", "Nitsche between two bodies: biased (the slave's stress) or "
+                       "unbiased (both sides, half weights)",
+                       choices=("biased", "unbiased"))  # fmt: skip
     name = "nitsche"
     sweep = ("theta", (1, 0, -1))
     supports = Supports(friction=("none", "tresca", "coulomb"), mixed_up=True,
-                        nodal_quadrature=True, interfaces=True)  # fmt: skip
+                        nodal_quadrature=True, interfaces=True, two_body=True)  # fmt: skip
 
     def __post_init__(self) -> None:
         validate(self)
@@ -89,3 +92,11 @@ class Nitsche(MethodBase):
             if self.theta != 0:
                 form -= self.theta / gamma * ufl.dot(s.sigma_t(s.stress, n), st_v) * s.ds
         return form
+
+    def coupling(self, pair):
+        """Between two bodies (frictionless): biased or unbiased Nitsche at Gauss points
+        (:mod:`contactfx.contact.point_coupling`)."""
+        from contactfx.contact.point_coupling import Law, PointCoupling
+
+        law = Law("nitsche", self.gamma0, self.theta)
+        return PointCoupling(pair, law, unbiased=self.sides == "unbiased")

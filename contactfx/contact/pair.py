@@ -55,12 +55,19 @@ class Facets:
 class Side:
     """One body's contact surface on this rank (owned facets). ``local`` (m, d): local node
     indices of the vertices (of the P1 vector space's index map), ``nodes`` (m, d): their
-    global indices, ``X`` (m, d, gdim): reference coordinates."""
+    global indices, ``X`` (m, d, gdim): reference coordinates; ``cell`` (m,): the local cell
+    of each facet, ``cell_local`` / ``cell_nodes`` (m, d + 1) its nodes (local, global) and
+    ``cell_X`` (m, d + 1, gdim) their reference coordinates (the stress of the body at its
+    surface, for Nitsche)."""
 
     tag: int
     local: np.ndarray
     nodes: np.ndarray
     X: np.ndarray
+    cell: np.ndarray
+    cell_local: np.ndarray
+    cell_nodes: np.ndarray
+    cell_X: np.ndarray
 
     def current(self, u: np.ndarray) -> Facets:
         """The facets at x = X + u; ``u`` the local (owned + ghost) array, blocked (n, gdim)."""
@@ -88,22 +95,29 @@ def side_of(V, facet_tags, tag: int) -> Side:
     X = _compat.dof_coordinates(V)[:, :gdim]
     d = fdim + 1
     local = np.zeros((len(facets), d), dtype=np.int64)
-    inward = np.zeros((len(facets), gdim))
+    cells = np.zeros(len(facets), dtype=np.int64)
+    cell_local = np.zeros((len(facets), d + 1), dtype=np.int64)
     for i, f in enumerate(facets):
-        cell = f2c.links(f)[0]
+        cells[i] = f2c.links(f)[0]
         vertices = f2v.links(f)
-        cell_vertices = c2v.links(cell)
-        dofs = V.dofmap.cell_dofs(cell)
+        cell_vertices = c2v.links(cells[i])
+        dofs = V.dofmap.cell_dofs(cells[i])
         # P1: the cell's dofs follow its vertices
         local[i] = [dofs[np.flatnonzero(cell_vertices == v)[0]] for v in vertices]
-        inward[i] = X[dofs].mean(axis=0)
+        cell_local[i] = dofs
     Xf = X[local]
     normals = facet_normals(Xf)
+    inward = X[cell_local].mean(axis=1)
     flip = np.einsum("ij,ij->i", normals, inward - Xf.mean(axis=1)) > 0.0
     local[flip, :2] = local[flip, 1::-1]
     imap = V.dofmap.index_map
-    nodes = np.asarray(imap.local_to_global(local.ravel().astype(np.int32)), dtype=np.int64)
-    return Side(tag, local, nodes.reshape(local.shape), X[local])
+
+    def glob(a):
+        out = imap.local_to_global(a.ravel().astype(np.int32))
+        return np.asarray(out, dtype=np.int64).reshape(a.shape)
+
+    return Side(tag, local, glob(local), X[local], cells, cell_local, glob(cell_local),
+                X[cell_local])  # fmt: skip
 
 
 def facet_normals(x: np.ndarray) -> np.ndarray:
@@ -170,17 +184,22 @@ class ContactPair:
     searches: int = 0
     search_time: float = 0.0
     radius: float = field(default=0.0)
+    #: (m, 3) E, lambda, mu of the cell of each slave / master facet (set by the problem)
+    slave_lame: np.ndarray | None = None
+    master_lame: np.ndarray | None = None
 
-    def search(self, slave: Facets, master: Facets):
-        """The master facets near this rank's slave facets (from every rank) and the candidate
-        pairs (slave facet, near master facet) whose boxes, enlarged by the search radius (the
-        largest facet of either surface), meet. Collective."""
+    def search(self, slave: Facets, master: Facets, pairs: bool = True):
+        """The master facets near this rank's slave facets (from every rank) and, with
+        ``pairs``, the candidate pairs (slave facet, near master facet) whose boxes, enlarged
+        by the search radius (the largest facet of either surface), meet. Collective."""
         t0 = time.perf_counter()
         comm = self.layout.comm
         self.radius = global_max(comm, max(slave.diameter(), master.diameter()))
         near = gather_near(comm, master, slave, self.radius)
-        tree = _compat.FacetTree(near.x, self.radius)
-        pairs = tree.collide(_compat.FacetTree(slave.x, 0.0))
+        found = None
+        if pairs:
+            tree = _compat.FacetTree(near.x, self.radius)
+            found = tree.collide(_compat.FacetTree(slave.x, 0.0))
         self.searches += 1
         self.search_time += time.perf_counter() - t0
-        return near, pairs
+        return near, found

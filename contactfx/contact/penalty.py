@@ -30,7 +30,7 @@ class Penalty(MethodBase):
     name = "penalty"
     sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
-        mixed_up=True, nodal_quadrature=True, interfaces=True,
+        mixed_up=True, nodal_quadrature=True, interfaces=True, two_body=True,
         why_not={"friction": "its stick traction needs the tangential traction history"},
     )  # fmt: skip
 
@@ -45,3 +45,9 @@ class Penalty(MethodBase):
 
     def residual(self, s: Surface):
         return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds
+
+    def coupling(self, pair):
+        """Between two bodies: p = kappa [-g]_+ at the slave facets' Gauss points."""
+        from contactfx.contact.point_coupling import Law, PointCoupling
+
+        return PointCoupling(pair, Law("penalty", self.kappa0))

@@ -117,7 +117,8 @@ class Problem:
                 * ufl.dx
             )
         L = self.extra_load(L)
-        F = self.method.residual(self.surface)
+        # two bodies: no UFL surface, the contact terms are the solver's coupling
+        F = None if self.surface is None else self.method.residual(self.surface)
         compiled = [dolfinx.fem.form(a), dolfinx.fem.form(L)]
         if F is None:
             return (*compiled, None, None)

@@ -43,6 +43,9 @@ class TwoBodyProblem(Problem):
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
+        if numerics.friction != "none":
+            raise ValueError("friction between two meshed bodies is not implemented yet: use "
+                             "--friction none")  # fmt: skip
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
 
@@ -70,7 +73,18 @@ class TwoBodyProblem(Problem):
             side_of(self.V, self.facet_tags, scene.master_tag), scene.contact_modulus(),
             search_each_newton=self.num.search_update == "newton",
         )  # fmt: skip
+        self.pair.slave_lame = self._lame(self.pair.slave)
+        self.pair.master_lame = self._lame(self.pair.master)
         return None
+
+    def _lame(self, side) -> np.ndarray:
+        """(m, 3): E, lambda, mu of the cell of each facet of ``side``."""
+        mat = self.material
+        fields = [mat.modulus, mat.poisson]
+        dofs = np.array([fields[0].function_space.dofmap.cell_dofs(c)[0] for c in side.cell],
+                        dtype=np.int64)  # fmt: skip
+        E, nu = (f.x.array[dofs] for f in fields)
+        return np.stack([E, E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))], axis=1)
 
     def coupling(self):
         if not hasattr(self, "_coupling"):
@@ -122,7 +136,7 @@ class TwoBodyPost:
             self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
         self.status.x.array[:] = closed
         sym = self.scene.symmetry
-        force = self.comm.allreduce(float(np.sum(D * lam)), op=MPI.SUM) * sym
+        force = self.pb.coupling().force() * sym
         measure = self.comm.allreduce(float(np.sum(D[closed[local]])), op=MPI.SUM) * sym
         size = self.scene.contact_size(measure)
         x = self.x[local][closed[local]]

@@ -1,0 +1,293 @@
+"""Contact terms between two bodies at the Gauss points of a surface (penalty, Nitsche), the
+other body's basis functions evaluated at the projected point.
+
+For every Gauss point x of a slave facet (current configuration), the search
+(:meth:`contactfx.contact.pair.ContactPair.search`) finds the closest point y on the master
+surface, its facet, barycentric coordinates and outward normal n_m. With n = -n_m,
+
+    g(u) = (x_s + u_s(x) - y - u_m(y)) . n_m     (> 0 apart),
+    [v] . n = (v_s(x) - v_m(y)) . n               (the relative test function),
+
+and sigma_n(u) = n . sigma(u_s) n the normal stress of the slave body at x (P1: constant in the
+slave cell, from the cell's gradients and its Lame constants). The methods' pointwise laws:
+
+* penalty: p = kappa [-g]_+, residual int p [v].n, kappa = kappa0 E / h;
+* Nitsche (biased): P = [-sigma_n(u) - gamma g]_+, residual
+  int P ([v].n - theta / gamma sigma_n(v)) - theta / gamma int sigma_n(u) sigma_n(v),
+  gamma = gamma0 E / h (E and h of the slave cell): the rigid-obstacle Nitsche of
+  :mod:`contactfx.contact.nitsche` with the obstacle replaced by the master body (Chouly,
+  Mlika & Renard 2018, doi:10.1007/s00211-018-0959-1, the biased variant);
+* Nitsche (unbiased): the same with each body as the slave in turn, half weights each (ibid.).
+
+Jacobian: the derivatives of P and of the stress terms with respect to both bodies' dofs
+(the coupling blocks included), exact for the projection of the last search. With
+``--search-update newton`` the projection (y, n_m) is recomputed at every residual and its
+derivatives are not linearised: for the closest-point projection they vanish in the gap to
+first order (n_m is orthogonal to the master tangent and x - y is parallel to n_m), what is
+left out is the curvature (geometric) stiffness.
+
+Points whose projection falls off the master surface (no candidate facet within the search
+radius, or the closest point on an edge of the master surface that no other master facet
+shares) are not in contact.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from petsc4py import PETSc
+
+from contactfx.contact.coupling import NodeLayout, blocked_rows
+from contactfx.contact.pair import Facets, Side, facet_normals
+from contactfx.contact.projection import gauss_segment, gauss_triangle, pick_closest
+
+__all__ = ["PointCoupling", "Law"]
+
+
+@dataclass(frozen=True)
+class Law:
+    """The pointwise law: ``kind`` "penalty" (``stiffness`` = kappa0) or "nitsche"
+    (``stiffness`` = gamma0, ``theta``)."""
+
+    kind: str
+    stiffness: float
+    theta: int = 0
+
+
+def _cell_gradients(X: np.ndarray) -> np.ndarray:
+    """(m, d + 1, gdim) gradients of the P1 basis of simplices X (m, d + 1, gdim)."""
+    J = np.swapaxes(X[:, 1:] - X[:, :1], 1, 2)  # (m, gdim, d)
+    Jinv = np.linalg.inv(J)  # (m, d, gdim): rows are grad lambda_1..d
+    return np.concatenate([-Jinv.sum(axis=1, keepdims=True), Jinv], axis=1)
+
+
+class _Directed:
+    """One direction of the pair (slave -> master) with its weight and Gauss points."""
+
+    def __init__(self, slave: Side, master: Side, weight: float, lame: np.ndarray) -> None:
+        self.slave, self.master, self.weight = slave, master, weight
+        self.lame = lame  # (m, 3): E, lambda, mu of each slave facet's cell
+        d = slave.local.shape[1]
+        self.grads = _cell_gradients(slave.cell_X) if len(slave) else None
+        # position of each facet vertex among its cell's nodes
+        self.pos = np.array([[np.flatnonzero(c == v)[0] for v in f]
+                             for f, c in zip(slave.local, slave.cell_local, strict=True)],
+                            dtype=np.int64).reshape(-1, d)  # fmt: skip
+        X = slave.cell_X
+        edges = [np.linalg.norm(X[:, i] - X[:, j], axis=-1)
+                 for i in range(d + 1) for j in range(i)]  # fmt: skip
+        self.h = np.max(edges, axis=0) if len(slave) else np.zeros(0)
+        if d == 2:
+            q, w = gauss_segment(2)
+            self.qbary = np.stack([1.0 - q, q], axis=1)
+        else:
+            self.qbary, w = gauss_triangle(2)
+        self.qweight = w
+
+
+class PointCoupling:
+    """Penalty / Nitsche terms of a contact pair at Gauss points (module docstring)."""
+
+    def __init__(self, pair, law: Law, unbiased: bool = False) -> None:
+        self.pair, self.law = pair, law
+        self.layout: NodeLayout = pair.layout
+        self.comm = self.layout.comm
+        self.search_each_newton = pair.search_each_newton
+        dirs = [_Directed(pair.slave, pair.master, 0.5 if unbiased else 1.0, pair.slave_lame)]
+        if unbiased:
+            dirs.append(_Directed(pair.master, pair.slave, 0.5, pair.master_lame))
+        self.dirs = dirs
+        self.scatter = None
+
+    # -- search ---------------------------------------------------------------------------
+    def update(self, u: np.ndarray) -> None:
+        lay = self.layout
+        gdim, bs = lay.gdim, lay.bs
+        ub = u.reshape(-1, bs)[:, :gdim]
+        points = [self._points(dr, ub) for dr in self.dirs]
+        needed = np.unique(np.concatenate([p["rows"].ravel() for p in points]))
+        self._scatter_setup(needed)
+        self.points = points
+        u_upd = self._gather_u(u)
+        for p in points:
+            p["idx"] = np.searchsorted(needed, p["rows"])
+            # reference positions of the involved dofs: current at the search minus u then
+            p["X"] = p["x_search"] - u_upd[p["idx"]]
+
+    def _points(self, dr: _Directed, ub: np.ndarray) -> dict:
+        lay, pair = self.layout, self.pair
+        gdim, bs = lay.gdim, lay.bs
+        slave, master = dr.slave.current(ub), dr.master.current(ub)
+        near, _ = pair.search(slave, master, pairs=False)
+        m, d = len(dr.slave), dr.slave.local.shape[1]
+        nq = len(dr.qweight)
+        xq = np.einsum("qb,mbg->mqg", dr.qbary, slave.x).reshape(-1, gdim)
+        ref = dr.slave.X
+        if d == 2:
+            measure = np.linalg.norm(ref[:, 1] - ref[:, 0], axis=1)
+        else:
+            measure = 0.5 * np.linalg.norm(np.cross(ref[:, 1] - ref[:, 0], ref[:, 2] - ref[:, 0]),
+                                           axis=1)  # fmt: skip
+        w = (measure[:, None] * dr.qweight[None, :]).reshape(-1) * dr.weight
+        facet = np.repeat(np.arange(m), nq)
+        pick = self._project(xq, near)
+        paired = pick.index >= 0
+        # slave cell shape functions at the points: the facet's vertices carry qbary
+        N = np.zeros((m, nq, d + 1))
+        for b in range(d):
+            np.put_along_axis(N, dr.pos[:, None, b:b + 1].repeat(nq, axis=1),
+                              dr.qbary[None, :, b:b + 1].repeat(m, axis=0), axis=2)  # fmt: skip
+        N = N.reshape(-1, d + 1)
+        k = np.where(paired, pick.index, 0)
+        n_m = np.zeros((len(xq), gdim))
+        if len(near):
+            n_m[paired] = facet_normals(near.x[k[paired]])
+        n = -n_m
+        Nm = np.where(paired[:, None], np.nan_to_num(pick.bary), 0.0)
+        # dofs of the point: slave cell nodes, then master facet nodes (gdim each)
+        cell_nodes = dr.slave.cell_nodes[facet]
+        master_nodes = near.nodes[k] if len(near) else np.zeros((len(xq), d), dtype=np.int64)
+        rows = np.concatenate([blocked_rows(cell_nodes, bs)[..., :gdim],
+                               blocked_rows(master_nodes, bs)[..., :gdim]],
+                              axis=1).reshape(len(xq), -1)  # fmt: skip
+        Jn = np.concatenate([N[:, :, None] * n[:, None, :], -Nm[:, :, None] * n[:, None, :]],
+                            axis=1).reshape(len(xq), -1)  # fmt: skip
+        E, lmbda, mu = (dr.lame[facet, i] for i in range(3))
+        grads = dr.grads[facet]  # (P, d + 1, gdim)
+        gn = np.einsum("pag,pg->pa", grads, n)
+        S = lmbda[:, None, None] * grads + 2.0 * mu[:, None, None] * gn[:, :, None] * n[:, None, :]
+        S = np.concatenate([S, np.zeros((len(xq), d, gdim))], axis=1).reshape(len(xq), -1)
+        x_cell = dr.slave.cell_X[facet] + ub[dr.slave.cell_local[facet]]
+        x_master = near.x[k] if len(near) else np.zeros((len(xq), d, gdim))
+        x_search = np.concatenate([x_cell, x_master], axis=1).reshape(len(xq), -1)
+        scale = self.law.stiffness * E / dr.h[facet]
+        return dict(rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale, x_search=x_search,
+                    N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
+                    slave_nodes=dr.slave.nodes[facet])  # fmt: skip
+
+    def _project(self, xq: np.ndarray, near: Facets):
+        """The master facet of each point (index -1: not in contact)."""
+        from contactfx import _compat
+
+        radius = self.pair.radius
+        tree = _compat.FacetTree(near.x, radius)
+        rows, facets = tree.collide_points(xq)
+        counts = np.bincount(rows, minlength=len(xq))
+        width = max(int(counts.max(initial=0)), 1)
+        cand = -np.ones((len(xq), width), dtype=np.int64)
+        order = np.argsort(rows, kind="stable")
+        rows, facets = rows[order], facets[order]
+        slot = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
+        cand[rows, slot] = facets
+        pick = pick_closest(xq, cand, near.x, fallback=True)
+        off = (pick.index >= 0) & ~pick.inside
+        if np.any(off):
+            # the closest point is a vertex: in contact if another master facet shares it
+            vertex = np.argmax(np.nan_to_num(pick.bary[off], nan=-1.0), axis=1)
+            node = near.nodes[pick.index[off], vertex]
+            uniq, count = np.unique(near.nodes, return_counts=True)
+            shared = count[np.searchsorted(uniq, node)] > 1
+            bary = np.zeros_like(pick.bary[off])
+            bary[np.arange(len(vertex)), vertex] = 1.0
+            pick.bary[off] = bary
+            pick.index[np.flatnonzero(off)[~shared]] = -1
+        return pick
+
+    # -- communication of the involved dofs ----------------------------------------------
+    def _scatter_setup(self, needed: np.ndarray) -> None:
+        if self.scatter is not None:
+            for obj in (self.scatter, self._local):
+                obj.destroy()
+        self._local = PETSc.Vec().createSeq(len(needed))
+        idx = PETSc.IS().createGeneral(needed.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
+        self._xvec = self.layout.X.duplicate()
+        self.scatter = PETSc.Scatter().create(self._xvec, idx, self._local, None)
+        idx.destroy()
+
+    def _gather(self, x: PETSc.Vec) -> np.ndarray:
+        self.scatter.scatter(x, self._local, addv=PETSc.InsertMode.INSERT,
+                             mode=PETSc.ScatterMode.FORWARD)  # fmt: skip
+        return self._local.getArray().copy()
+
+    def _gather_u(self, u: np.ndarray) -> np.ndarray:
+        n = self.layout.n_owned * self.layout.bs
+        self._xvec.getArray()[:] = u[:n]
+        return self._gather(self._xvec)
+
+    # -- residual and Jacobian ------------------------------------------------------------
+    def _law(self, p: dict, vals: np.ndarray):
+        """(P, dP/du coefficient vector, the stress term's value) at the points of p."""
+        u = vals[p["idx"]]
+        x = p["X"] + u
+        g = np.where(p["paired"], -np.einsum("pi,pi->p", p["Jn"], x), np.inf)
+        law = self.law
+        if law.kind == "penalty":
+            arg = -p["scale"] * g
+            P = np.maximum(arg, 0.0)
+            dP = (arg > 0.0)[:, None] * p["scale"][:, None] * p["Jn"]
+            return P, dP, g, None
+        sn = np.einsum("pi,pi->p", p["S"], u)
+        arg = -sn - p["scale"] * g
+        P = np.maximum(arg, 0.0)
+        dP = (arg > 0.0)[:, None] * (p["scale"][:, None] * p["Jn"] - p["S"])
+        return P, dP, g, sn
+
+    def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
+        vals = self._gather(x)
+        add = PETSc.InsertMode.ADD_VALUES
+        self.state = []
+        for p in self.points:
+            P, _, g, sn = self._law(p, vals)
+            r = P[:, None] * p["Jn"]
+            if sn is not None and self.law.theta != 0:
+                r -= (self.law.theta / p["scale"])[:, None] * (P + sn)[:, None] * p["S"]
+            r *= p["w"][:, None]
+            F.setValues(p["rows"].ravel(), r.ravel(), addv=add)
+            self.state.append((P, g))
+        F.assemblyBegin()
+        F.assemblyEnd()
+
+    def jacobian(self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None:
+        vals = self._gather(x)
+        J.zeroEntries()
+        J.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        add = PETSc.InsertMode.ADD_VALUES
+        theta = self.law.theta
+        for p in self.points:
+            _, dP, _, sn = self._law(p, vals)
+            A = np.einsum("pi,pj->pij", p["Jn"], dP)
+            if sn is not None and theta != 0:
+                t = (theta / p["scale"])[:, None]
+                A -= np.einsum("pi,pj->pij", p["S"], t * (dP + p["S"]))
+            A *= p["w"][:, None, None]
+            keep = np.any(A != 0.0, axis=(1, 2))
+            for rows, block in zip(p["rows"][keep], A[keep], strict=True):
+                J.setValues(rows, rows, block, addv=add)
+        J.assemble()
+
+    # -- what the post-processing reads ----------------------------------------------------
+    def nodal(self):
+        """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
+        quadrature values lumped to the nodes of the first direction's slave surface."""
+        p = self.points[0]
+        P, g = self.state[0]
+        lay = self.layout
+        Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
+        gap = np.where(np.isfinite(g), g, 0.0)
+        nodes = p["slave_nodes"].ravel()
+        data = np.stack([Nw.ravel(), (Nw * P[:, None]).ravel(), (Nw * gap[:, None]).ravel(),
+                         (Nw * np.isfinite(g)[:, None]).ravel()], axis=1)  # fmt: skip
+        sums = lay.node_sum(nodes, data, 4)
+        # nodes whose support has a master (more than half of it): the contact nodes
+        on = (sums[:, 0] > 0.0) & (sums[:, 3] > 0.5 * sums[:, 0])
+        D = sums[on, 0]
+        return np.flatnonzero(on) + lay.start, D, sums[on, 1] / D, sums[on, 2] / sums[on, 3]
+
+    def force(self) -> float:
+        """The normal contact force (the quadrature sum of P over both directions)."""
+        local = sum(float(np.sum(p["w"] * P)) for p, (P, _) in zip(self.points, self.state,
+                                                                    strict=True))  # fmt: skip
+        from mpi4py import MPI
+
+        return self.comm.allreduce(local, op=MPI.SUM)
