@@ -40,7 +40,7 @@ from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.pair import Facets, Side, facet_normals
-from contactfx.contact.projection import gauss_segment, gauss_triangle, pick_closest
+from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
 
 __all__ = ["PointCoupling", "Law"]
 
@@ -170,6 +170,11 @@ class PointCoupling:
         """The master facet of each point (index -1: not in contact)."""
         from contactfx import _compat
 
+        n, d = xq.shape
+        if n == 0 or len(near) == 0:  # nothing to project, or nothing near: no contact
+            nan = np.full((n, d), np.nan)
+            return Pick(-np.ones(n, dtype=np.int64), np.zeros(n, dtype=bool), nan, nan,
+                        np.full(n, np.nan), np.full(n, np.nan))  # fmt: skip
         radius = self.pair.radius
         tree = _compat.FacetTree(near.x, radius)
         rows, facets = tree.collide_points(xq)
