@@ -1,16 +1,22 @@
 """Mortar contact between two bodies: dual Lagrange multipliers on the slave surface, condensed
 out, and the nodal complementarity solved by semi-smooth Newton.
 
-Mortar integrals (P1, 2D), segment-based: for every slave segment and every master segment
+Mortar integrals (P1), segment-based: in 2D for every slave segment and every master segment
 whose projection along the slave segment's normal overlaps it (:mod:`.projection`),
-Gauss points on the overlap (the map to the master parameter is affine, so the rule is exact)
-give
+Gauss points on the overlap (the map to the master parameter is affine, so the rule is exact);
+in 3D for every slave triangle and every facing master triangle, the master projected onto the
+slave plane along the slave normal and clipped by the slave triangle
+(:func:`.projection.triangle_overlaps`, Puso & Laursen 2004, doi:10.1016/j.cma.2003.10.010;
+Popp et al. 2010, doi:10.1002/nme.2866), the degree-2 triangle rule on the clip polygon's fan
+triangles (both maps affine there, psi_j N_k quadratic: exact). They give
 
     D_j  = int_{Gamma_s} N_j ds  (diagonal: the dual basis psi_j is biorthogonal to N_j),
     M_jk = int_{Gamma_s} psi_j N_k^m ds,
 
-with psi_0 = 2 N_0 - N_1, psi_1 = 2 N_1 - N_0 on a segment (Wohlmuth 2000,
-doi:10.1137/S0036142999350929). The weighted nodal gap along the averaged nodal normal n_j is
+with psi_0 = 2 N_0 - N_1, psi_1 = 2 N_1 - N_0 on a segment and psi_i = 4 N_i - 1 on a
+triangle (int_T psi_i N_k = delta_ik |T| / 3; Wohlmuth 2000, doi:10.1137/S0036142999350929).
+The nodal normals n_j are the length- / area-weighted averages of the facet normals. The
+weighted nodal gap along n_j is
 
     g_j = n_j . (sum_k M_jk x_k - D_j x_j) / D_j
 
@@ -32,7 +38,14 @@ doi:10.1016/j.cma.2004.09.012): with T the row operator
     slave row (j, n):    D_j C(lambda_j, c_j g_j),      c_j = r0 E / h_j,
 
 C the complementarity function (``min``: lambda - max(0, lambda - c g), Alart-Curnier;
-``fb``: Fischer-Burmeister) and (j, n) the component of the largest |n_j|. The multiplier
+``fb``: Fischer-Burmeister), h_j = D_j^(1 / (gdim - 1)) (the length of a 2D node's support,
+the square root of a 3D node's area) and (j, n) the component of the largest |n_j|. At a slave
+node with Dirichlet components (a symmetry plane through the contact) those rows carry the
+support's reaction and are replaced by their conditions: the frame is built on the free
+components F instead, lambda_j = -n_F . R_j / (D_j |n_F|^2) from R_jc = -D_j lambda_j n_jc
+(c in F), the tangents span the free directions orthogonal to n_F, and (j, n) is the free
+component of largest |n_F| (without this a tangent row lands on a Dirichlet row, and the
+node's tangential equilibrium is lost while the reaction is forced to zero). The multiplier
 thus lives on the slave nodes only; no unknown is added. The Jacobian is exact for the mortar
 matrices and normals of the last search: J = diag(s) T K + diag(w) G with s = D_j dC/dlambda
 on the normal rows (1 elsewhere) and w = D_j c_j dC/d(cg). With ``--search-update newton`` the
@@ -49,7 +62,12 @@ from petsc4py import PETSc
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.method import MethodBase, Supports
 from contactfx.contact.pair import Facets, facet_normals, owners
-from contactfx.contact.projection import gauss_segment, segment_overlaps
+from contactfx.contact.projection import (
+    gauss_segment,
+    gauss_triangle,
+    segment_overlaps,
+    triangle_overlaps,
+)
 from contactfx.params import param, validate
 
 __all__ = ["Mortar", "MortarCoupling", "mortar_matrices"]
@@ -95,12 +113,22 @@ def _linear(xi: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - xi, xi], axis=-1)
 
 
+def _dual_triangle(lam: np.ndarray) -> np.ndarray:
+    """Dual shape functions psi_i = 4 N_i - 1 on a triangle, of barycentric coordinates
+    (..., 3): int_T psi_i N_k = 4 |T| (1 + delta_ik) / 12 - |T| / 3 = delta_ik |T| / 3."""
+    return 4.0 * lam - 1.0
+
+
 def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
-    """The local mortar integrals of 2D P1 segments: D contributions (m_s, 2) per slave
-    facet node (int N_j), length-weighted normal contributions (m_s, 2, gdim), and the
-    triplets (slave node, master node, value) of M over the candidate ``pairs`` (slave facet
-    indices, master facet indices) whose normals face each other and whose projections
-    overlap."""
+    """The local mortar integrals of P1 facets (segments in 2D, triangles in 3D, from
+    ``slave.x.shape[1]``): D contributions (m_s, d) per slave facet node (int N_j),
+    measure-weighted normal contributions (m_s, d, gdim), and the triplets (slave node, master
+    node, value) of M over the candidate ``pairs`` (slave facet indices, master facet indices)
+    whose normals face each other and whose projections overlap. ``order``: Gauss points per
+    overlap segment in 2D; the 3D fan triangles use the degree-2 rule (psi_j N_k is quadratic
+    on a fan triangle, where both are affine)."""
+    if slave.x.shape[1] == 3:
+        return _mortar_triangles(slave, master, pairs)
     xs, xm = slave.x, master.x
     length = np.linalg.norm(xs[:, 1] - xs[:, 0], axis=1)
     ns = facet_normals(xs)
@@ -125,6 +153,49 @@ def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
     flat = [np.concatenate([a.reshape(-1) for a in arr]) if arr else np.zeros(0)
             for arr in (rows, cols, vals)]  # fmt: skip
     return D, normals, (flat[0].astype(np.int64), flat[1].astype(np.int64), flat[2])
+
+
+def _mortar_triangles(slave: Facets, master: Facets, pairs):
+    """:func:`mortar_matrices` of P1 triangles: each facing candidate pair's overlap, the
+    master projected onto the slave plane along the slave normal
+    (:func:`.projection.triangle_overlaps`), integrated over its fan triangles with the
+    3-point degree-2 rule (exact for psi_j N_k); D_j = |T| / 3 per vertex, area-weighted
+    normals."""
+    xs, xm = slave.x, master.x
+    ns = facet_normals(xs)
+    area = 0.5 * np.linalg.norm(np.cross(xs[:, 1] - xs[:, 0], xs[:, 2] - xs[:, 0]), axis=1)
+    D = np.repeat(area[:, None] / 3.0, 3, axis=1)
+    normals = np.repeat((area[:, None] / 3.0 * ns)[:, None], 3, axis=1)
+    i, k = pairs
+    nm = facet_normals(xm) if len(xm) else np.zeros((0, 3))
+    # per facet once: centroid and radius (largest centroid-vertex distance); a master whose
+    # centroid projects onto the slave plane farther than r_s + r_m from the slave's centroid
+    # cannot overlap it (the orthogonal projection does not stretch): most candidates of the
+    # box search go here, before any per-pair array is built
+    cs, cm = xs.mean(axis=1), xm.mean(axis=1)
+    rs = np.linalg.norm(xs - cs[:, None], axis=2).max(axis=1)
+    rm = np.linalg.norm(xm - cm[:, None], axis=2).max(axis=1) if len(xm) else np.zeros(0)
+    d = cm[k] - cs[i]
+    nsi = ns[i]
+    d_n = np.sum(d * nsi, axis=1)
+    lateral2 = np.sum(d * d, axis=1) - d_n**2
+    near = (np.sum(nsi * nm[k], axis=1) < 0.0) & (lateral2 < (rs[i] + rm[k]) ** 2)
+    i, k = i[near], k[near]
+    ov = triangle_overlaps(xs[i], xm[k], ns[i])
+    i, k = i[ov.valid], k[ov.valid]
+    fan_area, sb, mb = ov.fan_area, ov.slave_bary, ov.master_bary
+    points, weights = gauss_triangle(2)
+    vals = np.zeros((len(i), 3, 3))
+    for lq, wq in zip(points, weights, strict=True):
+        # slave and master coordinates of the point in every fan triangle (pair, fan, 3)
+        ls = lq[0] * sb[:, :, 0] + lq[1] * sb[:, :, 1] + lq[2] * sb[:, :, 2]
+        lm = lq[0] * mb[:, :, 0] + lq[1] * mb[:, :, 1] + lq[2] * mb[:, :, 2]
+        psi = (wq * fan_area)[:, :, None] * _dual_triangle(ls)
+        vals += np.matmul(psi.transpose(0, 2, 1), lm)
+    rows = np.repeat(slave.nodes[i][:, :, None], 3, axis=2)
+    cols = np.repeat(master.nodes[k][:, None, :], 3, axis=1)
+    return D, normals, (rows.reshape(-1).astype(np.int64), cols.reshape(-1).astype(np.int64),
+                        vals.reshape(-1))  # fmt: skip
 
 
 def _to_owners(comm, ranges: np.ndarray, node: np.ndarray, payload: list[np.ndarray]):
@@ -184,46 +255,75 @@ class MortarCoupling:
         contact = coverage > 0.5
         scale = np.where(contact, Dj / np.where(Msum > 0, Msum, 1.0), 0.0)
         m_w = m_vals * scale[key] / Dj[key]  # M_jk / D_j, rescaled to sum to 1
+        # frames on the free components (a Dirichlet row is overwritten by its condition)
+        free = np.ones((len(uniq), gdim), dtype=bool)
+        if self.pair.fixed is not None:
+            local = (uniq - lay.start).astype(np.int64)
+            free = ~self.pair.fixed.reshape(-1, bs)[local, :gdim]
+        n_free, comp, tangents = _frames(nj, free)
+        # a normal nearly along the fixed components: the support carries the contact
+        contact &= np.linalg.norm(n_free, axis=1) > 0.5
         keep = contact[key]
-        # frames: the normal row is the component of largest |n_j|
-        comp = np.argmax(np.abs(nj), axis=1)
         self.nodes, self.D = uniq[contact], Dj[contact]
         self.normal, self.comp = nj[contact], comp[contact]
+        n_free, tangents, free = n_free[contact], tangents[contact], free[contact]
         self.h = self.D ** (1.0 / max(gdim - 1, 1))
         self.c = self.r0 * self.pair.E / self.h
         self.normal_rows = (self.nodes * bs + self.comp - lay.start * bs).astype(np.int32)
         for M in (self.T, self.G, self.TK):
             if M is not None:
                 M.destroy()
-        T, G = lay.matrix(), lay.matrix()
-        slave_local = (uniq[contact] - lay.start).astype(np.int64)
-        one = np.ones((lay.n_owned, bs))
-        one[slave_local] = 0.0
-        ones = T.createVecLeft()
-        ones.getArray()[:] = one.ravel()
-        T.assemble()
-        T.setDiagonal(ones)
-        ones.destroy()
-        add = PETSc.InsertMode.ADD_VALUES
-        tangents = _tangents(self.normal)
-        for a, j in enumerate(self.nodes):
-            cols_j = blocked_rows(j, bs)
-            n = self.normal[a]
-            t_rows = [c for c in range(gdim) if c != self.comp[a]]
-            for r, t in zip(t_rows, tangents[a], strict=True):
-                T.setValues([j * bs + r], cols_j, t, addv=add)
-            T.setValues([j * bs + self.comp[a]], cols_j, -n / self.D[a], addv=add)
-            G.setValues([j * bs + self.comp[a]], cols_j, -n, addv=add)
-        # master couplings
+        m = len(self.nodes)
+        # lambda_j = -n_F . R_j / (D_j |n_F|^2) from the free components' equilibrium
+        # R_jc = -D_j lambda_j n_jc (the fixed ones carry the support's reaction)
+        lam_row = -n_free / (self.D * np.sum(n_free**2, axis=1))[:, None]
+        # slave rows (j, c): lambda_j at comp, the tangents at the other free components,
+        # the identity at a fixed one (replaced by the Dirichlet condition)
+        rows_c = np.where(free[:, :, None], tangents, np.eye(gdim)[None])
+        rows_c[np.arange(m), self.comp] = lam_row
+        block = np.zeros((m, bs, bs))
+        block[:, :gdim, :gdim] = rows_c
+        block[:, gdim:, gdim:] = np.eye(bs - gdim)
+        j_rows = blocked_rows(self.nodes, bs)  # (m, bs)
+        t_r = [np.repeat(j_rows[:, :, None], bs, axis=2)]
+        t_c = [np.repeat(j_rows[:, None, :], bs, axis=1)]
+        t_v = [block]
+        normal_global = self.nodes * bs + self.comp
+        g_r = [np.repeat(normal_global[:, None], gdim, axis=1)]
+        g_c = [j_rows[:, :gdim]]
+        g_v = [-self.normal]
+        # identity on the rows of every other owned node
+        others = np.ones(lay.n_owned, dtype=bool)
+        others[(self.nodes - lay.start).astype(np.int64)] = False
+        diag = blocked_rows(np.flatnonzero(others) + lay.start, bs).ravel()
+        t_r.append(diag)
+        t_c.append(diag)
+        t_v.append(np.ones(len(diag)))
+        # master couplings: R_k - sum_j M_jk n_j lambda_j; the gap's master terms
         mk, mj, mw = m_cols[keep], m_rows[keep], m_w[keep]
         pos = np.searchsorted(self.nodes, mj)
-        for k, j, w, a in zip(mk, mj, mw, pos, strict=True):
-            n = self.normal[a]
-            block = w * np.outer(n, n)
-            T.setValues(blocked_rows(k, bs), blocked_rows(j, bs), block.ravel(), addv=add)
-            G.setValues([j * bs + self.comp[a]], blocked_rows(k, bs), w * n, addv=add)
-        for M in (T, G):
-            M.assemble()
+        k_rows, jm_rows = blocked_rows(mk, bs), j_rows[pos]
+        mblock = np.zeros((len(mk), bs, bs))
+        mblock[:, :gdim, :gdim] = -(self.D[pos] * mw)[:, None, None] * (
+            self.normal[pos][:, :, None] * lam_row[pos][:, None, :]
+        )
+        master_r = np.repeat(k_rows[:, :, None], bs, axis=2).ravel()
+        master_c = np.repeat(jm_rows[:, None, :], bs, axis=1).ravel()
+        g_r.append(np.repeat(normal_global[pos][:, None], gdim, axis=1))
+        g_c.append(k_rows[:, :gdim])
+        g_v.append(mw[:, None] * self.normal[pos])
+        # the master rows go to their owners
+        node_k, (master_r, master_c, master_v) = _to_owners(
+            self.comm, self.ranges, master_r // bs, [master_r, master_c, mblock.ravel()]
+        )
+        t_r.append(master_r)
+        t_c.append(master_c)
+        t_v.append(master_v)
+        T = _owned_matrix(
+            lay, *(np.concatenate([x.ravel() for x in arr]) for arr in (t_r, t_c, t_v))
+        )
+        G = _owned_matrix(lay, *(np.concatenate([x.ravel() for x in arr])
+                                 for arr in (g_r, g_c, g_v)))  # fmt: skip
         self.T, self.G = T, G
         self.g0 = G.createVecLeft()
         G.mult(lay.X, self.g0)
@@ -240,7 +340,10 @@ class MortarCoupling:
         lam = self._y.getArray()[self.normal_rows]
         cg = self.c * self._g.getArray()[self.normal_rows]
         if self.ncp == "min":
-            act = lam - cg >= 0.0
+            # a tie (lambda = 0, g at round-off of either sign, as on coinciding flat
+            # surfaces at the start) is active: gaps below 1e-12 h_j count as closed in the
+            # choice of the branch (C differs by at most r0 E 1e-12 from the other branch)
+            act = lam - cg >= -1e-12 * self.c * self.h
             C = np.where(act, cg, lam)
             da, db = np.where(act, 0.0, 1.0), np.where(act, 1.0, 0.0)
         else:
@@ -292,11 +395,47 @@ class MortarCoupling:
         return self.nodes, self.D, self.lam, self.gap
 
 
-def _tangents(n: np.ndarray) -> np.ndarray:
-    """(m, gdim - 1, gdim) unit tangents orthogonal to the unit normals n (m, gdim)."""
-    if n.shape[1] == 2:
-        return np.stack([n[:, 1], -n[:, 0]], axis=1)[:, None, :]
-    a = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-    t1 = np.cross(n, a)
-    t1 /= np.linalg.norm(t1, axis=1)[:, None]
-    return np.stack([t1, np.cross(n, t1)], axis=1)
+def _owned_matrix(lay: NodeLayout, rows, cols, vals) -> PETSc.Mat:
+    """The AIJ matrix of the node layout with the entries (global row, global column, value)
+    of owned rows (duplicates summed), built from local CSR arrays in one call."""
+    n_local = lay.n_owned * lay.bs
+    n_global = lay.imap.size_global * lay.bs
+    start = lay.start * lay.bs
+    key = (rows.astype(np.int64) - start) * n_global + cols.astype(np.int64)
+    uniq, inv = np.unique(key, return_inverse=True)
+    values = np.bincount(inv, weights=vals, minlength=len(uniq))
+    local_rows, cols_u = np.divmod(uniq, n_global)
+    indptr = np.searchsorted(local_rows, np.arange(n_local + 1))
+    M = PETSc.Mat().createAIJ(((n_local, n_global), (n_local, n_global)),
+                              csr=(indptr.astype(PETSc.IntType), cols_u.astype(PETSc.IntType),
+                                   values), comm=lay.comm)  # fmt: skip
+    M.assemble()
+    return M
+
+
+def _frames(n: np.ndarray, free: np.ndarray):
+    """Nodal frames restricted to the free (not Dirichlet) components.
+
+    n: (m, gdim) unit normals, free: (m, gdim) bool. Returns n_F = the normals' free part,
+    comp = the free component of largest |n_F| (the row of the complementarity), and
+    tangents (m, gdim, gdim): for every free component c != comp the unit vector of the free
+    subspace orthogonal to n_F and to the tangents of the lower components (Gram-Schmidt of
+    e_c; e_c and n_F span the free subspace because n_F is largest at comp), zero rows
+    elsewhere. Without fixed components these are tangent planes' orthonormal bases."""
+    m, gdim = n.shape
+    n_free = np.where(free, n, 0.0)
+    comp = np.argmax(np.abs(n_free), axis=1)
+    norm = np.linalg.norm(n_free, axis=1)
+    basis = [n_free / np.where(norm > 0, norm, 1.0)[:, None]]
+    tangents = np.zeros((m, gdim, gdim))
+    for c in range(gdim):
+        use = free[:, c] & (comp != c)
+        v = np.zeros((m, gdim))
+        v[:, c] = 1.0
+        for b in basis:
+            v -= np.sum(v * b, axis=1)[:, None] * b
+        length = np.linalg.norm(v, axis=1)
+        v = np.where(use[:, None], v / np.where(length > 0, length, 1.0)[:, None], 0.0)
+        tangents[:, c] = v
+        basis.append(v)
+    return n_free, comp, tangents

@@ -173,14 +173,16 @@ def global_max(comm, value: float) -> float:
 @dataclass
 class ContactPair:
     """A (slave, master) pair of contact surfaces of one mesh's bodies, the node layout of the
-    displacement, the modulus E that scales the methods' parameters, the search policy, and
-    the search's counters (number of searches, wall time)."""
+    displacement, the modulus E that scales the methods' parameters, the search policy, the
+    owned Dirichlet dofs (``fixed``: bool (n_owned * bs,), local unrolled dof indices, or
+    None), and the search's counters (number of searches, wall time)."""
 
     layout: object
     slave: Side
     master: Side
     E: float
     search_each_newton: bool = False
+    fixed: np.ndarray | None = None
     searches: int = 0
     search_time: float = 0.0
     radius: float = field(default=0.0)

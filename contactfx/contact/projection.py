@@ -69,6 +69,7 @@ __all__ = [
     "SegmentOverlaps",
     "SegmentProjection",
     "TriangleOverlap",
+    "TriangleOverlaps",
     "clip_polygon",
     "closest_point_facets",
     "closest_point_segments",
@@ -86,6 +87,7 @@ __all__ = [
     "segment_overlaps",
     "triangle_normal",
     "triangle_overlap",
+    "triangle_overlaps",
 ]
 
 #: default tolerance on the facet coordinates (xi, barycentric) for "inside"
@@ -569,6 +571,166 @@ def triangle_overlap(
     beta = (master[0] - triangles) @ nm / den_m
     master_bary = _plane_bary(triangles + beta[..., None] * v, master)
     return TriangleOverlap(polygon, float(polygon_area(poly)), triangles, slave_bary, master_bary)
+
+
+class TriangleOverlaps(NamedTuple):
+    """Overlaps of n (slave, master) triangle pairs, vectorised. A clip polygon has at most 6
+    vertices (a triangle clipped by three half-planes; more only with repeated vertices on an
+    edge, of zero-area fan triangles), its fan as many triangles, padded to f >= 6.
+
+    valid: (n,) bool, the overlap area exceeds the tolerance. The other arrays hold the valid
+    pairs only, in order (v = valid.sum() rows, those of ``np.flatnonzero(valid)``): area (v,)
+    overlap areas; fan_area (v, f) areas of the fan triangles (centroid, v_i, v_{i+1}), 0 for
+    padding; slave_bary, master_bary (v, f, 3, 3) barycentric coordinates of the fan
+    triangles' vertices in the slave triangle and of their projections in the master triangle
+    (as in :class:`TriangleOverlap`)."""
+
+    valid: np.ndarray
+    area: np.ndarray
+    fan_area: np.ndarray
+    slave_bary: np.ndarray
+    master_bary: np.ndarray
+
+
+def _bary2(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
+    """Barycentric coordinates (n, ..., 3) of 2D points p (n, ..., 2) in triangles tri
+    (n, 3, 2) of either orientation (NaN for degenerate ones)."""
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    det = _cross2(e1, e2)
+    shape = (-1,) + (1,) * (p.ndim - 2)
+    w = p - tri[:, 0].reshape(shape + (2,))
+    s = _div(_cross2(w, e2.reshape(shape + (2,))), det.reshape(shape))
+    t = _div(_cross2(e1.reshape(shape + (2,)), w), det.reshape(shape))
+    return np.stack([1.0 - s - t, s, t], axis=-1)
+
+
+def _clip_halfplanes(poly: np.ndarray, count: np.ndarray, clip: np.ndarray):
+    """Sutherland-Hodgman on n convex polygons at once: poly (n, k, 2) padded, count (n,) the
+    vertex numbers, clipped by the n counter-clockwise triangles clip (n, 3, 2). Returns the
+    clipped (n, k', 2) and the counts (0 for an empty result). A vertex is kept by the exact
+    sign of its distance to an edge (>= 0 inside), as in :func:`clip_polygon`."""
+    n = poly.shape[0]
+    rows = np.arange(n)[:, None]
+    for e in range(3):
+        c0, c1 = clip[:, e][:, None, :], clip[:, (e + 1) % 3][:, None, :]
+        k = poly.shape[1]
+        idx = np.arange(k)[None, :]
+        live = idx < count[:, None]
+        dist = _cross2(c1 - c0, poly - c0)  # (n, k), > 0 inside
+        nxt = np.where(idx + 1 < count[:, None], idx + 1, 0)
+        pnext, dnext = poly[rows, nxt], dist[rows, nxt]
+        keep = live & (dist >= 0)
+        cut = live & ((dist >= 0) != (dnext >= 0))
+        t = _div(dist, dist - dnext, 0.0)[..., None]
+        cross_point = poly + t * (pnext - poly)
+        n_out = keep.astype(np.int64) + cut
+        start = np.cumsum(n_out, axis=1) - n_out
+        count = n_out.sum(axis=1)
+        out = np.zeros((n, max(int(count.max(initial=0)), 1), 2))
+        r, c = np.nonzero(keep)
+        out[r, start[r, c]] = poly[r, c]
+        r, c = np.nonzero(cut)
+        out[r, start[r, c] + keep[r, c]] = cross_point[r, c]
+        poly = out
+    return poly, count
+
+
+def _dot3(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Dot product over a last axis of length 3 (faster than einsum on many short rows)."""
+    return u[..., 0] * v[..., 0] + u[..., 1] * v[..., 1] + u[..., 2] * v[..., 2]
+
+
+def _separated(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n,) bool: the 2D triangles a, b (n, 3, 2) are separated (or only touch) along one of
+    their six edge normals (separating axis theorem for convex polygons)."""
+    out = np.zeros(a.shape[0], dtype=bool)
+    for tri in (a, b):
+        for e in range(3):
+            edge = tri[:, (e + 1) % 3] - tri[:, e]
+            pa = [a[:, v, 1] * edge[:, 0] - a[:, v, 0] * edge[:, 1] for v in range(3)]
+            pb = [b[:, v, 1] * edge[:, 0] - b[:, v, 0] * edge[:, 1] for v in range(3)]
+            lo_a, hi_a = (
+                np.minimum(np.minimum(*pa[:2]), pa[2]),
+                np.maximum(np.maximum(*pa[:2]), pa[2]),
+            )
+            lo_b, hi_b = (
+                np.minimum(np.minimum(*pb[:2]), pb[2]),
+                np.maximum(np.maximum(*pb[:2]), pb[2]),
+            )
+            out |= (hi_a <= lo_b) | (hi_b <= lo_a)
+    return out
+
+
+def triangle_overlaps(
+    slave: ArrayLike, master: ArrayLike, normal: ArrayLike | None = None, tol: float = 1e-12
+) -> TriangleOverlaps:
+    """The overlaps of n (slave, master) triangle pairs ((n, 3, 3) each), the master projected
+    onto the slave's plane along ``normal`` ((n, 3) or (3,), default: the slave normals): the
+    vectorised :func:`triangle_overlap`, with the same clip polygons and the same fan
+    (centroid of the clip polygon's vertices; coinciding vertices, which
+    :func:`clip_polygon` merges, only add fan triangles of zero area).
+
+    In 2D coordinates of each slave plane (orthonormal, counter-clockwise seen from the slave
+    normal) the pairs that an edge normal separates (most candidates of a box search) are
+    dropped first; in the others the slave triangle is clipped by the projected master
+    triangle (reoriented counter-clockwise). Both maps from the plane to the facets'
+    barycentric coordinates are affine, so they are evaluated at the fan's vertices. A pair is
+    ``valid`` when its area exceeds tol * L^2 (L the larger extent of the two triangles in the
+    plane) and the normal is not parallel to either plane."""
+    slave, master = np.asarray(slave, float), np.asarray(master, float)
+    ns_all = ns = triangle_normal(slave)
+    nm = triangle_normal(master)
+    v = ns if normal is None else np.broadcast_to(np.asarray(normal, float), ns.shape)
+    den_s, den_m = _dot3(v, ns), _dot3(v, nm)
+    ok = (den_s != 0.0) & (den_m != 0.0) & np.isfinite(den_s * den_m)
+    # cheap exclusion first: the projection along v onto the slave plane stretches lengths by
+    # at most |v| / |v . ns|, so the projected master lies in the disc of radius r_m times
+    # that around its projected centroid (r: the largest centroid-vertex distance)
+    cs, cm = slave.mean(axis=1), master.mean(axis=1)
+    rs = np.sqrt(np.max([_dot3(slave[:, j] - cs, slave[:, j] - cs) for j in range(3)], axis=0))
+    rm = np.sqrt(np.max([_dot3(master[:, j] - cm, master[:, j] - cm) for j in range(3)], axis=0))
+    stretch = np.sqrt(_dot3(v, v)) / np.abs(np.where(ok, den_s, 1.0))
+    pc = cm - _div(_dot3(cm - cs, ns), np.where(ok, den_s, 1.0), 0.0)[:, None] * v
+    d = pc - cs
+    ok &= _dot3(d, d) < (rs + rm * stretch) ** 2
+    keep = np.flatnonzero(ok)
+    slave, master, ns, nm, v = slave[keep], master[keep], ns[keep], nm[keep], v[keep]
+    den_s, ok = den_s[keep], ok[keep]
+    origin = slave[:, None, 0]
+    t1 = _unit(slave[:, 1] - slave[:, 0])[:, None]
+    t2 = np.cross(ns[:, None], t1)  # t1 x t2 = ns
+    alpha = _div(_dot3(master - origin, ns[:, None]), den_s[:, None], 0.0)
+    projected = master - alpha[..., None] * v[:, None]
+    s2 = np.stack([_dot3(slave - origin, t1), _dot3(slave - origin, t2)], axis=-1)
+    m2 = np.stack([_dot3(projected - origin, t1), _dot3(projected - origin, t2)], axis=-1)
+    sel = np.flatnonzero(ok & ~_separated(s2, m2))
+    s2, m2 = s2[sel], m2[sel]
+    n = len(sel)
+    # the clip triangle counter-clockwise (facing surfaces project clockwise)
+    clip = m2.copy()
+    cw = _cross2(m2[:, 1] - m2[:, 0], m2[:, 2] - m2[:, 0]) < 0
+    clip[cw, 1], clip[cw, 2] = m2[cw, 2], m2[cw, 1]
+    poly, count = _clip_halfplanes(s2, np.full(n, 3), clip)
+    k = poly.shape[1]
+    idx = np.arange(k)[None, :]
+    live = idx < count[:, None]
+    centre = np.sum(np.where(live[..., None], poly, 0.0), axis=1) / np.maximum(count, 1)[:, None]
+    nxt = np.where(idx + 1 < count[:, None], idx + 1, 0)
+    pnext = poly[np.arange(n)[:, None], nxt]
+    fan = np.stack([np.broadcast_to(centre[:, None], poly.shape), poly, pnext], axis=2)
+    fan_area = np.where(live, 0.5 * _cross2(poly - centre[:, None], pnext - centre[:, None]), 0.0)
+    area = fan_area.sum(axis=1)
+    both = np.concatenate([s2, m2], axis=1)
+    scale = np.max(both.max(axis=1) - both.min(axis=1), axis=1)
+    good = (count >= 3) & (area > tol * scale**2)
+    valid = np.zeros(len(ns_all), dtype=bool)
+    valid[keep[sel[good]]] = True
+    fan, fan_area = fan[good], fan_area[good]
+    if k < 6:
+        fan_area = np.pad(fan_area, ((0, 0), (0, 6 - k)))
+        fan = np.pad(fan, ((0, 0), (0, 6 - k), (0, 0), (0, 0)))
+    return TriangleOverlaps(valid, area[good], fan_area, _bary2(fan, s2[good]),
+                            _bary2(fan, m2[good]))  # fmt: skip
 
 
 # --- quadrature ----------------------------------------------------------------------------

@@ -68,10 +68,15 @@ class TwoBodyProblem(Problem):
             if count == 0:
                 raise ValueError(f"the {what} surface (facet tag {tag}) has no facet")
         self.layout = NodeLayout(self.V)
+        n_dofs = self.layout.n_owned * self.layout.bs
+        fixed = np.zeros(n_dofs, dtype=bool)  # owned Dirichlet dofs (symmetry planes, rollers)
+        for bc in self.bcs:
+            dofs = np.asarray(_compat.bc_dofs(bc))
+            fixed[dofs[dofs < n_dofs]] = True
         self.pair = ContactPair(
             self.layout, side_of(self.V, self.facet_tags, scene.slave_tag),
             side_of(self.V, self.facet_tags, scene.master_tag), scene.contact_modulus(),
-            search_each_newton=self.num.search_update == "newton",
+            search_each_newton=self.num.search_update == "newton", fixed=fixed,
         )  # fmt: skip
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)

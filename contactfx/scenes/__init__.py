@@ -10,7 +10,7 @@ from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.sliding_block import SlidingBlock
-from contactfx.scenes.two_body import HertzCylinders, PatchTest
+from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.westergaard import Westergaard
 
 __all__ = ["SCENES", "get_scene", "Scene", "Numerics"]
@@ -31,6 +31,7 @@ SCENES: dict[str, type[Scene]] = {
         JointColumn,
         PatchTest,
         HertzCylinders,
+        HertzSpheres,
     )
 }
 

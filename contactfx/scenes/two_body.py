@@ -9,6 +9,10 @@ bodies and the uniform contact pressure q; a mortar method with exact segment-ba
 integration reproduces it to round-off for any ratio and either slave side (the partition of
 unity sum_k M_jk = D_j).
 
+With ``dim = 3`` the blocks are two stacked boxes [0, width]^2 (tetrahedra), the lower one on
+rollers at its bottom (u_z = 0), both on rollers at x = 0 (u_x = 0) and y = 0 (u_y = 0); the
+exact state is sigma_zz = -q, the contact pressure q and the force q * width^2.
+
 ``hertz-cylinders``: two cylinders of radii R1 (upper), R2 (lower), quarter model with the
 symmetry plane x = 0, pressed together by the prescribed approach ``depth`` of the upper
 body's flat top. At the computed force P per unit length (full model),
@@ -17,6 +21,15 @@ body's flat top. At the computed force P per unit length (full model),
     1/R = 1/R1 + 1/R2,   1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2
 
 (Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, section 4.2).
+
+``hertz-spheres``: two spheres of radii R1 (upper), R2 (lower), quarter model with the
+symmetry planes x = 0 and y = 0, pressed together by the approach ``depth`` of the upper
+body's flat top, the lower body's flat bottom on rollers (u_z = 0). At the computed force P
+(full model)
+
+    a = (3 P R / (4 E*))^(1/3),   p0 = 3 P / (2 pi a^2)
+
+(Johnson 1985, section 4.2), R and E* as for the cylinders.
 """
 
 from __future__ import annotations
@@ -31,17 +44,23 @@ from contactfx import _compat
 from contactfx.meshes import (
     CylindersCells,
     CylindersFacets,
+    SpheresCells,
+    SpheresFacets,
     StackedBlocksCells,
     StackedBlocksFacets,
+    StackedBoxesCells,
+    StackedBoxesFacets,
     cylinders,
+    spheres,
     stacked_blocks,
+    stacked_boxes,
 )
 from contactfx.params import param
-from contactfx.references import hertz_2d
+from contactfx.references import hertz_2d, hertz_3d
 from contactfx.scenes._common import fix_component
 from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
 
-__all__ = ["PatchTest", "HertzCylinders"]
+__all__ = ["PatchTest", "HertzCylinders", "HertzSpheres"]
 
 
 def _component_value(V, facet_tags, tag: int, component: int, value):
@@ -61,41 +80,60 @@ class PatchTestParams(two_elastic(1000.0, 0.3)):
     offset: float = param(0.3, "shift of the upper block's contact nodes (fraction of its "
                           "element, in [0, 1))", nonnegative=True)  # fmt: skip
     pressure: float = param(1.0, "pressure q on the top of the upper block", positive=True)
+    dim: int = param(2, "dimension: 2 (stacked blocks) or 3 (stacked boxes)", choices=(2, 3))
 
 
 class PatchTest(TwoBodyScene):
     name = "patch-test"
-    summary = ("two stacked blocks with non-matching meshes under uniform pressure; exact: "
-               "uniform stress and contact pressure")  # fmt: skip
+    summary = ("two stacked blocks (--dim 3: boxes) with non-matching meshes under uniform "
+               "pressure; exact: uniform stress and contact pressure")  # fmt: skip
     Params = PatchTestParams
     cells = {"lower": StackedBlocksCells.LOWER, "upper": StackedBlocksCells.UPPER}
     surfaces = {"lower": StackedBlocksFacets.LOWER_TOP, "upper": StackedBlocksFacets.UPPER_BOTTOM}
 
+    def __init__(self, params) -> None:
+        super().__init__(params)
+        if params.dim == 3:
+            self.cells = {"lower": StackedBoxesCells.LOWER, "upper": StackedBoxesCells.UPPER}
+            self.surfaces = {"lower": StackedBoxesFacets.LOWER_TOP,
+                             "upper": StackedBoxesFacets.UPPER_BOTTOM}  # fmt: skip
+
     def build_mesh(self, comm):
         p = self.p
-        builder = functools.partial(stacked_blocks, width=p.width, h_lower=p.height,
-                                    h_upper=p.height, h1=p.h, ratio=p.ratio,
-                                    offset=p.offset)  # fmt: skip
-        return self.mesh_of(comm, builder, 2)
+        blocks = stacked_boxes if p.dim == 3 else stacked_blocks
+        builder = functools.partial(blocks, width=p.width, h_lower=p.height, h_upper=p.height,
+                                    h1=p.h, ratio=p.ratio, offset=p.offset)  # fmt: skip
+        return self.mesh_of(comm, builder, p.dim)
 
     def h_contact(self) -> float:
         return self.p.h
 
     def dirichlet(self, V, facet_tags) -> list:
+        if self.p.dim == 3:
+            f = StackedBoxesFacets
+            return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
+                    fix_component(V, facet_tags, f.LOWER_X0, 0),
+                    fix_component(V, facet_tags, f.UPPER_X0, 0),
+                    fix_component(V, facet_tags, f.LOWER_Y0, 1),
+                    fix_component(V, facet_tags, f.UPPER_Y0, 1)]  # fmt: skip
         f = StackedBlocksFacets
         return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
                 fix_component(V, facet_tags, f.LOWER_LEFT, 0),
                 fix_component(V, facet_tags, f.UPPER_LEFT, 0)]  # fmt: skip
 
     def load(self, v, ds, t):
+        if self.p.dim == 3:
+            return -self.p.pressure * t * v[2] * ds(StackedBoxesFacets.UPPER_TOP)
         return -self.p.pressure * t * v[1] * ds(StackedBlocksFacets.UPPER_TOP)
 
     def contact_size(self, measure: float) -> float:
+        """The contact length (2D) or area (3D)."""
         return measure
 
     def reference(self, force: float) -> dict[str, float]:
-        """The exact contact force q * width and the uniform pressure q (as p0)."""
-        return {"force": self.p.pressure * self.p.width, "p0": self.p.pressure}
+        """The exact contact force q * width^(dim - 1) and the uniform pressure q (as p0)."""
+        p = self.p
+        return {"force": p.pressure * p.width ** (p.dim - 1), "p0": p.pressure}
 
     def pressure_scores(self, x, p, force):
         """Largest relative deviation of the nodal contact pressure from q."""
@@ -103,8 +141,10 @@ class PatchTest(TwoBodyScene):
         return {"pressure_deviation": float(np.max(np.abs(p - q), initial=0.0)) / q}
 
     def exact_stress(self):
-        """The exact stress (uniform): sigma_yy = -q, the rest zero."""
-        return np.array([[0.0, 0.0], [0.0, -self.p.pressure]])
+        """The exact stress (uniform): sigma_yy (2D) or sigma_zz (3D) = -q, the rest zero."""
+        sigma = np.zeros((self.p.dim, self.p.dim))
+        sigma[-1, -1] = -self.p.pressure
+        return sigma
 
 
 @dataclass(frozen=True)
@@ -174,3 +214,105 @@ class HertzCylinders(TwoBodyScene):
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.R(), self.E_star())
+
+
+def radial_edge(r: np.ndarray, p: np.ndarray, width: float) -> float | None:
+    """The radius of a round contact area from its closed nodes at the radii r with the
+    pressures p > 0: the closed nodes are binned in rings of ``width`` (the slave element
+    size), each ring gives its mean radius and mean p^2, and the straight line of p^2 through
+    the two outermost rings is extrapolated to zero (near the edge of a smooth contact p^2 falls
+    linearly with the distance to the edge; for Hertz p^2 = p0^2 (1 - r^2 / a^2) exactly
+    linear in r^2, and the line in r errs by O((width / a)^2)). Averaging over a ring of nodes
+    smooths the scatter of single nodes of an unstructured surface mesh. None with fewer than
+    two rings."""
+    if len(r) == 0:
+        return None
+    ring = np.floor(r / width).astype(np.int64)
+    rings, inv = np.unique(ring, return_inverse=True)
+    if len(rings) < 2:
+        return None
+    count = np.bincount(inv)
+    r_mean = np.bincount(inv, weights=r) / count
+    p2_mean = np.bincount(inv, weights=p**2) / count
+    (r1, r2), (q1, q2) = r_mean[-2:], p2_mean[-2:]
+    if not q1 > q2:
+        return float(r2)
+    return float(r2 + q2 * (r2 - r1) / (q1 - q2))
+
+
+@dataclass(frozen=True)
+class HertzSpheresParams(two_elastic(1000.0, 0.3)):
+    R_upper: float = param(1.0, "radius R1 of the upper sphere", positive=True)
+    R_lower: float = param(1.0, "radius R2 of the lower sphere", positive=True)
+    depth: float = param(0.02, "approach of the upper body's top (ramped over the load "
+                         "steps)", positive=True)  # fmt: skip
+    h_contact: float = param(0.0065, "element size of the lower body in the contact zone",
+                             positive=True)  # fmt: skip
+    h_far: float = param(0.25, "element size far from the contact zone", positive=True)
+    refine: float = param(0.13, "radius of the refined zone around the first contact point",
+                          positive=True)  # fmt: skip
+    # the slave (upper) surface coarser than the master: with a finer slave the nodal
+    # pressures scatter by several % (docs/verification.md section 10)
+    ratio: float = param(1.3, "element size of the upper body / that of the lower",
+                         positive=True)  # fmt: skip
+    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
+                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    grading: float = param(0.3, "element size growth per unit distance from the refined zone",
+                           positive=True)  # fmt: skip
+
+
+class HertzSpheres(TwoBodyScene):
+    name = "hertz-spheres"
+    summary = "two elastic spheres pressed together (quarter model); reference Hertz a, p0"
+    Params = HertzSpheresParams
+    cells = {"lower": SpheresCells.LOWER, "upper": SpheresCells.UPPER}
+    surfaces = {"lower": SpheresFacets.LOWER_CONTACT, "upper": SpheresFacets.UPPER_CONTACT}
+    symmetry = 4.0
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(spheres, radius_lower=p.R_lower, radius_upper=p.R_upper,
+                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
+                                    ratio=p.ratio, offset=p.offset,
+                                    grading=p.grading)  # fmt: skip
+        mesh, facet_tags = self.mesh_of(comm, builder, 3)
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = SpheresFacets
+        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
+                fix_component(V, facet_tags, f.LOWER_X0, 0),
+                fix_component(V, facet_tags, f.UPPER_X0, 0),
+                fix_component(V, facet_tags, f.LOWER_Y0, 1),
+                fix_component(V, facet_tags, f.UPPER_Y0, 1),
+                _component_value(V, facet_tags, f.UPPER_TOP, 2, self.push)]  # fmt: skip
+
+    def set_load(self, t: float) -> None:
+        self.push.value = -t * self.p.depth
+
+    def h_slave(self) -> float:
+        """The element size of the slave surface in the contact zone."""
+        p = self.p
+        return p.h_contact * (p.ratio if p.slave == "upper" else 1.0)
+
+    def contact_size(self, measure: float) -> float:
+        """The radius of a disc of the closed nodes' area (fallback of :meth:`contact_edge`)."""
+        return float(np.sqrt(measure / np.pi))
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+        """The contact radius from the closed slave nodes: :func:`radial_edge` of their radial
+        distances sqrt(x^2 + y^2), rings of the slave element size."""
+        closed = p > 0.0
+        r = np.hypot(x[closed, 0], x[closed, 1])
+        return radial_edge(r, p[closed], self.h_slave())
+
+    def E_star(self) -> float:
+        m = self.materials()
+        return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())
+
+    def R(self) -> float:
+        return 1.0 / (1.0 / self.p.R_upper + 1.0 / self.p.R_lower)
+
+    def reference(self, force: float) -> dict[str, float]:
+        return hertz_3d(force, self.R(), self.E_star())

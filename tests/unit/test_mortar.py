@@ -73,3 +73,112 @@ def test_facet_tree_candidates():
     # padded boxes (0.1): the first point meets facet 0 only, the shared vertex both, the
     # point at x = 3 none (farther than the padding from every facet)
     assert hits == {(0, 0), (1, 0), (1, 1)}
+
+
+def _square(n: int, z: float, nodes0: int, rng, upward: bool) -> Facets:
+    """A triangulation of the unit square at height z: an n x n grid, interior nodes moved
+    by up to 0.3 of a cell, each cell cut along a random diagonal; normals +z (``upward``) or
+    -z."""
+    s = np.linspace(0.0, 1.0, n + 1)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    inner = (X > 0) & (X < 1) & (Y > 0) & (Y < 1)
+    X = X + np.where(inner, rng.uniform(-0.3, 0.3, X.shape) / n, 0.0)
+    Y = Y + np.where(inner, rng.uniform(-0.3, 0.3, Y.shape) / n, 0.0)
+    pts = np.stack([X.ravel(), Y.ravel(), np.full(X.size, z)], axis=1)
+    tris = []
+    for a in range(n):
+        for b in range(n):
+            v00, v10, v01, v11 = a * (n + 1) + b, (a + 1) * (n + 1) + b, a * (n + 1) + b + 1, (
+                a + 1) * (n + 1) + b + 1  # fmt: skip
+            if rng.random() < 0.5:
+                tris += [(v00, v10, v11), (v00, v11, v01)]
+            else:
+                tris += [(v00, v10, v01), (v10, v11, v01)]
+    tris = np.array(tris)  # counter-clockwise seen from +z
+    if not upward:
+        tris = tris[:, [0, 2, 1]]
+    return Facets(pts[tris], tris + nodes0)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_mortar_partition_of_unity_3d(seed):
+    rng = np.random.default_rng(seed)
+    # slave: the upper body's bottom (normal -z), master: the lower body's top (normal +z),
+    # non-matching random triangulations of the same square
+    slave = _square(5, 0.0, 0, rng, upward=False)
+    master = _square(7, 0.0, 1000, rng, upward=True)
+    assert np.allclose(facet_normals(slave.x), [0.0, 0.0, -1.0])
+    assert np.allclose(facet_normals(master.x), [0.0, 0.0, 1.0])
+    pairs = FacetTree(master.x, 0.3).collide(FacetTree(slave.x, 0.0))
+    D, normals, (rows, cols, vals) = mortar_matrices(slave, master, pairs)
+    n_nodes = 36
+    D_node = np.zeros(n_nodes)
+    np.add.at(D_node, slave.nodes.ravel(), D.ravel())
+    M_sum = np.zeros(n_nodes)
+    np.add.at(M_sum, rows, vals)
+    # exact integration (the degree-2 rule on the fan triangles, where psi_j N_k is quadratic)
+    # and full coverage: sum_k M_jk = int psi_j = int N_j = D_j; the values are O(1 / 25)
+    # sums of O(100) terms, so round-off is ~1e-16
+    assert np.allclose(M_sum, D_node, rtol=0, atol=1e-14)
+    # D_j = a third of the adjacent areas; the total is the slave area 1
+    assert D_node.sum() == pytest.approx(1.0, abs=1e-14)
+    # the master column sums are int N_k over the overlap: their total is the covered area 1
+    assert vals.sum() == pytest.approx(1.0, abs=1e-13)
+    # a linear field is transmitted: sum_k M_jk x_k = D_j x_j (the patch test's premise)
+    xm = np.zeros((2000, 3))
+    xm[master.nodes.ravel()] = master.x.reshape(-1, 3)
+    xs = np.zeros((n_nodes, 3))
+    xs[slave.nodes.ravel()] = slave.x.reshape(-1, 3)
+    Mx = np.zeros((n_nodes, 3))
+    np.add.at(Mx, rows, vals[:, None] * xm[cols])
+    assert np.allclose(Mx, D_node[:, None] * xs, rtol=0, atol=1e-14)
+    # the area-weighted normals add up to the slave area times its normal
+    assert np.allclose(normals.sum(axis=(0, 1)), [0.0, 0.0, -1.0], atol=1e-14)
+
+
+def test_dual_basis_biorthogonal_on_a_triangle():
+    from contactfx.contact.mortar import _dual_triangle
+    from contactfx.contact.projection import gauss_triangle
+
+    # int_T psi_i N_k = delta_ik |T| / 3, by the degree-2 rule (exact for the quadratic
+    # integrand) on the unit triangle (|T| = 1/2)
+    points, weights = gauss_triangle(2)
+    integral = 0.5 * np.einsum("q,qi,qk->ik", weights, _dual_triangle(points), points)
+    assert np.allclose(integral, np.eye(3) / 6.0, rtol=0, atol=1e-15)
+
+
+def test_triangle_overlaps_match_the_scalar_clip():
+    from contactfx.contact.projection import triangle_overlap, triangle_overlaps
+
+    rng = np.random.default_rng(3)
+    n = 200
+    slave = rng.uniform(0, 1, (n, 3, 3)) * [1.0, 1.0, 0.05]
+    master = slave[:, ::-1] + rng.uniform(-0.4, 0.4, (n, 3, 3)) * [1.0, 1.0, 0.05]
+    ov = triangle_overlaps(slave, master)
+    row = np.cumsum(ov.valid) - 1  # the row of a valid pair in the compact arrays
+    for a in range(n):
+        one = triangle_overlap(slave[a], master[a])
+        assert (one is not None) == ov.valid[a]
+        if one is None:
+            continue
+        # the same polygon (area) and the same integrals: the moments int l_s l_m^T of the
+        # slave and master barycentric coordinates over the fan (both maps affine, the
+        # degree-2 rule exact), to round-off of O(1) quantities
+        b = row[a]
+        assert ov.area[b] == pytest.approx(one.area, rel=1e-12)
+        assert np.allclose(_moments(ov.fan_area[b], ov.slave_bary[b], ov.master_bary[b]),
+                           _moments(_areas(one.triangles), one.slave_bary, one.master_bary),
+                           rtol=0, atol=1e-14)  # fmt: skip
+
+
+def _areas(tri):
+    return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+
+
+def _moments(area, sb, mb):
+    from contactfx.contact.projection import gauss_triangle
+
+    points, weights = gauss_triangle(2)
+    ls = np.einsum("qv,fvc->fqc", points, sb)
+    lm = np.einsum("qv,fvc->fqc", points, mb)
+    return np.einsum("f,q,fqj,fqk->jk", area, weights, ls, lm)
