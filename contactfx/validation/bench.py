@@ -75,6 +75,9 @@ CASES: dict[str, BenchCase] = {
         "propped fracture, open branch p_net > p* (Sneddon)",
     ),  # fmt: skip
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
+    "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
+    "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),
+    "hertz-spheres": BenchCase("hertz-spheres", {}, 2.0, "two elastic spheres, quarter model"),
 }
 
 #: relative errors below this are round-off (e.g. the force under force control): no rate
