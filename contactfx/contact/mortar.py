@@ -390,6 +390,10 @@ class MortarCoupling:
 
         return self.comm.allreduce(float(np.sum(self.D * self.lam)), op=MPI.SUM)
 
+    def search_gaps(self) -> np.ndarray:
+        """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""
+        return self.g0.getArray()[self.normal_rows] + 0.0 if self.g0 is not None else np.zeros(0)
+
     def nodal(self):
         """Owned contact nodes: (global node, weight D_j, pressure lambda_j, gap g_j)."""
         return self.nodes, self.D, self.lam, self.gap

@@ -271,6 +271,11 @@ class PointCoupling:
                 J.setValues(rows, rows, block, addv=add)
         J.assemble()
 
+    def search_gaps(self) -> np.ndarray:
+        """The gaps of this rank's paired Gauss points at the last search."""
+        out = [-np.einsum("pi,pi->p", p["Jn"], p["x_search"])[p["paired"]] for p in self.points]
+        return np.concatenate(out) if out else np.zeros(0)
+
     # -- what the post-processing reads ----------------------------------------------------
     def nodal(self):
         """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the

@@ -106,7 +106,33 @@ class TwoBodyProblem(Problem):
         self.scene.set_load(t)
 
     def start(self, solver) -> None:
-        """From the undeformed state (the Dirichlet values are set by the solve)."""
+        """From the undeformed state (the Dirichlet values are set by the solve), after two
+        checks of the geometry at the start (collective, so that every rank raises alike):
+        the bodies must not overlap by more than 1 % of the contact element size (two
+        polygonal approximations of touching curved surfaces cross by O(h^2 / R)), and a body
+        without any support must touch the other one (else the first solve is singular)."""
+        comm, scene = self.mesh.comm, self.scene
+        coupling = self.coupling()
+        coupling.update(np.zeros_like(self.state.x.array))
+        gaps = coupling.search_gaps()
+        least = comm.allreduce(float(np.min(gaps, initial=np.inf)), op=MPI.MIN)
+        tol = 1e-2 * scene.h_contact()
+        if least < -tol:
+            raise ValueError(f"the bodies overlap by {-least:.3g} at the start (more than "
+                             f"{tol:.3g}): move them apart or correct the geometry")  # fmt: skip
+        fixed = np.zeros(len(self.state.x.array) // self.gdim, dtype=bool)
+        for bc in self.bcs:
+            fixed[np.asarray(_compat.bc_dofs(bc)) // self.gdim] = True
+        cell_tags = scene.cell_tags
+        for body, tag in scene.cells.items():
+            cells = cell_tags.indices[cell_tags.values == tag]
+            dofs = np.unique([self.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
+            supported = comm.allreduce(bool(np.any(fixed[np.asarray(dofs, dtype=np.int64)])),
+                                       op=MPI.LOR)  # fmt: skip
+            if not supported and not least <= tol:
+                raise ValueError(f"the {body} body has no support and does not touch the other "
+                                 f"one at the start (closest gap {least:.3g}): the solve would "
+                                 "be singular")  # fmt: skip
 
     def post_processor(self) -> TwoBodyPost:
         return TwoBodyPost(self)

@@ -254,3 +254,38 @@ def test_coupling_jacobian_is_consistent(num):
     else:
         assert e1 < 1e-9
     solver.destroy()
+
+
+class _Moved(PatchTest):
+    """The patch test with the upper block moved up by ``lift`` (< 0: into the lower block),
+    optionally without its roller (then nothing holds it but the contact)."""
+
+    lift = 0.0
+    roller = True
+
+    def build_mesh(self, comm):
+        mesh, facet_tags = super().build_mesh(comm)
+        upper = self.cell_tags.indices[self.cell_tags.values == self.cells["upper"]]
+        nodes = np.unique(mesh.geometry.dofmap.array.reshape(-1, 3)[upper]
+                          if hasattr(mesh.geometry.dofmap, "array")
+                          else mesh.geometry.dofmap[upper])  # fmt: skip
+        mesh.geometry.x[nodes, 1] += self.lift
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags):
+        bcs = super().dirichlet(V, facet_tags)
+        return bcs if self.roller else bcs[:2]
+
+
+def test_overlapping_bodies_refused():
+    scene = _Moved(PatchTest.Params())
+    scene.lift = -0.05  # half an element into the lower block
+    with pytest.raises(ValueError, match="overlap by 0.05"):
+        scene.run(Numerics(method="mortar"), verbose=False)
+
+
+def test_unsupported_body_apart_refused():
+    scene = _Moved(PatchTest.Params())
+    scene.lift, scene.roller = 0.2, False
+    with pytest.raises(ValueError, match="upper body has no support"):
+        scene.run(Numerics(method="nitsche"), verbose=False)
