@@ -181,7 +181,9 @@ ufl_math = SimpleNamespace(sqrt=ufl.sqrt, atan2=getattr(ufl, "atan2", None) or u
 class FacetTree:
     """A bounding-box tree over loose facets (segments in 2D, triangles in 3D) given by their
     vertex coordinates ``(m, d, gdim)``: a serial dolfinx manifold mesh of them carries
-    ``dolfinx.geometry``'s tree. ``padding`` enlarges every box (the search radius).
+    ``dolfinx.geometry``'s tree. ``padding`` enlarges every box (the search radius): a number,
+    or one per facet (m,), then every box is represented by a simplex spanning it (the tree
+    reads only the boxes).
 
     ``collide_points(points)`` and ``collide(other)`` give candidate pairs (point or facet of
     ``other``, facet of this tree) as two index arrays, in the caller's facet numbering.
@@ -195,6 +197,17 @@ class FacetTree:
         self.size = m
         if m == 0:
             return
+        if np.ndim(padding) == 1:
+            pad = np.asarray(padding, dtype=np.float64)[:, None]
+            lo, hi = coords.min(axis=1) - pad, coords.max(axis=1) + pad
+            # a simplex whose box is [lo, hi]: (lo), (hi in the first gdim - 1 coordinates,
+            # lo in the last), (lo, with hi in the last coordinate)
+            spanning = np.repeat(lo[:, None, :], d, axis=1)
+            spanning[:, 1, : gdim - 1] = hi[:, : gdim - 1]
+            spanning[:, -1, gdim - 1] = hi[:, gdim - 1]
+            if d == 3:
+                spanning[:, 1, gdim - 1] = lo[:, gdim - 1]
+            coords, padding = spanning, 0.0
         name = "interval" if d == 2 else "triangle"
         cells = np.arange(m * d, dtype=np.int64).reshape(m, d)
         x = np.ascontiguousarray(coords.reshape(m * d, gdim), dtype=np.float64)

@@ -10,7 +10,9 @@ Search across ranks (:func:`gather_near`): every rank publishes the bounding box
 region it searches (its slave facets in the current configuration, enlarged by the search
 radius); every rank sends each other rank the master facets (current coordinates and global
 node indices) that meet that box; candidates are then found in a bounding-box tree of the
-received facets (:class:`contactfx._compat.FacetTree`, dolfinx.geometry). The cost is one
+received facets (:class:`contactfx._compat.FacetTree`, dolfinx.geometry), every facet's box
+enlarged by its own diameter (a uniform padding by the largest facet would give thousands of
+candidates per facet on a graded mesh). The cost is one
 ``alltoall`` of the facets near each rank's slave region: at 1 rank nothing is sent, at p
 ranks each master facet is sent to the ranks whose slave region it meets (usually one or
 two), never the whole surface to everybody.
@@ -41,14 +43,16 @@ class Facets:
     def __len__(self) -> int:
         return len(self.nodes)
 
-    def diameter(self) -> float:
-        """The largest edge length (0 for no facet)."""
-        if len(self) == 0:
-            return 0.0
+    def diameters(self) -> np.ndarray:
+        """(m,) the longest edge of every facet."""
         d = self.x.shape[1]
         edges = [np.linalg.norm(self.x[:, i] - self.x[:, (i + 1) % d], axis=1)
                  for i in range(d if d > 2 else 1)]  # fmt: skip
-        return float(np.max(edges))
+        return np.max(edges, axis=0) if len(self) else np.zeros(0)
+
+    def diameter(self) -> float:
+        """The largest edge length (0 for no facet)."""
+        return float(np.max(self.diameters(), initial=0.0))
 
 
 @dataclass
@@ -191,17 +195,19 @@ class ContactPair:
     master_lame: np.ndarray | None = None
 
     def search(self, slave: Facets, master: Facets, pairs: bool = True):
-        """The master facets near this rank's slave facets (from every rank) and, with
-        ``pairs``, the candidate pairs (slave facet, near master facet) whose boxes, enlarged
-        by the search radius (the largest facet of either surface), meet. Collective."""
+        """The master facets near this rank's slave facets (from every rank: those meeting the
+        rank's slave box enlarged by the largest facet of either surface) and, with ``pairs``,
+        the candidate pairs (slave facet, near master facet) whose boxes, each enlarged by its
+        own facet's diameter, meet: pairs up to about h_s + h_m apart, a bounded number per
+        facet on graded meshes. Collective."""
         t0 = time.perf_counter()
         comm = self.layout.comm
         self.radius = global_max(comm, max(slave.diameter(), master.diameter()))
         near = gather_near(comm, master, slave, self.radius)
         found = None
         if pairs:
-            tree = _compat.FacetTree(near.x, self.radius)
-            found = tree.collide(_compat.FacetTree(slave.x, 0.0))
+            tree = _compat.FacetTree(near.x, near.diameters())
+            found = tree.collide(_compat.FacetTree(slave.x, slave.diameters()))
         self.searches += 1
         self.search_time += time.perf_counter() - t0
         return near, found

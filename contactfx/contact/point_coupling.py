@@ -175,8 +175,7 @@ class PointCoupling:
             nan = np.full((n, d), np.nan)
             return Pick(-np.ones(n, dtype=np.int64), np.zeros(n, dtype=bool), nan, nan,
                         np.full(n, np.nan), np.full(n, np.nan))  # fmt: skip
-        radius = self.pair.radius
-        tree = _compat.FacetTree(near.x, radius)
+        tree = _compat.FacetTree(near.x, near.diameters())
         rows, facets = tree.collide_points(xq)
         counts = np.bincount(rows, minlength=len(xq))
         width = max(int(counts.max(initial=0)), 1)
