@@ -193,6 +193,10 @@ class ContactPair:
     #: (m, 3) E, lambda, mu of the cell of each slave / master facet (set by the problem)
     slave_lame: np.ndarray | None = None
     master_lame: np.ndarray | None = None
+    #: Coulomb friction coefficient (None: frictionless) and the last converged displacement
+    #: (a Function: the history of the slip increments), set by the problem
+    mu: float | None = None
+    previous: object = None
 
     def search(self, slave: Facets, master: Facets, pairs: bool = True):
         """The master facets near this rank's slave facets (from every rank: those meeting the

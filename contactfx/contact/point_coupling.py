@@ -99,6 +99,9 @@ class PointCoupling:
             dirs.append(_Directed(pair.master, pair.slave, 0.5, pair.master_lame))
         self.dirs = dirs
         self.scatter = None
+        #: Coulomb coefficient (None: frictionless) and the last converged state (history)
+        self.mu = pair.mu
+        self.previous = pair.previous
 
     # -- search ---------------------------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -110,10 +113,13 @@ class PointCoupling:
         self._scatter_setup(needed)
         self.points = points
         u_upd = self._gather_u(u)
+        u_prev = None if self.mu is None else self._gather_u(self.previous.x.array)
         for p in points:
             p["idx"] = np.searchsorted(needed, p["rows"])
             # reference positions of the involved dofs: current at the search minus u then
             p["X"] = p["x_search"] - u_upd[p["idx"]]
+            if u_prev is not None:
+                p["u_prev"] = u_prev[p["idx"]]
 
     def _points(self, dr: _Directed, ub: np.ndarray) -> dict:
         lay, pair = self.layout, self.pair
@@ -162,7 +168,25 @@ class PointCoupling:
         x_master = near.x[k] if len(near) else np.zeros((len(xq), d, gdim))
         x_search = np.concatenate([x_cell, x_master], axis=1).reshape(len(xq), -1)
         scale = self.law.stiffness * E / dr.h[facet]
-        return dict(rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale, x_search=x_search,
+        extra = {}
+        if self.mu is not None:
+            P_T = np.eye(gdim)[None] - n[:, :, None] * n[:, None, :]
+            Nfull = np.concatenate([N, -Nm], axis=1)  # (P, nodes)
+            # [u] = Jvec^T u: rows (node, c) carry N_node e_c
+            Jvec = (Nfull[:, :, None, None] * np.eye(gdim)[None, None]).reshape(len(xq), -1, gdim)
+            # sigma(N_a e_c) n = lambda d_c N_a n + mu ((grad N_a . n) e_c + grad N_a n_c),
+            # tangential part (I - n n) of it; zero on the master's rows
+            sn = lmbda[:, None, None, None] * grads[:, :, :, None] * n[:, None, None, :] + mu[
+                :, None, None, None
+            ] * (
+                gn[:, :, None, None] * np.eye(gdim)[None, None]
+                + n[:, None, :, None] * grads[:, :, None, :]
+            )
+            ST = np.einsum("pacg,phg->pach", sn, P_T).reshape(len(xq), -1, gdim)
+            ST = np.concatenate([ST, np.zeros((len(xq), d * gdim, gdim))], axis=1)
+            extra = dict(Jvec=Jvec, ST=ST, P_T=P_T)
+        return dict(**extra, rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale,
+                    x_search=x_search,
                     N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
                     slave_nodes=dr.slave.nodes[facet])  # fmt: skip
 
@@ -237,18 +261,48 @@ class PointCoupling:
         dP = (arg > 0.0)[:, None] * (p["scale"][:, None] * p["Jn"] - p["S"])
         return P, dP, g, sn
 
+    def _friction(self, p: dict, vals: np.ndarray, P: np.ndarray, dP: np.ndarray):
+        """Coulomb (Nitsche): t = proj_{B(0, mu P)}(sigma_T(u) - gamma P_T [u - u_prev]) and
+        its derivative (P, gdim, ndofs); the stick mask."""
+        u = vals[p["idx"]]
+        gamma = p["scale"]
+        Z = p["ST"] - gamma[:, None, None] * np.einsum("pig,pgh->pih", p["Jvec"], p["P_T"])
+        z = np.einsum("pig,pi->pg", p["ST"], u) - gamma[:, None] * np.einsum(
+            "pgh,pih,pi->pg", p["P_T"], p["Jvec"], u - p["u_prev"])  # fmt: skip
+        s = self.mu * P
+        nz = np.linalg.norm(z, axis=1)
+        stick = nz <= s
+        zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
+        t = np.where(stick[:, None], z, s[:, None] * zhat)
+        ratio = np.where(stick, 1.0, s / np.where(nz > 0.0, nz, 1.0))
+        gdim = z.shape[1]
+        proj = np.where(stick[:, None, None], np.eye(gdim)[None],
+                        ratio[:, None, None] * (np.eye(gdim)[None]
+                                                - zhat[:, :, None] * zhat[:, None, :]))  # fmt: skip
+        dt = np.einsum("pgh,pih->pgi", proj, Z)
+        dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
+        return t, dt, stick
+
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         vals = self._gather(x)
         add = PETSc.InsertMode.ADD_VALUES
         self.state = []
         for p in self.points:
-            P, _, g, sn = self._law(p, vals)
+            P, dP, g, sn = self._law(p, vals)
             r = P[:, None] * p["Jn"]
             if sn is not None and self.law.theta != 0:
                 r -= (self.law.theta / p["scale"])[:, None] * (P + sn)[:, None] * p["S"]
+            t = stick = None
+            if self.mu is not None:
+                t, _, stick = self._friction(p, vals, P, dP)
+                tt = (self.law.theta / p["scale"])[:, None]
+                r -= np.einsum("pig,pg->pi", p["Jvec"] - tt[:, :, None] * p["ST"], t)
+                if self.law.theta != 0:
+                    sT = np.einsum("pig,pi->pg", p["ST"], vals[p["idx"]])
+                    r -= tt * np.einsum("pig,pg->pi", p["ST"], sT)
             r *= p["w"][:, None]
             F.setValues(p["rows"].ravel(), r.ravel(), addv=add)
-            self.state.append((P, g))
+            self.state.append((P, g, t, stick))
         F.assemblyBegin()
         F.assemblyEnd()
 
@@ -259,11 +313,17 @@ class PointCoupling:
         add = PETSc.InsertMode.ADD_VALUES
         theta = self.law.theta
         for p in self.points:
-            _, dP, _, sn = self._law(p, vals)
+            P, dP, _, sn = self._law(p, vals)
             A = np.einsum("pi,pj->pij", p["Jn"], dP)
             if sn is not None and theta != 0:
                 t = (theta / p["scale"])[:, None]
                 A -= np.einsum("pi,pj->pij", p["S"], t * (dP + p["S"]))
+            if self.mu is not None:
+                _, dt, _ = self._friction(p, vals, P, dP)
+                tt = (theta / p["scale"])[:, None, None]
+                A -= np.einsum("pig,pgj->pij", p["Jvec"] - tt * p["ST"], dt)
+                if theta != 0:
+                    A -= tt * np.einsum("pig,pjg->pij", p["ST"], p["ST"])
             A *= p["w"][:, None, None]
             keep = np.any(A != 0.0, axis=(1, 2))
             for rows, block in zip(p["rows"][keep], A[keep], strict=True):
@@ -280,7 +340,7 @@ class PointCoupling:
         """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
         quadrature values lumped to the nodes of the first direction's slave surface."""
         p = self.points[0]
-        P, g = self.state[0]
+        P, g = self.state[0][:2]
         lay = self.layout
         Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
         gap = np.where(np.isfinite(g), g, 0.0)
@@ -295,8 +355,8 @@ class PointCoupling:
 
     def force(self) -> float:
         """The normal contact force (the quadrature sum of P over both directions)."""
-        local = sum(float(np.sum(p["w"] * P)) for p, (P, _) in zip(self.points, self.state,
-                                                                    strict=True))  # fmt: skip
+        local = sum(float(np.sum(p["w"] * s[0])) for p, s in zip(self.points, self.state,
+                                                                  strict=True))  # fmt: skip
         from mpi4py import MPI
 
         return self.comm.allreduce(local, op=MPI.SUM)

@@ -43,9 +43,9 @@ class TwoBodyProblem(Problem):
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
-        if numerics.friction != "none":
-            raise ValueError("friction between two meshed bodies is not implemented yet: use "
-                             "--friction none")  # fmt: skip
+        if numerics.friction == "tresca":
+            raise ValueError("Tresca friction between two meshed bodies is not implemented: use "
+                             "--friction coulomb or none")  # fmt: skip
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
 
@@ -78,6 +78,8 @@ class TwoBodyProblem(Problem):
             side_of(self.V, self.facet_tags, scene.master_tag), scene.contact_modulus(),
             search_each_newton=self.num.search_update == "newton", fixed=fixed,
         )  # fmt: skip
+        if self.friction is not None:
+            self.pair.mu, self.pair.previous = self.friction.mu, self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)
         return None

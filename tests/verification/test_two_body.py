@@ -127,11 +127,12 @@ def test_partition_cuts_the_contact_surfaces():
     [
         (PatchTest(PatchTest.Params()), Numerics(method="vi"),
          "not offered between two meshed bodies"),
-        (PatchTest(PatchTest.Params()), Numerics(method="nitsche", friction="coulomb", mu=0.3),
-         "friction between two meshed bodies"),
+        (PatchTest(PatchTest.Params()), Numerics(method="nitsche", friction="tresca",
+                                                 threshold=0.3),
+         "Tresca friction between two meshed bodies"),
         (PatchTest(PatchTest.Params()), Numerics(method="mortar", degree=2), "P1"),
     ],
-    ids=["vi", "friction-not-yet", "mortar-P2"],
+    ids=["vi", "tresca", "mortar-P2"],
 )  # fmt: skip
 def test_two_body_refuses(scene, num, message):
     with pytest.raises(ValueError, match=message):
@@ -197,8 +198,11 @@ def test_unbiased_nitsche_patch_force():
 @pytest.mark.parametrize(
     "num",
     [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=-1, sides="unbiased"),
-     Numerics(method="penalty"), Numerics(method="mortar", ncp="fb"), Numerics(method="mortar")],
-    ids=["nitsche", "unbiased-skew", "penalty", "mortar-fb", "mortar"],
+     Numerics(method="penalty"), Numerics(method="mortar", ncp="fb"), Numerics(method="mortar"),
+     Numerics(method="nitsche", friction="coulomb", mu=0.3),
+     Numerics(method="nitsche", theta=0, sides="unbiased", friction="coulomb", mu=0.5)],
+    ids=["nitsche", "unbiased-skew", "penalty", "mortar-fb", "mortar", "nitsche-coulomb",
+         "unbiased-incomplete-coulomb"],
 )  # fmt: skip
 def test_coupling_jacobian_is_consistent(num):
     """J du against the central difference of the residual (contact terms included) at a
@@ -217,6 +221,10 @@ def test_coupling_jacobian_is_consistent(num):
     X = pb.layout.X.getArray().reshape(-1, 2)
     u = np.zeros_like(X)
     u[X[:, 1] > 0, 1] = -4e-3
+    # and sideways: a little near the first contact point (stick: gamma |du_T| < mu P),
+    # much farther out (slip)
+    upper = X[:, 1] > 0
+    u[upper, 0] = np.where(X[upper, 0] < 0.01, 1e-7, 1e-3)
     u += 1e-5 * rng.standard_normal(u.shape)
     x.getArray()[:] = u.ravel()
     x.ghostUpdate()
@@ -248,6 +256,11 @@ def test_coupling_jacobian_is_consistent(num):
     # exact up to round-off (measured 2e-11), a switch within eps du would show as an O(1)
     # error; Fischer-Burmeister is smooth: its central difference errs by O(eps^2) (measured
     # 4e-5 at eps = 1e-4), so a consistent Jacobian shows as second-order decay
+    if num.friction == "coulomb":  # both branches of the friction law are present
+        sticks = [s[3][s[0] > 0] for s in solver.coupling.state]
+        comm = MPI.COMM_WORLD
+        assert comm.allreduce(any(np.any(s) for s in sticks), op=MPI.LOR)
+        assert comm.allreduce(any(np.any(~s) for s in sticks), op=MPI.LOR)
     e1 = error(1e-4)
     if num.method == "mortar" and num.ncp == "fb":
         assert error(2.5e-5) < e1 / 8.0 + 1e-9
