@@ -218,7 +218,7 @@ class TwoBodyPost:
         (nodes with a support left out: they carry its reaction too), with f_j = -(K u - b)_j
         the force the contact exerts on node j, from the bulk residual, independent of the
         multiplier. Frictionless contact transmits no tangential nodal force: this is the
-        solver's tolerance. nan without nodal normals."""
+        solver's tolerance. nan without nodal normals (the Gauss-point couplings)."""
         normals = getattr(self.pb.coupling(), "normal", None)
         if normals is None or solver is None:
             return float("nan")
@@ -249,8 +249,9 @@ class TwoBodyPost:
         scores = {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in scores.items()}
         loads = np.array([t for t, _ in self.history])
         forces = np.array([f for _, f in self.history]).reshape(len(loads), self.gdim)
-        scores.update(self.scene.force_scores(loads, forces))
-        scores["tangential_nodal_force"] = float(np.max(self.tangential, initial=0.0))
+        if np.all(np.isfinite(forces)):  # a coupling with nodal normals
+            scores.update(self.scene.force_scores(loads, forces))
+            scores["tangential_nodal_force"] = float(np.max(self.tangential, initial=0.0))
         pair = self.pb.pair
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
