@@ -1,6 +1,7 @@
 """The closed forms the scenes and tests compare with, each written once (docs/verification.md
-lists them with their sources): Hertz (section 1), the exact discrete Nitsche bar (section 8),
-the oedometric modulus, and crack-face contact and joints (plane strain; sections 6, 7).
+lists them with their sources): Hertz (section 1), the rigid flat punch (section 2), the exact
+discrete Nitsche bar (section 8), the oedometric modulus, and crack-face contact and joints
+(plane strain; sections 6, 7).
 
 Hertz (Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, sections 4.2 and 5.2),
 at the load P (per unit length in 2D) with the contact modulus E*:
@@ -78,6 +79,7 @@ from contactfx._compat import numpy_math
 __all__ = [
     "hertz_2d",
     "hertz_3d",
+    "rigid_punch_2d",
     "bar_nitsche_exact",
     "oedometric_modulus",
     "crack_perturbation_stress",
@@ -103,6 +105,16 @@ def hertz_2d(force: float, radius: float, E_star: float) -> dict[str, float]:
 def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
     a = (3.0 * force * radius / (4.0 * E_star)) ** (1.0 / 3.0)
     return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
+
+
+def rigid_punch_2d(x, half_width: float, force: float):
+    """Pressure P / (pi sqrt(a^2 - x^2)) under a rigid flat punch of half-width a pressed with
+    the force P (per unit length) into an elastic half-plane, frictionless (Johnson 1985,
+    section 2.8); nan outside |x| < a."""
+    x = np.asarray(x, dtype=float)
+    inside = np.abs(x) < half_width
+    r = np.sqrt(np.where(inside, half_width**2 - x**2, 1.0))
+    return np.where(inside, force / (np.pi * r), np.nan)
 
 
 def bar_nitsche_exact(*, E, L, f, g0, n, theta, gamma0) -> dict[str, float]:

@@ -225,7 +225,7 @@ class RunSummary:
         out.update(self.quantities.to_json())
         out.update(xdmf=self.xdmf, reference=self.reference, scores=self.scores,
                    errors=self.errors)  # fmt: skip
-        if self.interface is not None:
+        if self.interface is not None or self.plot is not None:
             out["plot"] = self.plot
         return out
 

@@ -19,10 +19,11 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
 
 Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.two_body`: the
 bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
-:func:`spheres`, :func:`punch_foundation`.
+:func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`.
 
 Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,joint-column,
-stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation} ... --out mesh.msh``.
+stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block} ...
+--out mesh.msh``.
 """
 
 from contactfx.meshes._build import Builder, MeshData, MshInfo, build, write_msh
@@ -35,6 +36,8 @@ from contactfx.meshes.two_body import (
     CylindersFacets,
     PunchFoundationCells,
     PunchFoundationFacets,
+    RoundedOnBlockCells,
+    RoundedOnBlockFacets,
     SpheresCells,
     SpheresFacets,
     StackedBlocksCells,
@@ -43,6 +46,7 @@ from contactfx.meshes.two_body import (
     StackedBoxesFacets,
     cylinders,
     punch_foundation,
+    rounded_on_block,
     spheres,
     stacked_blocks,
     stacked_boxes,
@@ -64,6 +68,8 @@ __all__ = [
     "PunchFoundationFacets",
     "RectangleCells",
     "RectangleFacets",
+    "RoundedOnBlockCells",
+    "RoundedOnBlockFacets",
     "SpheresCells",
     "SpheresFacets",
     "StackedBlocksCells",
@@ -77,6 +83,7 @@ __all__ = [
     "joint_column",
     "punch_foundation",
     "rectangle",
+    "rounded_on_block",
     "spheres",
     "stacked_blocks",
     "stacked_boxes",

@@ -15,6 +15,9 @@ Examples::
         --h-far 0.1 --refine 0.1 --ratio 0.6 --out cylinders.msh
     python3 -m contactfx.meshes punch-foundation --width 3 --depth 2 --b 1 --rho 0.25 \\
         --h-punch 0.8 --h-contact 0.01 --h-far 0.2 --refine 0.05 --ratio 1.3 --out punch.msh
+    python3 -m contactfx.meshes rounded-on-block --radius 1 --height 0.15 --left 0.8 \
+        --right 1.2 --depth 0.5 --track 0.2 --h-contact 0.004 --h-far 0.1 --refine 0.06 \
+        --ratio 0.8 --out sliding.msh
 
 Invalid parameters print a one-line error to stderr and exit with code 2.
 """
@@ -35,6 +38,7 @@ from contactfx.meshes.rectangle import rectangle
 from contactfx.meshes.two_body import (
     cylinders,
     punch_foundation,
+    rounded_on_block,
     spheres,
     stacked_blocks,
     stacked_boxes,
@@ -168,6 +172,16 @@ def _parser() -> argparse.ArgumentParser:
     punch.add_argument("--rho", type=float, required=True, metavar="R", help="edge radius")
     punch.add_argument("--h-punch", type=float, required=True, metavar="H", help="punch height")
     _add_graded_two_body(punch)
+    rounded = geometries.add_parser(
+        "rounded-on-block", help="2D: a rounded body on a wide block, full model"
+    )
+    rounded.add_argument("--radius", type=float, required=True, metavar="R", help="body radius")
+    rounded.add_argument("--height", type=float, required=True, metavar="H", help="body height")
+    rounded.add_argument("--left", type=float, required=True, metavar="L", help="block left")
+    rounded.add_argument("--right", type=float, required=True, metavar="R", help="block right")
+    rounded.add_argument("--depth", type=float, required=True, metavar="D", help="block depth")
+    rounded.add_argument("--track", type=float, required=True, metavar="T", help="track length")
+    _add_graded_two_body(rounded)
     return parser
 
 
@@ -215,6 +229,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             radius_lower=args.radius_lower, radius_upper=args.radius_upper,
             h_contact=args.h_contact, h_far=args.h_far, refine=args.refine,
             ratio=args.ratio, offset=args.offset, grading=args.grading,
+        )  # fmt: skip
+    elif args.geometry == "rounded-on-block":
+        builder = partial(
+            rounded_on_block,
+            radius=args.radius, height=args.height, left=args.left, right=args.right,
+            depth=args.depth, track=args.track, h_contact=args.h_contact, h_far=args.h_far,
+            refine=args.refine, ratio=args.ratio, offset=args.offset, grading=args.grading,
         )  # fmt: skip
     else:
         builder = partial(

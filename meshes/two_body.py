@@ -62,6 +62,8 @@ __all__ = [
     "CylindersFacets",
     "PunchFoundationCells",
     "PunchFoundationFacets",
+    "RoundedOnBlockCells",
+    "RoundedOnBlockFacets",
     "SpheresCells",
     "SpheresFacets",
     "StackedBlocksCells",
@@ -71,6 +73,7 @@ __all__ = [
     "cylinders",
     "offset_length",
     "punch_foundation",
+    "rounded_on_block",
     "spheres",
     "stacked_blocks",
     "stacked_boxes",
@@ -189,6 +192,28 @@ class PunchFoundationFacets(IntEnum):
     PUNCH_SIDE = 6
     PUNCH_TOP = 7
     PUNCH_SYMMETRY = 8
+
+
+class RoundedOnBlockCells(IntEnum):
+    """Cell tags of :func:`rounded_on_block`."""
+
+    BLOCK = 1
+    ROUNDED = 2
+
+
+class RoundedOnBlockFacets(IntEnum):
+    """Facet tags of :func:`rounded_on_block`.
+
+    ``BLOCK_TOP`` (the whole top edge) and ``ROUNDED_CONTACT`` (the arc) are the contact
+    surfaces.
+    """
+
+    BLOCK_TOP = 1
+    BLOCK_RIGHT = 2
+    BLOCK_BOTTOM = 3
+    BLOCK_LEFT = 4
+    ROUNDED_CONTACT = 5
+    ROUNDED_TOP = 6
 
 
 def offset_length(offset: float, h2: float) -> float:
@@ -325,21 +350,23 @@ def _set_body_sizes(
     model: type[gmsh.model],
     dim: int,
     bodies: Sequence[tuple[int, float, float]],
-    distance: str,
+    distance: str | Sequence[str],
     *,
     dist_min: float,
     grading: float,
 ) -> None:
     """Give each body (entity, size_min, size_max) its own graded size field
-    (``set_graded_size``), restricted to the body and its boundary entities; the background
-    field is their minimum."""
+    (``set_graded_size``) of the distance to its zone (one expression for all bodies, or one
+    per body), restricted to the body and its boundary entities; the background field is their
+    minimum."""
     field = model.mesh.field
     lists = {3: "VolumesList", 2: "SurfacesList", 1: "CurvesList", 0: "PointsList"}
     restricted = []
-    for entity, size_min, size_max in bodies:
+    distances = [distance] * len(bodies) if isinstance(distance, str) else list(distance)
+    for (entity, size_min, size_max), body_distance in zip(bodies, distances, strict=True):
         size = set_graded_size(
             model,
-            distance,
+            body_distance,
             size_min=size_min,
             size_max=size_max,
             dist_min=dist_min,
@@ -734,6 +761,120 @@ def punch_foundation(
         2,
         [(block, h_contact, h_far), (punch, ratio * h_contact, h_far)],
         f"Sqrt(({along})^2+y^2)",
+        dist_min=refine,
+        grading=grading,
+    )
+    _generate(model, 2)
+
+
+def rounded_on_block(
+    model: type[gmsh.model],
+    *,
+    radius: float,
+    height: float,
+    left: float,
+    right: float,
+    depth: float,
+    track: float,
+    h_contact: float,
+    h_far: float,
+    refine: float,
+    ratio: float,
+    offset: float = 0.0,
+    grading: float = 0.3,
+) -> None:
+    """Build and mesh a rounded body touching a wide block at the origin (a gmsh builder).
+
+    Full model (no symmetry plane), for a body dragged along the block. The block is
+    [-left, right] x [-depth, 0]. The rounded body is the part y <= ``height`` of the disk of
+    radius R = ``radius`` centred at (0, R): its contact surface is the arc from (-w, height)
+    through the origin to (w, height), w = sqrt(height (2 R - height)), split at the origin (a
+    half cylinder for height = R); its top is the segment y = height. The block's element size
+    is h_contact within the distance ``refine`` of the track [0, track] x {0} (where the contact
+    travels when the body is dragged by ``track`` towards +x), the rounded body's ratio *
+    h_contact within ``refine`` of the origin; both grow by ``grading`` per unit distance up to
+    ``h_far``. With offset > 0 the arc is also split at the arc length l0
+    (:func:`offset_length`) right of the origin.
+
+    Args:
+        model: The ``gmsh.model`` namespace of an open gmsh session.
+        radius: Radius R of the rounded body (length).
+        height: Height of the rounded body, in (0, R] (length).
+        left, right: Extent of the block left and right of the origin, right > track (length).
+        depth: Depth of the block (length).
+        track: Length of the refined track on the block, >= 0 (length).
+        h_contact: Element size of the block along the track (length).
+        h_far: Element size far from the contact zones, >= h_contact and >= ratio * h_contact
+            (length).
+        refine: Distance from the track / the origin meshed with the contact sizes (length).
+        ratio: Element size of the rounded body / that of the block (dimensionless).
+        offset: Shift of the rounded body's contact nodes, fraction of its element (in [0, 1)).
+        grading: Size increase per unit distance from the refined zones (dimensionless).
+
+    Raises:
+        ValueError: Before any gmsh call, if a parameter is invalid.
+    """
+    check_finite(radius=radius, height=height, left=left, right=right, depth=depth, track=track)
+    check_positive(radius=radius, height=height, left=left, right=right, depth=depth)
+    check_less_equal("height", height, "radius", radius)
+    if not track >= 0.0:
+        raise ValueError(f"track must be >= 0, got {track}")
+    check_less("track", track, "right", right)
+    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    r = radius
+    half = math.acos((r - height) / r)  # half the arc's angle
+    w = r * math.sin(half)
+    check_less("the arc half-width", w, "left", left)
+    check_less("the arc half-width", w, "right", right)
+    l0 = offset_length(offset, ratio * h_contact)
+    if offset > 0:
+        _check_first_element(l0, "the right half of the arc", half * r)
+
+    occ = model.occ
+    block_points = [
+        occ.addPoint(x, y, 0.0)
+        for x, y in ((-left, 0.0), (right, 0.0), (right, -depth), (-left, -depth))
+    ]
+    block_top, block_right, block_bottom, block_left = _polyline(
+        model, [*block_points, block_points[0]]
+    )
+    block = _surface(model, [block_top, block_right, block_bottom, block_left])
+
+    # The arc from (-w, height) through the origin (and the offset point) to (w, height).
+    centre = occ.addPoint(0.0, r, 0.0)
+    angles = [-half, 0.0, *([l0 / r] if offset > 0 else []), half]
+    arc_points = [occ.addPoint(r * math.sin(a), r * (1 - math.cos(a)), 0.0) for a in angles]
+    arcs = [
+        occ.addCircleArc(a, centre, b) for a, b in zip(arc_points[:-1], arc_points[1:], strict=True)
+    ]
+    (top,) = _polyline(model, [arc_points[-1], arc_points[0]])
+    rounded = _surface(model, [*arcs, top])
+    occ.remove([(0, centre)])  # the arc's centre is no vertex of the body: no free point
+    occ.synchronize()
+    if offset > 0:
+        model.mesh.setTransfiniteCurve(arcs[1], 2)
+
+    f = RoundedOnBlockFacets
+    _add_body_groups(
+        model,
+        {
+            RoundedOnBlockCells.BLOCK: (
+                block,
+                {f.BLOCK_TOP: [block_top], f.BLOCK_RIGHT: [block_right],
+                 f.BLOCK_BOTTOM: [block_bottom], f.BLOCK_LEFT: [block_left]},
+            ),
+            RoundedOnBlockCells.ROUNDED: (rounded, {f.ROUNDED_CONTACT: arcs, f.ROUNDED_TOP: [top]}),
+        },
+    )  # fmt: skip
+    # The block: distance to the track [0, track] x {0}, as in rectangle(); the body: to the
+    # origin.
+    end = matheval_number(track)
+    along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
+    _set_body_sizes(
+        model,
+        2,
+        [(block, h_contact, h_far), (rounded, ratio * h_contact, h_far)],
+        [f"Sqrt(({along})^2+y^2)", "Sqrt(x^2+y^2)"],
         dist_min=refine,
         grading=grading,
     )

@@ -17,7 +17,7 @@ from contactfx.contact.laws import active
 from contactfx.driver.fields import NodalProjection, global_sum, nodal_contact
 from contactfx.results import InterfaceQuantities, Quantities
 
-__all__ = ["InterfacePost", "Profile", "STATUS"]
+__all__ = ["InterfacePost", "Profile", "STATUS", "plot_profile", "pyplot"]
 
 #: interface status codes of the ``interface_status`` field
 STATUS = {"open": 0, "stick": 1, "slip": 2, "propped": 3}
@@ -201,14 +201,20 @@ class InterfacePost:
                 "plot": None if plot is None else str(plot)}  # fmt: skip
 
 
-def plot_profile(prof: Profile, scene, path: Path) -> None:
-    """Line plots along the interface: aperture and slip (with the closed forms where the
-    scene has them), normal and tangential traction, status."""
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (files only, no display)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+def plot_profile(prof: Profile, scene, path: Path) -> None:
+    """Line plots along the interface: aperture and slip (with the closed forms where the
+    scene has them), normal and tangential traction, status."""
+    plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 8.0), sharex=True)
     s = prof.s
     ref = scene.reference_profile(s)

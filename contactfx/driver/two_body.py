@@ -5,10 +5,15 @@ a two-body method's coupling (:mod:`contactfx.contact.coupling`).
 Unknown: the P1 displacement of all bodies. Surface: the pair's two sides
 (:class:`contactfx.contact.pair.ContactPair`). Post-processing: the contact force of the pair,
 the nodal pressure and gap on the slave surface, the contact size, penetration and
-complementarity, and the errors against the scene's closed forms.
+complementarity, and the errors against the scene's closed forms; per step the force vector
+the pair exerts on the upper body (from the nodal pressures and normals; the scene scores its
+history), written to ``pair_forces.csv``, and the pressure profile along the slave surface
+against the scene's closed form, ``pressure.png``, when an output folder is given.
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import dolfinx
 import numpy as np
@@ -19,11 +24,12 @@ from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
 from contactfx.contact.pair import ContactPair, side_of
 from contactfx.driver.fields import nodal_contact
+from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
 from contactfx.driver.problem import Problem
 from contactfx.results import Quantities
 
-__all__ = ["TwoBodyProblem", "TwoBodyPost"]
+__all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
 
 
 class TwoBodyProblem(Problem):
@@ -155,6 +161,16 @@ class TwoBodyPost:
         self.vm_expr = _compat.expression(pb.material.von_mises(pb.state), DG0)
         self.start = pb.layout.start
         self.x = _compat.dof_coordinates(self.Q1)
+        self.gdim = mesh.geometry.dim
+        #: per converged step: (load factor, force vector on the upper body)
+        self.history: list[tuple[float, np.ndarray]] = []
+        #: per converged step: sum over the slave nodes of |tangential part of the nodal force|
+        #: / sum of |normal part| (0 up to the solver tolerance for frictionless contact)
+        self.tangential: list[float] = []
+        n = pb.layout.n_owned * pb.layout.bs
+        rows = [_compat.bc_dofs(bc) for bc in pb.bcs]
+        rows = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int64)
+        self.bc_rows = rows[rows < n]
 
     def evaluate(self, solver) -> Quantities:
         nodes, D, lam, gap = self.pb.coupling().nodal()
@@ -176,6 +192,8 @@ class TwoBodyPost:
         x_all = np.concatenate(self.comm.allgather(x))
         p_all = np.concatenate(self.comm.allgather(lam[closed[local]]))
         edge = self.scene.contact_edge(x_all, p_all)
+        self.history.append((float(self.pb.tload.value), self.pair_force(local, D, lam)))
+        self.tangential.append(self.tangential_nodal_force(solver, local))
         return Quantities(
             force=force,
             contact_size=size if edge is None else edge,
@@ -183,6 +201,42 @@ class TwoBodyPost:
             max_penetration=penetration,
             complementarity=complementarity,
         )
+
+    def pair_force(self, local: np.ndarray, D: np.ndarray, lam: np.ndarray) -> np.ndarray:
+        """The force of the pair on the upper body, sum_j D_j lambda_j n_j over the slave nodes
+        (n_j the unit nodal normals of the last search, outward of the slave body: the pressure
+        pushes the slave along -n_j, the master along +n_j), times the scene's symmetry; nan
+        for a coupling without nodal normals."""
+        normals = getattr(self.pb.coupling(), "normal", None)
+        if normals is None:
+            return np.full(self.gdim, np.nan)
+        local_sum = np.sum((D * lam)[:, None] * normals, axis=0) if len(D) else np.zeros(self.gdim)
+        total = self.comm.allreduce(np.asarray(local_sum, dtype=float), op=MPI.SUM)
+        sign = -1.0 if self.scene.p.slave == "upper" else 1.0
+        return sign * self.scene.symmetry * total
+
+    def tangential_nodal_force(self, solver, local: np.ndarray) -> float:
+        """sum_j |f_j - (n_j . f_j) n_j| / sum_j |n_j . f_j| over the slave contact nodes j
+        (nodes with a support left out: they carry its reaction too), with f_j = -(K u - b)_j
+        the force the contact exerts on node j, from the bulk residual, independent of the
+        multiplier. Frictionless contact transmits no tangential nodal force: this is the
+        solver's tolerance. nan without nodal normals (the Gauss-point couplings)."""
+        normals = getattr(self.pb.coupling(), "normal", None)
+        if normals is None or solver is None:
+            return float("nan")
+        R = solver.K.createVecLeft()
+        solver.K.mult(_compat.petsc_vec(solver.u), R)
+        R.axpy(-1.0, solver.b)
+        bs = self.pb.layout.bs
+        f = -R.getArray().reshape(-1, bs)[local, : self.gdim]
+        R.destroy()
+        # nodes with a support (a symmetry plane) also carry its reaction: left out
+        free = ~np.isin(local, self.bc_rows // bs)
+        fn = np.einsum("ij,ij->i", f, normals)[free]
+        ft = np.linalg.norm(f[free] - fn[:, None] * normals[free], axis=1)
+        tangential = self.comm.allreduce(float(np.sum(ft)), op=MPI.SUM)
+        normal = self.comm.allreduce(float(np.sum(np.abs(fn))), op=MPI.SUM)
+        return tangential / normal if normal > 0.0 else 0.0
 
     def fields(self) -> list:
         self.vm.interpolate(self.vm_expr)
@@ -195,7 +249,53 @@ class TwoBodyPost:
         local = (nodes - self.start).astype(np.int64)
         scores = self.scene.pressure_scores(x[local], lam, q.force)
         scores = {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in scores.items()}
+        loads = np.array([t for t, _ in self.history])
+        forces = np.array([f for _, f in self.history]).reshape(len(loads), self.gdim)
+        if np.all(np.isfinite(forces)):  # a coupling with nodal normals
+            scores.update(self.scene.force_scores(loads, forces))
+            scores["tangential_nodal_force"] = float(np.max(self.tangential, initial=0.0))
         pair = self.pb.pair
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
-        return {"reference": reference, "scores": scores, "errors": {}}
+        plot = None
+        x_all = np.concatenate(self.comm.gather(x[local], root=0) or [np.zeros((0, 3))])
+        p_all = np.concatenate(self.comm.gather(lam, root=0) or [np.zeros(0)])
+        if out is not None:
+            plot = Path(out) / "pressure.png"
+            if self.comm.rank == 0:
+                plot_pressure(x_all[:, : self.gdim], p_all, self.scene, q.force, plot)
+                header = "load," + ",".join(f"force_{c}" for c in "xyz"[: self.gdim])
+                np.savetxt(Path(out) / "pair_forces.csv", np.column_stack([loads, forces]),
+                           delimiter=",", comments="", header=header)  # fmt: skip
+        return {"reference": reference, "scores": scores, "errors": {},
+                "plot": None if plot is None else str(plot)}  # fmt: skip
+
+
+def plot_pressure(x: np.ndarray, p: np.ndarray, scene, force: float, path: Path) -> None:
+    """The nodal contact pressure p at the slave nodes x (n, gdim) against s = x (2D) or the
+    distance s from the axis x = y = 0 (3D), with the scene's closed form
+    (``pressure_profile``) at the computed force on a fine grid of s where it has one."""
+    plt = pyplot()
+    s = x[:, 0] if x.shape[1] == 2 else np.hypot(x[:, 0], x[:, 1])
+    order = np.argsort(s)
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    ax.plot(s[order], p[order], "o-", ms=2, lw=0.8, label="contact pressure (computed)")
+    lo, hi = (s.min(), s.max()) if len(s) else (0.0, 1.0)
+    closed = s[p > 1e-6 * np.max(p, initial=0.0)] if np.any(p > 0.0) else s[:0]
+    if len(closed):  # the contact zone and half its width either side
+        margin = 0.5 * (closed.max() - closed.min())
+        lo, hi = max(lo, closed.min() - margin), min(hi, closed.max() + margin)
+    ax.set_xlim(lo, hi)
+    fine = np.linspace(lo, hi, 1001)
+    exact = scene.pressure_profile(fine, force)
+    if exact is not None:
+        ax.plot(fine, exact, "-", lw=1.2, label="closed form at the computed force")
+    if len(p) and np.max(p) > 0.0:  # the rigid punch's closed form is singular at its edge
+        ax.set_ylim(0.0, 1.3 * np.max(p))
+    ax.set_xlabel("x" if x.shape[1] == 2 else "r = sqrt(x^2 + y^2)")
+    ax.set_ylabel("pressure")
+    ax.set_title(f"{scene.name}: pressure along the slave surface")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -11,6 +11,7 @@ from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
+from contactfx.scenes.two_body_2d import PunchFoundation, SlidingContact
 from contactfx.scenes.westergaard import Westergaard
 
 __all__ = ["SCENES", "get_scene", "Scene", "Numerics"]
@@ -32,6 +33,8 @@ SCENES: dict[str, type[Scene]] = {
         PatchTest,
         HertzCylinders,
         HertzSpheres,
+        PunchFoundation,
+        SlidingContact,
     )
 }
 

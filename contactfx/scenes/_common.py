@@ -9,7 +9,7 @@ import numpy as np
 from contactfx import _compat
 from contactfx.meshes import build
 
-__all__ = ["gmsh_mesh", "fix", "fix_component"]
+__all__ = ["gmsh_mesh", "fix", "fix_component", "prescribe_component"]
 
 
 def gmsh_mesh(comm, builder, gdim: int, name: str, **kwargs):
@@ -38,3 +38,11 @@ def fix_component(V, facet_tags, tag: int, component: int):
     sub = V.sub(component)
     dofs = _compat.locate_dofs_topological(sub, mesh.topology.dim - 1, _facets(facet_tags, tag))
     return _compat.dirichletbc(np.float64(0.0), dofs, sub)
+
+
+def prescribe_component(V, facet_tags, tag: int, component: int, value):
+    """u_component = value (a ``dolfinx.fem.Constant`` that the load program updates) on the
+    facets tagged ``tag``."""
+    sub = V.sub(component)
+    dofs = _compat.locate_dofs_topological(sub, V.mesh.topology.dim - 1, _facets(facet_tags, tag))
+    return _compat.dirichletbc(value, dofs, sub)

@@ -205,6 +205,11 @@ class HertzCylinders(TwoBodyScene):
             return float(x2)
         return float(x2 + p2**2 * (x2 - x1) / (p1**2 - p2**2))
 
+    def pressure_profile(self, s, force):
+        """Hertz p0 sqrt(1 - s^2 / a^2) (0 beyond a) at the computed force."""
+        ref = self.reference(force)
+        return ref["p0"] * np.sqrt(np.clip(1.0 - (s / ref["a"]) ** 2, 0.0, None))
+
     def E_star(self) -> float:
         m = self.materials()
         return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())

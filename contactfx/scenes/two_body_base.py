@@ -110,3 +110,15 @@ class TwoBodyScene(Scene):
         """Scene-specific scores from this rank's slave contact nodes x and pressures p (local
         maxima, reduced with MAX over ranks)."""
         return {}
+
+    def pressure_profile(self, s: np.ndarray, force: float) -> np.ndarray | None:
+        """The closed-form contact pressure at the points s along the slave surface (x in 2D,
+        the distance from the axis x = y = 0 in 3D; reference coordinates) at the computed
+        force (full model), for the pressure plot; None for no closed form."""
+        return None
+
+    def force_scores(self, loads: np.ndarray, forces: np.ndarray) -> dict[str, float]:
+        """Scores from the history of the pair's force on the upper body: ``loads`` (steps,)
+        the load factors of the converged steps, ``forces`` (steps, gdim) the force vectors
+        (the sum over the slave nodes of D_j lambda_j n_j, times ``symmetry``)."""
+        return {}

@@ -259,10 +259,18 @@ class ContactSNES:
             F.axpy(1.0, self.fc)
         if self.coupling is not None:
             if self.coupling.search_each_newton:
-                self.coupling.update(self.u.x.array)
+                self._search()
             self.coupling.residual(x, F)
         dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
         self.timer.assembly += time.perf_counter() - t0
+
+    def _search(self) -> None:
+        """The coupling's search at the current u. The Jacobian's sparsity may change with it:
+        reset the preconditioner so that the factorisation is set up anew (PETSc 3.22 reuses
+        the symbolic LU of the old pattern after the coupling's MatAXPY with a different
+        pattern, and MUMPS fails)."""
+        self.coupling.update(self.u.x.array)
+        self.snes.getKSP().getPC().reset()
 
     def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
         t0 = time.perf_counter()
@@ -311,7 +319,7 @@ class ContactSNES:
         self._sync(x)
         self._late = False
         if self.coupling is not None:  # the search of this load step
-            self.coupling.update(self.u.x.array)
+            self._search()
         try:
             self.snes.solve(None, x)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash

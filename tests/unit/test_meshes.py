@@ -37,6 +37,8 @@ from contactfx.meshes import (
     PunchFoundationFacets,
     RectangleCells,
     RectangleFacets,
+    RoundedOnBlockCells,
+    RoundedOnBlockFacets,
     SpheresCells,
     SpheresFacets,
     StackedBlocksCells,
@@ -50,6 +52,7 @@ from contactfx.meshes import (
     joint_column,
     punch_foundation,
     rectangle,
+    rounded_on_block,
     spheres,
     stacked_blocks,
     stacked_boxes,
@@ -119,6 +122,20 @@ PUNCH_FOUNDATION = dict(
     offset=0.7,
     grading=0.3,
 )
+ROUNDED_ON_BLOCK = dict(
+    radius=1.0,
+    height=0.3,
+    left=0.9,
+    right=1.2,
+    depth=0.5,
+    track=0.2,
+    h_contact=0.01,
+    h_far=0.1,
+    refine=0.05,
+    ratio=0.8,
+    offset=0.3,
+    grading=0.5,
+)
 SPHERES = dict(
     radius_lower=1.5,
     radius_upper=1.0,
@@ -172,6 +189,12 @@ def cylinders_mesh() -> MeshData:
 def punch_foundation_mesh() -> MeshData:
     builder = partial(punch_foundation, **PUNCH_FOUNDATION)
     return build(MPI.COMM_WORLD, builder, gdim=2, name="punch")
+
+
+@pytest.fixture(scope="module")
+def rounded_on_block_mesh() -> MeshData:
+    builder = partial(rounded_on_block, **ROUNDED_ON_BLOCK)
+    return build(MPI.COMM_WORLD, builder, gdim=2, name="rounded")
 
 
 @pytest.fixture(scope="module")
@@ -734,6 +757,61 @@ def test_punch_foundation_sizes(punch_foundation_mesh: MeshData) -> None:
         _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
 
 
+def test_rounded_on_block(rounded_on_block_mesh: MeshData) -> None:
+    """The block tiles exactly; the rounded body is the circular segment below y = height
+    minus the segments cut off by the chords of its arc (every arc node is on the circle)."""
+    p, data = ROUNDED_ON_BLOCK, rounded_on_block_mesh
+    r, height, left, right, depth = p["radius"], p["height"], p["left"], p["right"], p["depth"]
+    cells, facets = RoundedOnBlockCells, RoundedOnBlockFacets
+    comm = data.mesh.comm
+    half = math.acos((r - height) / r)
+    w = r * math.sin(half)
+    _check_boundary_tagged_once(data)
+    assert _measure(data, cells.BLOCK, "dx") == pytest.approx((left + right) * depth, rel=1e-12)
+    lengths = {
+        facets.BLOCK_TOP: left + right, facets.BLOCK_RIGHT: depth,
+        facets.BLOCK_BOTTOM: left + right, facets.BLOCK_LEFT: depth, facets.ROUNDED_TOP: 2 * w,
+    }  # fmt: skip
+    for tag, length in lengths.items():
+        assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
+    ends = _facet_vertices(data, facets.ROUNDED_CONTACT)
+    arc = _arc_edges(ends, (0.0, r), r)
+    assert arc.shape == ends.shape  # every contact edge is a chord of the circle
+    chords = _lengths(arc)
+    angles = 2 * np.arcsin(chords / (2 * r))
+    assert comm.allreduce(angles.sum(), op=MPI.SUM) == pytest.approx(2 * half, rel=1e-10)
+    segments = comm.allreduce((r**2 * (angles - np.sin(angles)) / 2).sum(), op=MPI.SUM)
+    exact = r**2 * half - (r - height) * w  # the circular segment below y = height
+    assert _measure(data, cells.ROUNDED, "dx") == pytest.approx(exact - segments, rel=1e-10)
+    total = comm.allreduce(chords.sum(), op=MPI.SUM)
+    assert _measure(data, facets.ROUNDED_CONTACT) == pytest.approx(total, rel=1e-12)
+    low, high = _arc_bounds(2 * half * r, r, p["h_far"], 24)
+    assert low <= total <= high
+    _check_separate_bodies(data, cells.BLOCK, cells.ROUNDED)
+    # The surfaces only touch at the origin (a node of the body, generally none of the block);
+    # the offset's node right of it.
+    nodes = _tagged_vertices(data, facets.ROUNDED_CONTACT)
+    assert _coincident(nodes, _tagged_vertices(data, facets.BLOCK_TOP)).sum() <= 1
+    l0 = offset_length(p["offset"], p["ratio"] * p["h_contact"])
+    right_of_origin = np.sort(nodes[nodes[:, 0] > 1e-12, 0])
+    assert right_of_origin[0] == pytest.approx(r * math.sin(l0 / r), rel=1e-12)
+
+
+def test_rounded_on_block_sizes(rounded_on_block_mesh: MeshData) -> None:
+    """The block is refined along the track [0, track] x {0}, the body around the origin."""
+    p, data = ROUNDED_ON_BLOCK, rounded_on_block_mesh
+    cells = RoundedOnBlockCells
+    for body, h in ((cells.BLOCK, p["h_contact"]), (cells.ROUNDED, p["ratio"] * p["h_contact"])):
+        sizes, midpoints = _cell_sizes(data, body)
+        x, y = midpoints[:, 0], midpoints[:, 1]
+        if body == cells.BLOCK:
+            distance = np.hypot(np.maximum(np.maximum(-x, x - p["track"]), 0.0), y)
+        else:
+            distance = np.hypot(x, y)
+        graded = p["refine"] + (p["h_far"] - h) / p["grading"]
+        _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
+
+
 def test_spheres(spheres_mesh: MeshData) -> None:
     """Eighth balls. Bound: a chord triangle with circumradius rho lies in a plane at the
     distance sqrt(R^2 - rho^2) from the centre, inside its circumdisk, so within the shell
@@ -857,6 +935,22 @@ def test_spheres(spheres_mesh: MeshData) -> None:
             2,
             "offset: the first element of the punch's flat face",
         ),
+        (
+            partial(rounded_on_block, **dict(ROUNDED_ON_BLOCK, height=1.5)),
+            2,
+            "height must be <= radius",
+        ),
+        (
+            partial(rounded_on_block, **dict(ROUNDED_ON_BLOCK, track=1.2)),
+            2,
+            "track must be < right",
+        ),
+        (
+            partial(rounded_on_block, **dict(ROUNDED_ON_BLOCK, left=0.5)),
+            2,
+            "the arc half-width must be < left",
+        ),
+        (partial(rounded_on_block, **dict(ROUNDED_ON_BLOCK, track=-0.1)), 2, "track must be >= 0"),
         (partial(spheres, **dict(SPHERES, refine=0.0)), 3, "refine must be > 0"),
         (partial(spheres, **dict(SPHERES, h_far=0.01)), 3, "h_contact must be <= h_far"),
     ],
@@ -945,8 +1039,15 @@ def test_command_line_interior_facets(tmp_path, args: list[str]) -> None:
              "--ratio", "1.3"],
             "triangles", '1 5 "punch_contact"',
         ),
+        (
+            ["rounded-on-block", "--radius", "1", "--height", "0.2", "--left", "0.8",
+             "--right", "1", "--depth", "0.5", "--track", "0.2", "--h-contact", "0.02",
+             "--h-far", "0.2", "--refine", "0.05", "--ratio", "0.8", "--offset", "0.4"],
+            "triangles", '1 5 "rounded_contact"',
+        ),
     ],
-    ids=["stacked-blocks", "stacked-boxes", "cylinders", "spheres", "punch-foundation"],
+    ids=["stacked-blocks", "stacked-boxes", "cylinders", "spheres", "punch-foundation",
+         "rounded-on-block"],
 )  # fmt: skip
 def test_command_line_two_body(tmp_path, args: list[str], cells: str, group: str) -> None:
     out = tmp_path / "mesh.msh"

@@ -29,6 +29,7 @@ from contactfx.references import (
     joint_column,
     opening,
     propping_pressure,
+    rigid_punch_2d,
     stress_intensity,
     width_correction,
 )
@@ -276,3 +277,16 @@ def test_ufl_expression():
         local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(field * dx))
         integral = mesh.comm.allreduce(local, op=MPI.SUM)
         assert integral == pytest.approx(np.sum(reference * weights), rel=1e-8)
+
+
+def test_rigid_punch_2d():
+    """The rigid flat punch pressure P / (pi sqrt(a^2 - x^2)) carries the force P (with
+    x = a sin t the integral is P / pi * pi exactly), has its minimum P / (pi a) at the centre,
+    and is nan outside the punch."""
+    a, P = 0.05, 2.0
+    t = np.linspace(-0.5 * np.pi, 0.5 * np.pi, 2001)[1:-1]
+    x = a * np.sin(t)
+    integrand = rigid_punch_2d(x, a, P) * a * np.cos(t)  # p(x) dx/dt
+    assert np.allclose(integrand, P / np.pi, rtol=1e-12)
+    assert rigid_punch_2d(0.0, a, P) == pytest.approx(P / (np.pi * a), rel=1e-14)
+    assert np.all(np.isnan(rigid_punch_2d(np.array([-a, a, 2 * a]), a, P)))

@@ -1,0 +1,222 @@
+"""Two-body scenes in 2D: an elastic flat punch on an elastic block, and a rounded body dragged
+along a block (docs/verification.md section 10).
+
+``punch-foundation``: a flat punch of half-width b with edges rounded by the radius rho (its
+flat face is |x| <= a = b - rho), half model with the symmetry plane x = 0, pressed into a
+block clamped at its bottom by the prescribed vertical displacement ``indentation`` of its top
+(frictionless). As E_upper / E_lower (punch / block) grows the punch becomes rigid and the
+pressure tends to the rigid flat punch of ``punch2d`` (docs/verification.md section 2),
+
+    p(x) = P / (pi sqrt(a^2 - x^2)),
+
+scored, as ``punch2d`` does, by the normalised interior pressure on |x| <= 0.8 a
+(:func:`contactfx.scenes.flat_punch.normalised_pressure_error`); it is reported from
+E_upper / E_lower >= 1e3 on (``rigid_ratio``). For any moduli the score ``edge_peak`` is the
+largest nodal pressure over the mean pressure P / (2 b): for equal materials the edge
+singularity is weaker than the rigid punch's (a corner of two elastic wedges, Dundurs 1969),
+so it is reported, not compared with the rigid closed form.
+
+``sliding-contact``: the rounded body of :func:`contactfx.meshes.rounded_on_block` (radius R,
+cut at ``height``) is pressed into a wide block by the vertical displacement ``press`` of its
+top during the first ``press_fraction`` of the load program, then dragged along the block by
+``slide`` at that constant vertical displacement (frictionless). The pair's force on the
+rounded body has the components Q (tangential, along x) and P (normal, along y), computed
+from the nodal pressures and normals of the contact pair. Frictionless and elastic, the state
+at each position is the static indentation moved along: in the continuum Q = 0 and P is
+constant. Scores: ``P``, ``Q``, ``Q_over_P`` (last step), and over the steady drag (from the
+third drag step on) ``max_abs_Q_over_P``, ``P_jump`` the largest relative change of P between
+consecutive steps and ``P_variation`` (max - min) / mean of P: with mortar integrals the force
+does not jump when slave nodes cross master facet boundaries. Q is not zero to round-off: the
+pressure centroid of the discrete solution is off the body's axis by a fraction of an element
+(the slave mesh is not symmetric about it, see ``offset``), so Q / P is a discretisation error
+(about 3e-4 with the defaults, 3e-5 with offset = 0). The frictionless transmission itself is
+checked by the kind's score ``tangential_nodal_force`` (the tangential nodal forces on the slave
+nodes from the bulk residual: the solver's tolerance).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import dolfinx
+import numpy as np
+
+from contactfx.meshes import (
+    PunchFoundationCells,
+    PunchFoundationFacets,
+    RoundedOnBlockCells,
+    RoundedOnBlockFacets,
+    punch_foundation,
+    rounded_on_block,
+)
+from contactfx.params import param
+from contactfx.references import rigid_punch_2d
+from contactfx.scenes._common import fix, fix_component, prescribe_component
+from contactfx.scenes.flat_punch import normalised_pressure_error
+from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
+
+__all__ = ["PunchFoundation", "SlidingContact"]
+
+
+@dataclass(frozen=True)
+class PunchFoundationParams(two_elastic(1000.0, 0.3)):
+    # E_lower / nu_lower: the block; E_upper / nu_upper: the punch (stiff by default)
+    E_upper: float = param(1e6, "Young's modulus of the upper body (the punch)", positive=True)
+    b: float = param(0.052, "half-width of the punch (flat face b - rho, then the rounded "
+                     "edge)", positive=True)  # fmt: skip
+    rho: float = param(0.002, "edge radius of the punch", positive=True)
+    punch_height: float = param(0.05, "height of the punch", positive=True)
+    indentation: float = param(1e-4, "prescribed downward displacement of the punch's top",
+                               positive=True)  # fmt: skip
+    width: float = param(1.0, "half-width of the block", positive=True)
+    depth: float = param(1.0, "depth of the block", positive=True)
+    h_contact: float = param(5e-4, "element size of the block under the punch", positive=True)
+    h_far: float = param(0.1, "element size far from the punch", positive=True)
+    refine: float = param(0.01, "distance from the punch face meshed with the contact sizes",
+                          positive=True)  # fmt: skip
+    ratio: float = param(1.2, "element size of the punch / that of the block", positive=True)
+    offset: float = param(0.3, "shift of the punch's contact nodes (fraction of an element, "
+                          "in [0, 1))", nonnegative=True)  # fmt: skip
+    rigid_ratio: float = param(1e3, "E_upper / E_lower from which the punch is compared with "
+                               "the rigid flat punch", positive=True)  # fmt: skip
+
+
+class PunchFoundation(TwoBodyScene):
+    name = "punch-foundation"
+    summary = ("elastic flat punch with rounded edges on an elastic block (half model); stiff "
+               "punch: rigid flat punch pressure, equal moduli: edge peak")  # fmt: skip
+    Params = PunchFoundationParams
+    cells = {"lower": PunchFoundationCells.BLOCK, "upper": PunchFoundationCells.PUNCH}
+    surfaces = {"lower": PunchFoundationFacets.BLOCK_TOP,
+                "upper": PunchFoundationFacets.PUNCH_CONTACT}  # fmt: skip
+    symmetry = 2.0
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(
+            punch_foundation, width=p.width, depth=p.depth, b=p.b, rho=p.rho,
+            h_punch=p.punch_height, h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
+            ratio=p.ratio, offset=p.offset,
+        )  # fmt: skip
+        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = PunchFoundationFacets
+        return [*fix(V, facet_tags, f.BLOCK_BOTTOM),
+                fix_component(V, facet_tags, f.BLOCK_SYMMETRY, 0),
+                fix_component(V, facet_tags, f.PUNCH_SYMMETRY, 0),
+                prescribe_component(V, facet_tags, f.PUNCH_TOP, 1, self.push)]  # fmt: skip
+
+    def set_load(self, t: float) -> None:
+        self.push.value = -t * self.p.indentation
+
+    @property
+    def flat_half_width(self) -> float:
+        """a = b - rho, the half-width of the flat face (``punch2d``'s punch_half_width)."""
+        return self.p.b - self.p.rho
+
+    def rigid(self) -> bool:
+        return self.p.E_upper >= self.p.rigid_ratio * self.p.E_lower
+
+    def pressure_scores(self, x, p, force):
+        """The rigid-punch score of ``punch2d`` (stiff punch only) and the edge peak: the
+        largest nodal pressure over the mean pressure P / (2 b)."""
+        scores = {"edge_peak": float(np.max(p, initial=0.0)) * 2.0 * self.p.b / force}
+        if self.rigid():
+            scores["normalised_pressure_error"] = normalised_pressure_error(
+                x, p, force, self.flat_half_width)  # fmt: skip
+        return scores
+
+    def pressure_profile(self, s, force):
+        """The rigid flat punch (stiff punch only)."""
+        return rigid_punch_2d(s, self.flat_half_width, force) if self.rigid() else None
+
+
+@dataclass(frozen=True)
+class SlidingContactParams(two_elastic(1000.0, 0.3)):
+    radius: float = param(1.0, "radius R of the rounded body", positive=True)
+    height: float = param(0.15, "height of the rounded body (the disk cut at y = height <= R)",
+                          positive=True)  # fmt: skip
+    press: float = param(2e-3, "prescribed downward displacement of the rounded body's top",
+                         positive=True)  # fmt: skip
+    slide: float = param(0.2, "tangential displacement of the top (along +x) after pressing",
+                         positive=True)  # fmt: skip
+    press_fraction: float = param(0.1, "fraction of the load program spent pressing, in "
+                                  "(0, 1)", positive=True)  # fmt: skip
+    left: float = param(0.8, "extent of the block left of the first contact point",
+                        positive=True)  # fmt: skip
+    right: float = param(1.2, "extent of the block right of the first contact point (> slide)",
+                         positive=True)  # fmt: skip
+    depth: float = param(0.5, "depth of the block", positive=True)
+    h_contact: float = param(4e-3, "element size of the block along the track", positive=True)
+    h_far: float = param(0.1, "element size far from the contact", positive=True)
+    refine: float = param(0.06, "distance from the track meshed with the contact sizes",
+                          positive=True)  # fmt: skip
+    ratio: float = param(0.8, "element size of the rounded body / that of the block",
+                         positive=True)  # fmt: skip
+    offset: float = param(0.3, "shift of the rounded body's contact nodes (fraction of an "
+                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.press_fraction < 1.0:
+            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
+
+
+class SlidingContact(TwoBodyScene):
+    name = "sliding-contact"
+    summary = ("rounded body pressed into a block and dragged along it (frictionless); "
+               "Q / P = 0, P without jumps")  # fmt: skip
+    Params = SlidingContactParams
+    cells = {"lower": RoundedOnBlockCells.BLOCK, "upper": RoundedOnBlockCells.ROUNDED}
+    surfaces = {"lower": RoundedOnBlockFacets.BLOCK_TOP,
+                "upper": RoundedOnBlockFacets.ROUNDED_CONTACT}  # fmt: skip
+    numerics_defaults = {"steps": 50}
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(
+            rounded_on_block, radius=p.radius, height=p.height, left=p.left, right=p.right,
+            depth=p.depth, track=p.slide, h_contact=p.h_contact, h_far=p.h_far,
+            refine=p.refine, ratio=p.ratio, offset=p.offset,
+        )  # fmt: skip
+        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        self.drag = dolfinx.fem.Constant(mesh, 0.0)
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = RoundedOnBlockFacets
+        return [*fix(V, facet_tags, f.BLOCK_BOTTOM),
+                prescribe_component(V, facet_tags, f.ROUNDED_TOP, 0, self.drag),
+                prescribe_component(V, facet_tags, f.ROUNDED_TOP, 1, self.push)]  # fmt: skip
+
+    def top_displacement(self, t: float) -> tuple[float, float]:
+        """(tangential, vertical) displacement of the top at load factor t: pressing on
+        [0, press_fraction], then dragging at the constant vertical displacement."""
+        f = self.p.press_fraction
+        pressed = min(t / f, 1.0)
+        dragged = max(t - f, 0.0) / (1.0 - f)
+        return dragged * self.p.slide, -pressed * self.p.press
+
+    def set_load(self, t: float) -> None:
+        self.drag.value, self.push.value = self.top_displacement(t)
+
+    def force_scores(self, loads, forces):
+        """P, Q, Q / P at the last step; over the steady drag (the drag steps from the third
+        on) the largest |Q / P|, the largest relative change of P between consecutive steps
+        and the spread (max - min) / mean of P. The first two drag steps are the load
+        program's transient: the secant predictor extrapolates the pressing into the first
+        drag step, and the search of a step runs at its prediction."""
+        Q, P = forces[:, 0], forces[:, 1]
+        scores = {"P": float(P[-1]), "Q": float(Q[-1]), "Q_over_P": float(Q[-1] / P[-1])}
+        steady = np.flatnonzero(loads > self.p.press_fraction * (1.0 + 1e-9))[2:]
+        if len(steady) >= 2:
+            Pd, Qd = P[steady], Q[steady]
+            scores["max_abs_Q_over_P"] = float(np.max(np.abs(Qd / Pd)))
+            scores["P_jump"] = float(np.max(np.abs(np.diff(Pd)) / Pd[:-1]))
+            scores["P_variation"] = float((Pd.max() - Pd.min()) / Pd.mean())
+        return scores
