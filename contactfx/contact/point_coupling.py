@@ -156,24 +156,28 @@ class PointCoupling:
         master_nodes = near.nodes[k] if len(near) else np.zeros((len(xq), d), dtype=np.int64)
         rows = np.concatenate([blocked_rows(cell_nodes, bs)[..., :gdim],
                                blocked_rows(master_nodes, bs)[..., :gdim]],
-                              axis=1).reshape(len(xq), -1)  # fmt: skip
+                              axis=1).reshape(len(xq), (d + 1 + d) * gdim)  # fmt: skip
         Jn = np.concatenate([N[:, :, None] * n[:, None, :], -Nm[:, :, None] * n[:, None, :]],
-                            axis=1).reshape(len(xq), -1)  # fmt: skip
+                            axis=1).reshape(len(xq), (d + 1 + d) * gdim)  # fmt: skip
         E, lmbda, mu = (dr.lame[facet, i] for i in range(3))
         grads = dr.grads[facet]  # (P, d + 1, gdim)
         gn = np.einsum("pag,pg->pa", grads, n)
         S = lmbda[:, None, None] * grads + 2.0 * mu[:, None, None] * gn[:, :, None] * n[:, None, :]
-        S = np.concatenate([S, np.zeros((len(xq), d, gdim))], axis=1).reshape(len(xq), -1)
+        S = np.concatenate([S, np.zeros((len(xq), d, gdim))], axis=1).reshape(
+            len(xq), (d + 1 + d) * gdim
+        )
         x_cell = dr.slave.cell_X[facet] + ub[dr.slave.cell_local[facet]]
         x_master = near.x[k] if len(near) else np.zeros((len(xq), d, gdim))
-        x_search = np.concatenate([x_cell, x_master], axis=1).reshape(len(xq), -1)
+        x_search = np.concatenate([x_cell, x_master], axis=1).reshape(len(xq), (d + 1 + d) * gdim)
         scale = self.law.stiffness * E / dr.h[facet]
         extra = {}
         if self.mu is not None:
             P_T = np.eye(gdim)[None] - n[:, :, None] * n[:, None, :]
             Nfull = np.concatenate([N, -Nm], axis=1)  # (P, nodes)
             # [u] = Jvec^T u: rows (node, c) carry N_node e_c
-            Jvec = (Nfull[:, :, None, None] * np.eye(gdim)[None, None]).reshape(len(xq), -1, gdim)
+            Jvec = (Nfull[:, :, None, None] * np.eye(gdim)[None, None]).reshape(
+                len(xq), (d + 1 + d) * gdim, gdim
+            )
             # sigma(N_a e_c) n = lambda d_c N_a n + mu ((grad N_a . n) e_c + grad N_a n_c),
             # tangential part (I - n n) of it; zero on the master's rows
             sn = lmbda[:, None, None, None] * grads[:, :, :, None] * n[:, None, None, :] + mu[
@@ -182,10 +186,10 @@ class PointCoupling:
                 gn[:, :, None, None] * np.eye(gdim)[None, None]
                 + n[:, None, :, None] * grads[:, :, None, :]
             )
-            ST = np.einsum("pacg,phg->pach", sn, P_T).reshape(len(xq), -1, gdim)
+            ST = np.einsum("pacg,phg->pach", sn, P_T).reshape(len(xq), (d + 1) * gdim, gdim)
             ST = np.concatenate([ST, np.zeros((len(xq), d * gdim, gdim))], axis=1)
             extra = dict(Jvec=Jvec, ST=ST, P_T=P_T)
-        return dict(**extra, rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale,
+        return dict(**extra, rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale, n=n,
                     x_search=x_search,
                     N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
                     slave_nodes=dr.slave.nodes[facet])  # fmt: skip
@@ -352,6 +356,33 @@ class PointCoupling:
         on = (sums[:, 0] > 0.0) & (sums[:, 3] > 0.5 * sums[:, 0])
         D = sums[on, 0]
         return np.flatnonzero(on) + lay.start, D, sums[on, 1] / D, sums[on, 2] / sums[on, 3]
+
+    def slave_force(self) -> np.ndarray:
+        """The force vector of the pair on the (first direction's) slave body: the quadrature
+        sum of its traction -P n + t_T (minus that on the other body for the unbiased
+        variant). Collective."""
+        from mpi4py import MPI
+
+        total = np.zeros(self.layout.gdim)
+        for k, (p, s) in enumerate(zip(self.points, self.state, strict=True)):
+            traction = -s[0][:, None] * p["n"]
+            if s[2] is not None:
+                traction += s[2]
+            total += (1.0 if k == 0 else -1.0) * np.sum(p["w"][:, None] * traction, axis=0)
+        return self.comm.allreduce(total, op=MPI.SUM)
+
+    def friction_state(self) -> dict:
+        """Sums over this rank's points of the first direction (weights without the unbiased
+        halving): the contact measure (P > 0), the stick measure, the friction bound mu P and
+        the excess of |t_T| over it."""
+        p, s = self.points[0], self.state[0]
+        P, t, stick = s[0], s[2], s[3]
+        w = p["w"] / self.dirs[0].weight
+        closed = P > 0.0
+        bound = self.mu * P
+        excess = np.maximum(np.linalg.norm(t, axis=1) - bound, 0.0)
+        return {"measure": float(np.sum(w[closed])), "stick": float(np.sum(w[closed & stick])),
+                "bound": float(np.sum(w * bound)), "excess": float(np.sum(w * excess))}  # fmt: skip
 
     def force(self) -> float:
         """The normal contact force (the quadrature sum of P over both directions)."""

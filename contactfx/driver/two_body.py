@@ -27,7 +27,7 @@ from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
 from contactfx.driver.problem import Problem
-from contactfx.results import Quantities
+from contactfx.results import Friction, Quantities
 
 __all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
 
@@ -200,6 +200,25 @@ class TwoBodyPost:
             peak_pressure=peak,
             max_penetration=penetration,
             complementarity=complementarity,
+            friction=self.friction(),
+        )
+
+    def friction(self) -> Friction | None:
+        """Coulomb friction of the pair: the tangential force on the upper body (the last
+        component of the pair force is the normal one), the bound mu P, the stick size and the
+        slip fraction of the contact set, and the relative excess of |t_T| over mu P."""
+        if self.pb.friction is None:
+            return None
+        sums = self.pb.coupling().friction_state()
+        total = {k: self.comm.allreduce(v, op=MPI.SUM) for k, v in sums.items()}
+        sym = self.scene.symmetry
+        force = self.history[-1][1]
+        return Friction(
+            tangential_force=[float(c) for c in force[:-1]],
+            bound=total["bound"] * sym,
+            stick_size=self.scene.contact_size(total["stick"] * sym),
+            slip_fraction=1.0 - total["stick"] / total["measure"] if total["measure"] else 0.0,
+            excess=total["excess"] / total["bound"] if total["bound"] > 0.0 else total["excess"],
         )
 
     def pair_force(self, local: np.ndarray, D: np.ndarray, lam: np.ndarray) -> np.ndarray:
@@ -207,9 +226,14 @@ class TwoBodyPost:
         (n_j the unit nodal normals of the last search, outward of the slave body: the pressure
         pushes the slave along -n_j, the master along +n_j), times the scene's symmetry; nan
         for a coupling without nodal normals."""
-        normals = getattr(self.pb.coupling(), "normal", None)
-        if normals is None:
-            return np.full(self.gdim, np.nan)
+        coupling = self.pb.coupling()
+        normals = getattr(coupling, "normal", None)
+        if normals is None:  # the Gauss-point couplings sum their tractions
+            return (
+                self.scene.symmetry
+                * coupling.slave_force()
+                * (1.0 if self.scene.p.slave == "upper" else -1.0)
+            )
         local_sum = np.sum((D * lam)[:, None] * normals, axis=0) if len(D) else np.zeros(self.gdim)
         total = self.comm.allreduce(np.asarray(local_sum, dtype=float), op=MPI.SUM)
         sign = -1.0 if self.scene.p.slave == "upper" else 1.0
