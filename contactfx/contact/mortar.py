@@ -70,7 +70,7 @@ from contactfx.contact.projection import (
 )
 from contactfx.params import param, validate
 
-__all__ = ["Mortar", "MortarCoupling", "mortar_matrices"]
+__all__ = ["Mortar", "MortarCoupling", "mortar_matrices", "dual_triangle"]
 
 
 @dataclass(frozen=True)
@@ -113,7 +113,7 @@ def _linear(xi: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - xi, xi], axis=-1)
 
 
-def _dual_triangle(lam: np.ndarray) -> np.ndarray:
+def dual_triangle(lam: np.ndarray) -> np.ndarray:
     """Dual shape functions psi_i = 4 N_i - 1 on a triangle, of barycentric coordinates
     (..., 3): int_T psi_i N_k = 4 |T| (1 + delta_ik) / 12 - |T| / 3 = delta_ik |T| / 3."""
     return 4.0 * lam - 1.0
@@ -190,7 +190,7 @@ def _mortar_triangles(slave: Facets, master: Facets, pairs):
         # slave and master coordinates of the point in every fan triangle (pair, fan, 3)
         ls = lq[0] * sb[:, :, 0] + lq[1] * sb[:, :, 1] + lq[2] * sb[:, :, 2]
         lm = lq[0] * mb[:, :, 0] + lq[1] * mb[:, :, 1] + lq[2] * mb[:, :, 2]
-        psi = (wq * fan_area)[:, :, None] * _dual_triangle(ls)
+        psi = (wq * fan_area)[:, :, None] * dual_triangle(ls)
         vals += np.matmul(psi.transpose(0, 2, 1), lm)
     rows = np.repeat(slave.nodes[i][:, :, None], 3, axis=2)
     cols = np.repeat(master.nodes[k][:, None, :], 3, axis=1)

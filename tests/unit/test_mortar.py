@@ -137,13 +137,13 @@ def test_mortar_partition_of_unity_3d(seed):
 
 
 def test_dual_basis_biorthogonal_on_a_triangle():
-    from contactfx.contact.mortar import _dual_triangle
+    from contactfx.contact.mortar import dual_triangle
     from contactfx.contact.projection import gauss_triangle
 
     # int_T psi_i N_k = delta_ik |T| / 3, by the degree-2 rule (exact for the quadratic
     # integrand) on the unit triangle (|T| = 1/2)
     points, weights = gauss_triangle(2)
-    integral = 0.5 * np.einsum("q,qi,qk->ik", weights, _dual_triangle(points), points)
+    integral = 0.5 * np.einsum("q,qi,qk->ik", weights, dual_triangle(points), points)
     assert np.allclose(integral, np.eye(3) / 6.0, rtol=0, atol=1e-15)
 
 
