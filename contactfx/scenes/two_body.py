@@ -164,7 +164,18 @@ class HertzCylindersParams(two_elastic(1000.0, 0.3)):
                           "element, in [0, 1))", nonnegative=True)  # fmt: skip
 
 
-class HertzCylinders(TwoBodyScene):
+class _TwoHertz(TwoBodyScene):
+    """Two curved bodies of radii R_upper, R_lower: Hertz's combined radius and modulus."""
+
+    def E_star(self) -> float:
+        m = self.materials()
+        return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())
+
+    def R(self) -> float:
+        return 1.0 / (1.0 / self.p.R_upper + 1.0 / self.p.R_lower)
+
+
+class HertzCylinders(_TwoHertz):
     name = "hertz-cylinders"
     summary = "two elastic cylinders pressed together (quarter model); reference Hertz a, p0"
     Params = HertzCylindersParams
@@ -209,13 +220,6 @@ class HertzCylinders(TwoBodyScene):
         """Hertz p0 sqrt(1 - s^2 / a^2) (0 beyond a) at the computed force."""
         ref = self.reference(force)
         return ref["p0"] * np.sqrt(np.clip(1.0 - (s / ref["a"]) ** 2, 0.0, None))
-
-    def E_star(self) -> float:
-        m = self.materials()
-        return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())
-
-    def R(self) -> float:
-        return 1.0 / (1.0 / self.p.R_upper + 1.0 / self.p.R_lower)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.R(), self.E_star())
@@ -266,7 +270,7 @@ class HertzSpheresParams(two_elastic(1000.0, 0.3)):
                            positive=True)  # fmt: skip
 
 
-class HertzSpheres(TwoBodyScene):
+class HertzSpheres(_TwoHertz):
     name = "hertz-spheres"
     summary = "two elastic spheres pressed together (quarter model); reference Hertz a, p0"
     Params = HertzSpheresParams
@@ -311,13 +315,6 @@ class HertzSpheres(TwoBodyScene):
         closed = p > 0.0
         r = np.hypot(x[closed, 0], x[closed, 1])
         return radial_edge(r, p[closed], self.h_slave())
-
-    def E_star(self) -> float:
-        m = self.materials()
-        return 1.0 / sum((1.0 - b.nu**2) / b.E for b in m.values())
-
-    def R(self) -> float:
-        return 1.0 / (1.0 / self.p.R_upper + 1.0 / self.p.R_lower)
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_3d(force, self.R(), self.E_star())
