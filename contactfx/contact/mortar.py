@@ -46,10 +46,31 @@ components F instead, lambda_j = -n_F . R_j / (D_j |n_F|^2) from R_jc = -D_j lam
 (c in F), the tangents span the free directions orthogonal to n_F, and (j, n) is the free
 component of largest |n_F| (without this a tangent row lands on a Dirichlet row, and the
 node's tangential equilibrium is lost while the reaction is forced to zero). The multiplier
-thus lives on the slave nodes only; no unknown is added. The Jacobian is exact for the mortar
+thus lives on the slave nodes only; no unknown is added. Frictionless, the Jacobian is exact for the mortar
 matrices and normals of the last search: J = diag(s) T K + diag(w) G with s = D_j dC/dlambda
 on the normal rows (1 elsewhere) and w = D_j c_j dC/d(cg). With ``--search-update newton`` the
 search runs at every residual and the derivatives of D, M and n_j are not linearised.
+
+Coulomb friction (``--friction coulomb``): the tangent rows carry the tangential multiplier
+lambda_T,jc = -t_jc . R_j / D_j (the master rows receive M_jk / D_j times the whole free part
+of R_j), and the weighted slip increment of the load step is
+
+    v_jc = t_jc . (du_j - sum_k (M_jk / D_j) du_k),    du = u - u_prev
+
+(u_prev: the last converged step; M of the search at the start of the step, or of the last
+residual with ``--search-update newton``). A translation of both bodies gives no slip (the
+rows of M / D sum to 1), and a small rotation omega x gives omega x (D_j x_j - sum_k M_jk x_k)
+/ D_j = omega x (g_j n_j): none on a closed node (Gitterle et al. 2010,
+doi:10.1002/nme.2907, define the slip objectively at finite rotations; the kinematics here is
+small-strain). The rows are D_j C_T with
+
+    C_T = lambda_T - proj_{B(0, xi_j)}(lambda_T + c_j v_j),   xi_j = mu max(0, lambda_j - c_j g_j)
+
+(Hueeber, Stadler & Wohlmuth 2008, doi:10.1137/060671061): stick (|lambda_T + c v| <= xi)
+forces v = 0, slip puts lambda_T on the circle (sphere) of radius xi along the slip, an open
+node (xi = 0) has lambda_T = 0. Its semi-smooth derivative (the ball projection's, and the
+bound's through lambda and g) enters the Jacobian as nodal blocks P, Q: J = P T K + Q G, G
+holding the gap rows and the slip rows.
 """
 
 from __future__ import annotations
@@ -84,10 +105,11 @@ class Mortar(MethodBase):
     name = "mortar"
     sweep = ("ncp", ("min", "fb"))
     supports = Supports(
+        friction=("none", "coulomb"),
         obstacles=False, interfaces=False, two_body=True, dim1=False, iterative=False,
         why_not={"obstacles": "a mortar pair joins two meshed surfaces",
                  "interfaces": "a mortar pair joins two meshed surfaces",
-                 "friction": "mortar friction is not implemented yet",
+                 "friction": "mortar has Coulomb friction only",
                  "iterative": "its condensed Jacobian is not symmetric: use LU"},
     )  # fmt: skip
 
@@ -222,6 +244,8 @@ class MortarCoupling:
         self.search_each_newton = pair.search_each_newton
         self.ranges = owners(self.layout.imap, self.comm)
         self.T = self.G = self.TK = self.g0 = None
+        #: Coulomb coefficient (None: frictionless) and the last converged displacement
+        self.mu, self.previous = pair.mu, pair.previous
 
     # -- search and mortar integrals -------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -279,8 +303,14 @@ class MortarCoupling:
         lam_row = -n_free / (self.D * np.sum(n_free**2, axis=1))[:, None]
         # slave rows (j, c): lambda_j at comp, the tangents at the other free components,
         # the identity at a fixed one (replaced by the Dirichlet condition)
-        rows_c = np.where(free[:, :, None], tangents, np.eye(gdim)[None])
+        # tangent rows: t_c . R_j (frictionless: the nodal force has no tangential part), or
+        # the tangential multiplier lambda_T,jc = -t_c . R_j / D_j (Coulomb)
+        t_rows = tangents if self.mu is None else -tangents / self.D[:, None, None]
+        rows_c = np.where(free[:, :, None], t_rows, np.eye(gdim)[None])
         rows_c[np.arange(m), self.comp] = lam_row
+        self.tmask = free.copy()
+        self.tmask[np.arange(m), self.comp] = False
+        self.tangents = tangents
         block = np.zeros((m, bs, bs))
         block[:, :gdim, :gdim] = rows_c
         block[:, gdim:, gdim:] = np.eye(bs - gdim)
@@ -307,11 +337,23 @@ class MortarCoupling:
         mblock[:, :gdim, :gdim] = -(self.D[pos] * mw)[:, None, None] * (
             self.normal[pos][:, :, None] * lam_row[pos][:, None, :]
         )
+        if self.mu is not None:  # and - M_jk t_c lambda_T,jc
+            tp = tangents[pos]
+            mblock[:, :gdim, :gdim] += mw[:, None, None] * np.einsum("pci,pcj->pij", tp, tp)
         master_r = np.repeat(k_rows[:, :, None], bs, axis=2).ravel()
         master_c = np.repeat(jm_rows[:, None, :], bs, axis=1).ravel()
         g_r.append(np.repeat(normal_global[pos][:, None], gdim, axis=1))
         g_c.append(k_rows[:, :gdim])
         g_v.append(mw[:, None] * self.normal[pos])
+        if self.mu is not None:
+            # slip rows (j, c): v_jc = t_c . (du_j - sum_k M_jk / D_j du_k), du = u - u_prev
+            t_glob = j_rows[:, :gdim]  # the tangent rows of node j are its rows c
+            g_r.append(np.repeat(t_glob[:, :, None], gdim, axis=2))
+            g_c.append(np.repeat(j_rows[:, None, :gdim], gdim, axis=1))
+            g_v.append(tangents)
+            g_r.append(np.repeat(t_glob[pos][:, :, None], gdim, axis=2))
+            g_c.append(np.repeat(k_rows[:, None, :gdim], gdim, axis=1))
+            g_v.append(-mw[:, None, None] * tangents[pos])
         # the master rows go to their owners
         node_k, (master_r, master_c, master_v) = _to_owners(
             self.comm, self.ranges, master_r // bs, [master_r, master_c, mblock.ravel()]
@@ -327,6 +369,16 @@ class MortarCoupling:
         self.T, self.G = T, G
         self.g0 = G.createVecLeft()
         G.mult(lay.X, self.g0)
+        if self.mu is not None:  # slip rows: - G u_prev (the increment from the last step)
+            n = lay.n_owned * bs
+            prev = G.createVecRight()
+            prev.getArray()[:] = self.previous.x.array[:n]
+            slip0 = G.createVecLeft()
+            G.mult(prev, slip0)
+            rows = self.tangent_rows()[self.tmask]
+            self.g0.getArray()[rows] = -slip0.getArray()[rows]
+            prev.destroy()
+            slip0.destroy()
         self.TK = None  # T K, formed at the next Jacobian
         self._y = T.createVecLeft()
         self._g = G.createVecLeft()
@@ -352,11 +404,51 @@ class MortarCoupling:
             da, db = 1.0 - lam / rho, 1.0 - cg / rho
         return lam, cg, C, da, db
 
+    def tangent_rows(self) -> np.ndarray:
+        """Local rows (m, gdim) of the contact nodes' components (valid where ``tmask``)."""
+        bs = self.layout.bs
+        return ((self.nodes - self.layout.start)[:, None] * bs
+                + np.arange(self.layout.gdim)).astype(np.int64)  # fmt: skip
+
+    def _friction(self, lam, cg, y, q):
+        """Coulomb at the contact nodes: C_T = lambda_T - proj_{B(xi)}(lambda_T + c v), the
+        bound xi = mu max(0, lambda - c g) (Hueeber, Stadler & Wohlmuth 2008,
+        doi:10.1137/060671061), in the tangent slots (m, gdim) of ``tmask``; its derivatives
+        with respect to lambda_T, v (m, gdim, gdim) and to lambda, g (m, gdim)."""
+        tm = self.tmask
+        lt, v = np.where(tm, y, 0.0), np.where(tm, q, 0.0)
+        c = self.c[:, None]
+        z = lt + c * v
+        arg = lam - cg
+        xi = self.mu * np.maximum(arg, 0.0)
+        nz = np.linalg.norm(z, axis=1)
+        stick = (nz <= xi) & (xi > 0.0)
+        zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
+        ratio = np.where(stick, 1.0, xi / np.where(nz > 0.0, nz, 1.0))
+        proj = np.where(stick[:, None], z, xi[:, None] * zhat)
+        eye = np.eye(tm.shape[1])[None] * tm[:, :, None] * tm[:, None, :]
+        slip_d = ratio[:, None, None] * (eye - zhat[:, :, None] * zhat[:, None, :])
+        dproj = np.where(stick[:, None, None], eye, slip_d)
+        # d proj / d xi = zhat on slip, d xi = mu (d lambda - c d g) where lambda > c g
+        dxi = np.where(~stick & (arg > 0.0), self.mu, 0.0)
+        d_lam = -zhat * dxi[:, None]
+        self.stick, self.xi = stick, xi
+        return (lt - proj, eye - dproj, -dproj * c[:, :, None], d_lam,
+                -d_lam * self.c[:, None])  # fmt: skip
+
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         lam, cg, C, self._da, self._db = self._state(x, F)
         self.lam, self.gap = lam, cg / self.c
         self._y.copy(F)
-        F.getArray()[self.normal_rows] = self.D * C
+        out = F.getArray()
+        out[self.normal_rows] = self.D * C
+        if self.mu is not None:
+            rows = self.tangent_rows()
+            y, q = self._y.getArray()[rows], self._g.getArray()[rows]
+            self.lam_t = np.where(self.tmask, y, 0.0)
+            self._fric = self._friction(lam, cg, y, q)
+            CT = self._fric[0]
+            out[rows[self.tmask]] = (self.D[:, None] * CT)[self.tmask]
 
     def jacobian(self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None:
         """At the x of the last residual (SNES evaluates F(x) before J(x))."""
@@ -368,20 +460,62 @@ class MortarCoupling:
             J.zeroEntries()
             J.axpy(1.0, union, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             union.destroy()
-        s = self.TK.createVecLeft()
-        s.set(1.0)
-        s.getArray()[self.normal_rows] = self.D * da
-        w = self.G.createVecLeft()
-        w.getArray()[self.normal_rows] = self.D * self.c * db
-        A = self.TK.copy()
-        A.diagonalScale(L=s)
-        B = self.G.copy()
-        B.diagonalScale(L=w)
+        if self.mu is not None:
+            A, B = self._friction_blocks(da, db)
+        else:
+            A = self.TK.copy()
+            s = self.TK.createVecLeft()
+            s.set(1.0)
+            s.getArray()[self.normal_rows] = self.D * da
+            A.diagonalScale(L=s)
+            B = self.G.copy()
+            w = self.G.createVecLeft()
+            w.getArray()[self.normal_rows] = self.D * self.c * db
+            B.diagonalScale(L=w)
+            s.destroy()
+            w.destroy()
         J.zeroEntries()
         J.axpy(1.0, A, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         J.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        for obj in (s, w, A, B):
-            obj.destroy()
+        A.destroy()
+        B.destroy()
+
+    def _friction_blocks(self, da, db):
+        """(P T K, Q G): the nodal blocks P, Q (identity and zero away from the contact nodes)
+        of the derivative of the rows (normal C, tangential C_T) with respect to y = T R
+        (lambda, lambda_T) and q = G u (g, v)."""
+        lay = self.layout
+        gdim, bs, m = lay.gdim, lay.bs, len(self.nodes)
+        _, d_lt, d_v, d_lam, d_g = self._fric
+        comp, idx = self.comp, np.arange(m)
+        P = np.zeros((m, bs, bs))
+        P[:, range(bs), range(bs)] = 1.0
+        P[:, :gdim, :gdim] = np.where(self.tmask[:, :, None], d_lt, P[:, :gdim, :gdim])
+        P[idx, :gdim, comp] = np.where(self.tmask, d_lam, P[idx, :gdim, comp])
+        P[idx, comp, :] = 0.0
+        P[idx, comp, comp] = da
+        Q = np.zeros((m, bs, bs))
+        Q[:, :gdim, :gdim] = np.where(self.tmask[:, :, None], d_v, 0.0)
+        Q[idx, :gdim, comp] = np.where(self.tmask, d_g, 0.0)
+        Q[idx, comp, comp] = self.c * db
+        # the normal and tangent rows are D_j C (the fixed components' rows stay R_jc)
+        scale = np.where(self.tmask, self.D[:, None], 1.0)
+        scale[idx, comp] = self.D
+        P[:, :gdim] *= scale[:, :, None]
+        Q[:, :gdim] *= scale[:, :, None]
+        j_rows = blocked_rows(self.nodes, bs)
+        r = np.repeat(j_rows[:, :, None], bs, axis=2).ravel()
+        c = np.repeat(j_rows[:, None, :], bs, axis=1).ravel()
+        others = np.ones(lay.n_owned, dtype=bool)
+        others[(self.nodes - lay.start).astype(np.int64)] = False
+        diag = blocked_rows(np.flatnonzero(others) + lay.start, bs).ravel()
+        Pm = _owned_matrix(lay, np.concatenate([r, diag]), np.concatenate([c, diag]),
+                           np.concatenate([P.ravel(), np.ones(len(diag))]))  # fmt: skip
+        Qm = _owned_matrix(lay, r, c, Q.ravel())
+        A, B = Pm.matMult(self.TK), Qm.matMult(self.G)
+        Pm.destroy()
+        Qm.destroy()
+        return A, B
 
     # -- what the post-processing reads ----------------------------------------------------
     def force(self) -> float:
@@ -389,6 +523,28 @@ class MortarCoupling:
         from mpi4py import MPI
 
         return self.comm.allreduce(float(np.sum(self.D * self.lam)), op=MPI.SUM)
+
+    def slave_force(self) -> np.ndarray:
+        """The force vector of the pair on the slave body, -sum_j D_j (lambda_j n_j
+        + sum_c lambda_T,jc t_jc). Collective."""
+        from mpi4py import MPI
+
+        traction = self.lam[:, None] * self.normal
+        if self.mu is not None:
+            traction = traction + np.einsum("jc,jci->ji", self.lam_t, self.tangents)
+        local = -np.sum(self.D[:, None] * traction, axis=0)
+        return self.comm.allreduce(np.asarray(local, dtype=float).reshape(-1), op=MPI.SUM)
+
+    def friction_state(self) -> dict:
+        """Sums over this rank's contact nodes (weights D_j): the contact measure (the nodes
+        where the friction bound is positive), the stick measure, the bound mu lambda and the
+        excess of |lambda_T| over it."""
+        closed = self.xi > 0.0
+        bound = self.mu * self.lam
+        excess = np.maximum(np.linalg.norm(self.lam_t, axis=1) - bound, 0.0)
+        D = self.D
+        return {"measure": float(np.sum(D[closed])), "stick": float(np.sum(D[self.stick])),
+                "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess))}  # fmt: skip
 
     def search_gaps(self) -> np.ndarray:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""

@@ -192,7 +192,7 @@ class TwoBodyPost:
         x_all = np.concatenate(self.comm.allgather(x))
         p_all = np.concatenate(self.comm.allgather(lam[closed[local]]))
         edge = self.scene.contact_edge(x_all, p_all)
-        self.history.append((float(self.pb.tload.value), self.pair_force(local, D, lam)))
+        self.history.append((float(self.pb.tload.value), self.pair_force()))
         self.tangential.append(self.tangential_nodal_force(solver, local))
         return Quantities(
             force=force,
@@ -221,23 +221,11 @@ class TwoBodyPost:
             excess=total["excess"] / total["bound"] if total["bound"] > 0.0 else total["excess"],
         )
 
-    def pair_force(self, local: np.ndarray, D: np.ndarray, lam: np.ndarray) -> np.ndarray:
-        """The force of the pair on the upper body, sum_j D_j lambda_j n_j over the slave nodes
-        (n_j the unit nodal normals of the last search, outward of the slave body: the pressure
-        pushes the slave along -n_j, the master along +n_j), times the scene's symmetry; nan
-        for a coupling without nodal normals."""
-        coupling = self.pb.coupling()
-        normals = getattr(coupling, "normal", None)
-        if normals is None:  # the Gauss-point couplings sum their tractions
-            return (
-                self.scene.symmetry
-                * coupling.slave_force()
-                * (1.0 if self.scene.p.slave == "upper" else -1.0)
-            )
-        local_sum = np.sum((D * lam)[:, None] * normals, axis=0) if len(D) else np.zeros(self.gdim)
-        total = self.comm.allreduce(np.asarray(local_sum, dtype=float), op=MPI.SUM)
-        sign = -1.0 if self.scene.p.slave == "upper" else 1.0
-        return sign * self.scene.symmetry * total
+    def pair_force(self) -> np.ndarray:
+        """The force of the pair on the upper body (the coupling's force on the slave body,
+        with the sign of the slave side), times the scene's symmetry. Collective."""
+        sign = 1.0 if self.scene.p.slave == "upper" else -1.0
+        return sign * self.scene.symmetry * self.pb.coupling().slave_force()
 
     def tangential_nodal_force(self, solver, local: np.ndarray) -> float:
         """sum_j |f_j - (n_j . f_j) n_j| / sum_j |n_j . f_j| over the slave contact nodes j
@@ -275,7 +263,7 @@ class TwoBodyPost:
         scores = {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in scores.items()}
         loads = np.array([t for t, _ in self.history])
         forces = np.array([f for _, f in self.history]).reshape(len(loads), self.gdim)
-        if np.all(np.isfinite(forces)):  # a coupling with nodal normals
+        if np.all(np.isfinite(forces)):  # every step converged to a finite force
             scores.update(self.scene.force_scores(loads, forces))
             scores["tangential_nodal_force"] = float(np.max(self.tangential, initial=0.0))
         pair = self.pb.pair
