@@ -571,6 +571,7 @@ def cylinders(
     ratio: float,
     offset: float = 0.0,
     grading: float = 0.3,
+    full: bool = False,
 ) -> None:
     """Build and mesh two cylinders touching at the origin, quarter model (a gmsh builder).
 
@@ -584,7 +585,9 @@ def cylinders(
     bottom y = -R2. The element size is h_contact (lower) and ratio * h_contact (upper) within
     the distance ``refine`` of the origin and grows by ``grading`` per unit distance up to
     ``h_far``. With offset > 0 the upper arc is split at the arc length l0 (:func:`offset_length`)
-    from the origin.
+    from the origin. With ``full`` the bodies are the half disks (both sides of x = 0, no
+    symmetry segment: for tangential loading); the contact arcs run from x = -R to x = R and
+    the upper arc is split at -l0 and l0.
 
     Args:
         model: The ``gmsh.model`` namespace of an open gmsh session.
@@ -595,10 +598,15 @@ def cylinders(
         ratio: Element size of the upper body / that of the lower body (dimensionless).
         offset: Shift of the upper body's contact nodes, fraction of its element (in [0, 1)).
         grading: Size increase per unit distance from the refinement disk (dimensionless).
+        full: Half disks instead of quarter disks.
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
+    if full:
+        _full_cylinders(model, radius_lower, radius_upper, h_contact, h_far, refine, ratio,
+                        offset, grading)  # fmt: skip
+        return
     check_finite(radius_lower=radius_lower, radius_upper=radius_upper)
     check_positive(radius_lower=radius_lower, radius_upper=radius_upper)
     _check_graded(h_contact, h_far, refine, grading, ratio, offset)
@@ -654,6 +662,50 @@ def cylinders(
         dist_min=refine,
         grading=grading,
     )
+    _generate(model, 2)
+
+
+def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grading) -> None:
+    """:func:`cylinders` with ``full``: the half disks below y = R1 (upper) and above
+    y = -R2 (lower)."""
+    check_finite(radius_lower=r2, radius_upper=r1)
+    check_positive(radius_lower=r2, radius_upper=r1)
+    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    l0 = offset_length(offset, ratio * h_contact)
+    if offset > 0:
+        _check_first_element(l0, "the upper contact arc", 0.5 * math.pi * r1)
+    occ = model.occ
+    # lower: the arc (-R2, -R2) -> origin -> (R2, -R2) around (0, -R2), closed by its bottom
+    left, origin, right, centre = (occ.addPoint(x, y, 0.0) for x, y in
+                                   ((-r2, -r2), (0.0, 0.0), (r2, -r2), (0.0, -r2)))  # fmt: skip
+    lower_arc = [occ.addCircleArc(left, centre, origin), occ.addCircleArc(origin, centre, right)]
+    (lower_bottom,) = _polyline(model, [right, left])
+    lower = _surface(model, [*lower_arc, lower_bottom])
+    # upper: its own points; the arc (-R1, R1) -> origin -> (R1, R1) around (0, R1), split at
+    # the arc lengths -l0 and l0 from the origin (the offset of its nodes)
+    centre = occ.addPoint(0.0, r1, 0.0)
+    angles = [-0.5 * math.pi, 0.5 * math.pi]
+    if offset > 0:
+        angles[1:1] = [-l0 / r1, l0 / r1]
+    else:
+        angles[1:1] = [0.0]
+    points = [occ.addPoint(r1 * math.sin(t), r1 * (1 - math.cos(t)), 0.0) for t in angles]
+    upper_arc = [occ.addCircleArc(a, centre, b) for a, b in zip(points[:-1], points[1:],
+                                                                   strict=True)]  # fmt: skip
+    (upper_top,) = _polyline(model, [points[-1], points[0]])
+    upper = _surface(model, [*upper_arc, upper_top])
+    occ.synchronize()
+    if offset > 0:
+        model.mesh.setTransfiniteCurve(upper_arc[1], 2)
+    f = CylindersFacets
+    _add_body_groups(
+        model,
+        {CylindersCells.LOWER: (lower, {f.LOWER_CONTACT: lower_arc,
+                                        f.LOWER_BOTTOM: [lower_bottom]}),
+         CylindersCells.UPPER: (upper, {f.UPPER_CONTACT: upper_arc, f.UPPER_TOP: [upper_top]})},
+    )  # fmt: skip
+    _set_body_sizes(model, 2, [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
+                    "Sqrt(x^2+y^2)", dist_min=refine, grading=grading)  # fmt: skip
     _generate(model, 2)
 
 

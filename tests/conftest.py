@@ -18,6 +18,19 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
+def pytest_runtest_logreport(report):
+    """Under MPI a test that fails on one rank leaves the others waiting in its next
+    collective: print the failure and abort the job, so that the session fails instead of
+    hanging."""
+    comm = MPI.COMM_WORLD
+    if comm.size > 1 and report.failed:
+        rank = comm.rank
+        sys.stderr.write(f"\nrank {rank}: {report.nodeid} failed ({report.when}):\n"
+                         f"{report.longreprtext}\nrank {rank}: aborting the MPI job\n")  # fmt: skip
+        sys.stderr.flush()
+        comm.Abort(1)
+
+
 def clean_env() -> dict[str, str]:
     """Environment for child processes: no MPI singleton state of the test process."""
     from contactfx.io.process import child_env

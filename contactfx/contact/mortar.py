@@ -46,10 +46,11 @@ components F instead, lambda_j = -n_F . R_j / (D_j |n_F|^2) from R_jc = -D_j lam
 (c in F), the tangents span the free directions orthogonal to n_F, and (j, n) is the free
 component of largest |n_F| (without this a tangent row lands on a Dirichlet row, and the
 node's tangential equilibrium is lost while the reaction is forced to zero). The multiplier
-thus lives on the slave nodes only; no unknown is added. Frictionless, the Jacobian is exact for the mortar
-matrices and normals of the last search: J = diag(s) T K + diag(w) G with s = D_j dC/dlambda
-on the normal rows (1 elsewhere) and w = D_j c_j dC/d(cg). With ``--search-update newton`` the
-search runs at every residual and the derivatives of D, M and n_j are not linearised.
+thus lives on the slave nodes only; no unknown is added. Frictionless, the Jacobian is exact
+for the mortar matrices and normals of the last search: J = diag(s) T K + diag(w) G with
+s = D_j dC/dlambda on the normal rows (1 elsewhere) and w = D_j c_j dC/d(cg). With
+``--search-update newton`` the search runs at every residual and the derivatives of D, M and
+n_j are not linearised.
 
 Coulomb friction (``--friction coulomb``): the tangent rows carry the tangential multiplier
 lambda_T,jc = -t_jc . R_j / D_j (the master rows receive M_jk / D_j times the whole free part
@@ -538,13 +539,14 @@ class MortarCoupling:
     def friction_state(self) -> dict:
         """Sums over this rank's contact nodes (weights D_j): the contact measure (the nodes
         where the friction bound is positive), the stick measure, the bound mu lambda and the
-        excess of |lambda_T| over it."""
+        excess of |lambda_T| over it, and the sum of |lambda_T|."""
         closed = self.xi > 0.0
         bound = self.mu * self.lam
         excess = np.maximum(np.linalg.norm(self.lam_t, axis=1) - bound, 0.0)
         D = self.D
         return {"measure": float(np.sum(D[closed])), "stick": float(np.sum(D[self.stick])),
-                "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess))}  # fmt: skip
+                "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess)),
+                "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1)))}  # fmt: skip
 
     def search_gaps(self) -> np.ndarray:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""

@@ -69,7 +69,10 @@ class _Directed:
         self.slave, self.master, self.weight = slave, master, weight
         self.lame = lame  # (m, 3): E, lambda, mu of each slave facet's cell
         d = slave.local.shape[1]
-        self.grads = _cell_gradients(slave.cell_X) if len(slave) else None
+        gdim = slave.cell_X.shape[-1] if slave.cell_X.ndim == 3 else d
+        # (a rank without facets of this side: empty arrays, the collectives still run)
+        self.grads = (_cell_gradients(slave.cell_X) if len(slave)
+                      else np.zeros((0, d + 1, gdim)))  # fmt: skip
         # position of each facet vertex among its cell's nodes
         self.pos = np.array([[np.flatnonzero(c == v)[0] for v in f]
                              for f, c in zip(slave.local, slave.cell_local, strict=True)],
@@ -374,7 +377,7 @@ class PointCoupling:
     def friction_state(self) -> dict:
         """Sums over this rank's points of the first direction (weights without the unbiased
         halving): the contact measure (P > 0), the stick measure, the friction bound mu P and
-        the excess of |t_T| over it."""
+        the excess of |t_T| over it, and the sum of |t_T|."""
         p, s = self.points[0], self.state[0]
         P, t, stick = s[0], s[2], s[3]
         w = p["w"] / self.dirs[0].weight
@@ -382,7 +385,8 @@ class PointCoupling:
         bound = self.mu * P
         excess = np.maximum(np.linalg.norm(t, axis=1) - bound, 0.0)
         return {"measure": float(np.sum(w[closed])), "stick": float(np.sum(w[closed & stick])),
-                "bound": float(np.sum(w * bound)), "excess": float(np.sum(w * excess))}  # fmt: skip
+                "bound": float(np.sum(w * bound)), "excess": float(np.sum(w * excess)),
+                "tangential": float(np.sum(w * np.linalg.norm(t, axis=1)))}  # fmt: skip
 
     def force(self) -> float:
         """The normal contact force (the quadrature sum of P over both directions)."""

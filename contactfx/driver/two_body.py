@@ -211,6 +211,9 @@ class TwoBodyPost:
             return None
         sums = self.pb.coupling().friction_state()
         total = {k: self.comm.allreduce(v, op=MPI.SUM) for k, v in sums.items()}
+        #: the tangential traction's integral of |t_T| over the friction bound's (1 at gross
+        #: slip, in the contact's own frame)
+        self.slip_ratio = total["tangential"] / total["bound"] if total["bound"] > 0 else 0.0
         sym = self.scene.symmetry
         force = self.history[-1][1]
         return Friction(
@@ -256,6 +259,8 @@ class TwoBodyPost:
 
     def finish(self, q: Quantities, out) -> dict:
         reference = closed_form_errors(self.scene, q)
+        if q.friction is not None:
+            reference.update(self.scene.friction_reference(q, self.pb.friction))
         x = _compat.dof_coordinates(self.Q1)
         nodes, _, lam, _ = self.pb.coupling().nodal()
         local = (nodes - self.start).astype(np.int64)
@@ -266,6 +271,8 @@ class TwoBodyPost:
         if np.all(np.isfinite(forces)):  # every step converged to a finite force
             scores.update(self.scene.force_scores(loads, forces))
             scores["tangential_nodal_force"] = float(np.max(self.tangential, initial=0.0))
+        if q.friction is not None:
+            scores["tangential_over_bound"] = self.slip_ratio
         pair = self.pb.pair
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)

@@ -11,7 +11,7 @@ from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
-from contactfx.scenes.two_body_2d import PunchFoundation, SlidingContact
+from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
 from contactfx.scenes.westergaard import Westergaard
 
 __all__ = ["SCENES", "get_scene", "Scene", "Numerics"]
@@ -35,6 +35,7 @@ SCENES: dict[str, type[Scene]] = {
         HertzSpheres,
         PunchFoundation,
         SlidingContact,
+        CattaneoCylinders,
     )
 }
 

@@ -31,7 +31,7 @@ from contactfx.references import hertz_2d, hertz_3d
 from contactfx.scenes._common import fix, fix_component, gmsh_mesh
 from contactfx.scenes.base import ObstacleScene, elastic
 
-__all__ = ["Hertz2D", "Hertz3D", "QuarterBlock"]
+__all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "cattaneo_mindlin"]
 
 
 def _elliptic(p0, s2):
@@ -50,7 +50,7 @@ def _indent_then_shift(t: float, depth: float, shift: float, gdim: int) -> np.nd
     return offset
 
 
-def _cattaneo_mindlin(f, a: float, exponent: float) -> dict[str, float]:
+def cattaneo_mindlin(f, a: float, exponent: float) -> dict[str, float]:
     """Stick size c = a (1 - Q / (mu P))^exponent (2D: 1/2, 3D: 1/3) at the computed normal
     force P and tangential force Q (Johnson 1985, section 7.1; approximate on a rigid-elastic
     pair, Dundurs beta != 0). With Q the x component and the bound mu P of the friction
@@ -163,7 +163,7 @@ class Hertz2D(ObstacleScene):
 
     def friction_reference(self, q, friction) -> dict[str, float]:
         ref = self._hertz(q.force)
-        return _cattaneo_mindlin(q.friction, ref["a"], exponent=0.5) if ref else {}
+        return cattaneo_mindlin(q.friction, ref["a"], exponent=0.5) if ref else {}
 
 
 @dataclass(frozen=True)
@@ -243,4 +243,4 @@ class Hertz3D(QuarterBlock):
 
     def friction_reference(self, q, friction) -> dict[str, float]:
         ref = hertz_3d(q.force, self.p.radius, self.material().E_star)
-        return _cattaneo_mindlin(q.friction, ref["a"], exponent=1.0 / 3.0)
+        return cattaneo_mindlin(q.friction, ref["a"], exponent=1.0 / 3.0)

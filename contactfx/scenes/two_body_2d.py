@@ -1,5 +1,6 @@
-"""Two-body scenes in 2D: an elastic flat punch on an elastic block, and a rounded body dragged
-along a block (docs/verification.md section 10).
+"""Two-body scenes in 2D: an elastic flat punch on an elastic block, a rounded body dragged
+along a block, and two identical cylinders pressed and sheared (docs/verification.md
+section 10).
 
 ``punch-foundation``: a flat punch of half-width b with edges rounded by the radius rho (its
 flat face is |x| <= a = b - rho), half model with the symmetry plane x = 0, pressed into a
@@ -32,6 +33,21 @@ pressure centroid of the discrete solution is off the body's axis by a fraction 
 (2e-5 at the end of the default drag, at most 4e-5 over the steady drag). The frictionless
 transmission itself is checked by the kind's score ``tangential_nodal_force`` (the tangential
 nodal forces on the slave nodes from the bulk residual: the solver's tolerance).
+
+``cattaneo-cylinders``: two identical cylinders (full half disks, :func:`contactfx.meshes.
+cylinders` with ``full``), the lower one clamped at its flat bottom, the upper one's flat top
+moved down by ``depth`` during the first ``press_fraction`` of the load program, then along
++x by ``shift`` at that depth, with Coulomb friction. Identical materials (Dundurs' beta = 0)
+decouple the normal and the tangential problems: the pressing is frictionless in effect and
+the Hertz pressure stays while the tangential force Q grows. Under a monotonically growing
+Q < mu P the contact sticks on the central band |x| < c and slips outside it, with
+
+    c / a = sqrt(1 - Q / (mu P))
+
+(Cattaneo 1938, Mindlin 1949; Johnson 1985, section 7.1), a the Hertz half-width at the
+normal force P; at Q = mu P the whole contact slips (gross slip). Scores per step: ``Q``,
+``P`` and the ratio Q / (mu P) (``Q_over_muP``); the friction references compare the stick
+half-width (the measure of the stick nodes / 2) with Cattaneo's at the computed Q / (mu P).
 """
 
 from __future__ import annotations
@@ -43,10 +59,12 @@ import dolfinx
 import numpy as np
 
 from contactfx.meshes import (
+    CylindersFacets,
     PunchFoundationCells,
     PunchFoundationFacets,
     RoundedOnBlockCells,
     RoundedOnBlockFacets,
+    cylinders,
     punch_foundation,
     rounded_on_block,
 )
@@ -54,9 +72,11 @@ from contactfx.params import param
 from contactfx.references import rigid_punch_2d
 from contactfx.scenes._common import fix, fix_component, prescribe_component
 from contactfx.scenes.flat_punch import normalised_pressure_error
+from contactfx.scenes.hertz import cattaneo_mindlin
+from contactfx.scenes.two_body import HertzCylinders
 from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
 
-__all__ = ["PunchFoundation", "SlidingContact"]
+__all__ = ["PunchFoundation", "SlidingContact", "CattaneoCylinders"]
 
 
 @dataclass(frozen=True)
@@ -221,3 +241,74 @@ class SlidingContact(TwoBodyScene):
             scores["P_jump"] = float(np.max(np.abs(np.diff(Pd)) / Pd[:-1]))
             scores["P_variation"] = float((Pd.max() - Pd.min()) / Pd.mean())
         return scores
+
+
+@dataclass(frozen=True)
+class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
+    R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
+    R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
+    depth: float = param(5e-3, "downward displacement of the upper body's top (pressing)",
+                         positive=True)  # fmt: skip
+    shift: float = param(1.5e-3, "displacement of the top along +x after pressing",
+                         nonnegative=True)  # fmt: skip
+    press_fraction: float = param(0.5, "fraction of the load program spent pressing, in "
+                                  "(0, 1)", positive=True)  # fmt: skip
+    h_contact: float = param(2e-3, "element size of the lower body in the contact zone",
+                             positive=True)  # fmt: skip
+    h_far: float = param(0.1, "element size far from the contact zone", positive=True)
+    refine: float = param(0.08, "radius of the refined zone around the first contact point",
+                          positive=True)  # fmt: skip
+    ratio: float = param(0.75, "element size of the upper body / that of the lower",
+                         positive=True)  # fmt: skip
+    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
+                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.press_fraction < 1.0:
+            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
+
+
+class CattaneoCylinders(HertzCylinders):
+    name = "cattaneo-cylinders"
+    summary = ("two identical cylinders pressed, then sheared with Coulomb friction; "
+               "stick half-width c / a = sqrt(1 - Q / (mu P))")  # fmt: skip
+    Params = CattaneoCylindersParams
+    symmetry = 1.0
+    numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 8}
+
+    def build_mesh(self, comm):
+        p = self.p
+        builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
+                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
+                                    ratio=p.ratio, offset=p.offset, full=True)  # fmt: skip
+        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        self.drag = dolfinx.fem.Constant(mesh, 0.0)
+        return mesh, facet_tags
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = CylindersFacets
+        return [*fix(V, facet_tags, f.LOWER_BOTTOM),
+                prescribe_component(V, facet_tags, f.UPPER_TOP, 0, self.drag),
+                prescribe_component(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
+
+    def set_load(self, t: float) -> None:
+        f = self.p.press_fraction
+        self.push.value = -min(t / f, 1.0) * self.p.depth
+        self.drag.value = max(t - f, 0.0) / (1.0 - f) * self.p.shift
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+        """Half the distance between the two edges of the contact band (each from the two
+        outermost closed nodes on its side, :meth:`HertzCylinders.contact_edge`)."""
+        right = super().contact_edge(x, p)
+        left = super().contact_edge(-x, p)
+        return None if right is None or left is None else 0.5 * (right + left)
+
+    def force_scores(self, loads, forces):
+        """Q, P at the last step and Q / (mu P) is in the friction references."""
+        return {"P": float(forces[-1, 1]), "Q": float(forces[-1, 0])}
+
+    def friction_reference(self, q, friction) -> dict[str, float]:
+        ref = self.reference(q.force)
+        return cattaneo_mindlin(q.friction, ref["a"], exponent=0.5)
