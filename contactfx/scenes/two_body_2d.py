@@ -253,10 +253,10 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
                          nonnegative=True)  # fmt: skip
     press_fraction: float = param(0.5, "fraction of the load program spent pressing, in "
                                   "(0, 1)", positive=True)  # fmt: skip
-    h_contact: float = param(2e-3, "element size of the lower body in the contact zone",
+    h_contact: float = param(1e-3, "element size of the lower body in the contact zone",
                              positive=True)  # fmt: skip
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
-    refine: float = param(0.08, "radius of the refined zone around the first contact point",
+    refine: float = param(0.045, "radius of the refined zone around the first contact point",
                           positive=True)  # fmt: skip
     ratio: float = param(0.75, "element size of the upper body / that of the lower",
                          positive=True)  # fmt: skip

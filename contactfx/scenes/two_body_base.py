@@ -106,6 +106,11 @@ class TwoBodyScene(Scene):
     def reference(self, force: float) -> dict[str, float]:
         return {}
 
+    def friction_reference(self, q, friction) -> dict[str, float]:
+        """Closed-form friction quantities at the computed state ``q``
+        (:class:`contactfx.results.Quantities`) under the ``friction`` law."""
+        return {}
+
     def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
         """Scene-specific scores from this rank's slave contact nodes x and pressures p (local
         maxima, reduced with MAX over ranks)."""

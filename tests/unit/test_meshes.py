@@ -575,7 +575,8 @@ def _arc_edges(
     return ends[np.all(np.abs(distance - radius) <= 1e-12 * radius, axis=1)]
 
 
-def _check_quarter_arc(data: MeshData, tag: int, centre: tuple[float, float], radius: float):
+def _check_quarter_arc(data: MeshData, tag: int, centre: tuple[float, float], radius: float,
+                       angle: float = 0.5 * math.pi):  # fmt: skip
     """The edges tagged ``tag`` that lie on the circle approximate a quarter arc; returns the
     global area between the arc and its chords (sum of the circular segments).
 
@@ -590,7 +591,7 @@ def _check_quarter_arc(data: MeshData, tag: int, centre: tuple[float, float], ra
     chords = _lengths(_arc_edges(_facet_vertices(data, tag), centre, radius))
     angles = 2 * np.arcsin(chords / (2 * radius))
     total_angle = comm.allreduce(angles.sum(), op=MPI.SUM)
-    assert total_angle == pytest.approx(0.5 * math.pi, rel=1e-10)
+    assert total_angle == pytest.approx(angle, rel=1e-10)
     segments = comm.allreduce((radius**2 * (angles - np.sin(angles)) / 2).sum(), op=MPI.SUM)
     return comm.allreduce(chords.sum(), op=MPI.SUM), segments
 
@@ -699,6 +700,34 @@ def test_cylinders(cylinders_mesh: MeshData) -> None:
     _check_separate_bodies(data, cells.LOWER, cells.UPPER)
     # The arcs only touch at the origin.
     _check_non_matching(data, facets.LOWER_CONTACT, facets.UPPER_CONTACT, max_coincident=1)
+
+
+def test_cylinders_full() -> None:
+    """``full``: half disks (both sides of x = 0), no symmetry segments."""
+    p = dict(CYLINDERS, h_contact=0.02, refine=0.05)
+    data = build(MPI.COMM_WORLD, partial(cylinders, **p, full=True), gdim=2, name="full")
+    r1, r2, h_far = p["radius_upper"], p["radius_lower"], p["h_far"]
+    cells, facets = CylindersCells, CylindersFacets
+    _check_boundary_tagged_once(data)
+    for tag, length in ((facets.LOWER_BOTTOM, 2 * r2), (facets.UPPER_TOP, 2 * r1),
+                        (facets.LOWER_SYMMETRY, 0.0), (facets.UPPER_SYMMETRY, 0.0)):  # fmt: skip
+        assert _measure(data, tag) == pytest.approx(length, rel=1e-12, abs=1e-14), tag.name
+    for body, contact, centre, radius in (
+        (cells.LOWER, facets.LOWER_CONTACT, (0.0, -r2), r2),
+        (cells.UPPER, facets.UPPER_CONTACT, (0.0, r1), r1),
+    ):
+        chords, segments = _check_quarter_arc(data, contact, centre, radius, angle=math.pi)
+        assert _measure(data, contact) == pytest.approx(chords, rel=1e-12)
+        # Exact: the half disk minus the circular segments cut off by the chords.
+        area = _measure(data, body, "dx")
+        assert area == pytest.approx(0.5 * math.pi * radius**2 - segments, rel=1e-10)
+        low, high = _arc_bounds(0.5 * math.pi * radius**2, radius, h_far, 6)
+        assert low <= area <= high, body.name
+    _check_separate_bodies(data, cells.LOWER, cells.UPPER)
+    # with the offset the upper arc has no node at the origin: no node coincides
+    lower = _tagged_vertices(data, facets.LOWER_CONTACT)
+    upper = _tagged_vertices(data, facets.UPPER_CONTACT)
+    assert not _coincident(upper, lower).any()
 
 
 def test_cylinders_sizes(cylinders_mesh: MeshData) -> None:

@@ -308,33 +308,76 @@ def test_unsupported_body_apart_refused():
         scene.run(Numerics(method="nitsche"), verbose=False)
 
 
-def _sliding_coulomb():
+def _sliding_coulomb(method: str = "nitsche"):
     from contactfx.scenes.two_body_2d import SlidingContact
 
     scene = SlidingContact(SlidingContact.Params(slide=0.05, h_contact=8e-3))
     return scene, SlidingContact.default_numerics(
-        method="nitsche", friction="coulomb", mu=0.3, steps=12
+        method=method, friction="coulomb", mu=0.3, steps=12
     )
 
 
-def test_sliding_contact_coulomb_nitsche():
-    scene, num = _sliding_coulomb()
+@pytest.mark.parametrize("method", ["nitsche", "mortar"])
+def test_sliding_contact_coulomb(method):
+    scene, num = _sliding_coulomb(method)
     res = scene.run(num, verbose=False)
     f = res.friction
     # steady sliding (the drag is 6 contact half-widths): gross slip, Q = -mu P on the
-    # dragged body; Q / P differs from mu by the pressure P the Nitsche law carries against
-    # the normal force of the pair's tractions (measured 0.2 %); 1 % as the issue asks
+    # dragged body. Q / P is the ratio of the force's x and y components: it differs from
+    # mu by the tilt of the contact normals of the pressed, curved surface (the normal
+    # pressure has an x component, the tangential traction a y one; measured 0.3 % for
+    # nitsche and 0.4 % for mortar); 1 % as the issue asks
     assert f.slip_fraction == pytest.approx(1.0, abs=1e-12)
     assert res.scores["Q_over_P"] == pytest.approx(-0.3, rel=0.01)
+    # in the contact's own frame the tangential traction is the bound: |t_T| = mu p at every
+    # point, to the solver's tolerance (measured 1e-13)
+    assert res.scores["tangential_over_bound"] == pytest.approx(1.0, abs=1e-8)
     # the traction is projected onto the Coulomb ball: no excess beyond round-off
     assert f.excess < 1e-10
 
 
-def test_sliding_contact_coulomb_serial_and_parallel_agree():
-    scene, num = _sliding_coulomb()
+@pytest.mark.parametrize("method", ["nitsche", "mortar"])
+def test_sliding_contact_coulomb_serial_and_parallel_agree(method):
+    scene, num = _sliding_coulomb(method)
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
     # every step converged to the relative residual 1e-10: forces agree to the tolerance
     assert parallel.force == pytest.approx(serial.force, rel=1e-8)
     assert parallel.friction.tangential_force[0] == pytest.approx(
         serial.friction.tangential_force[0], rel=1e-8)  # fmt: skip
+
+
+def test_mortar_slip_is_objective_under_translation():
+    """A rigid translation of both bodies from the last converged state gives no weighted slip
+    (the rows of M / D sum to 1 on the contact nodes), at any rank count."""
+    from contactfx.driver import setup
+    from contactfx.solvers.snes import ContactSNES
+
+    scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
+    pb = setup(scene, Numerics(method="mortar", friction="coulomb", mu=0.3))
+    a, L, _, _ = pb.forms()
+    solver = ContactSNES(pb.state, stiffness=a, load=L, bcs=[], prefix="objective_",
+                         coupling=pb.coupling())  # fmt: skip
+    x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
+    X = pb.layout.X.getArray().reshape(-1, 2)
+    # the last converged state presses the bodies together; the new one moves both by c
+    prev = np.zeros_like(X)
+    prev[X[:, 1] > 0, 1] = -4e-3
+    pb.prev.x.array[: prev.size] = prev.ravel()
+    pb.prev.x.scatter_forward()
+    shifted = prev + np.array([3e-3, -1e-3])
+    x.getArray()[:] = shifted.ravel()
+    x.ghostUpdate()
+    solver._sync(x)
+    coupling = solver.coupling
+    # the search at the step's start (the converged state), then the residual at the shift
+    coupling.update(pb.prev.x.array)
+    F = solver.K.createVecLeft()
+    solver._residual(None, x.copy(), F)
+    rows = coupling.tangent_rows()[coupling.tmask]
+    slip = coupling._g.getArray()[rows]
+    n_closed = MPI.COMM_WORLD.allreduce(int(np.sum(coupling.xi > 0)), op=MPI.SUM)
+    assert n_closed > 5  # a real contact zone
+    # v_j = t_j . (c - sum_k M_jk / D_j c) = 0: round-off of coordinates of order 1
+    assert MPI.COMM_WORLD.allreduce(float(np.max(np.abs(slip), initial=0.0)), op=MPI.MAX) < 1e-14
+    solver.destroy()

@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 from contactfx.scenes import Numerics
 from contactfx.scenes.two_body import HertzCylinders
-from contactfx.scenes.two_body_2d import PunchFoundation, SlidingContact
+from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
 
 MORTAR = Numerics(method="mortar")
 
@@ -119,3 +119,34 @@ def test_punch_foundation_serial_and_parallel_agree():
         assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
     for key in ("normalised_pressure_error", "edge_peak"):
         assert parallel.scores[key] == pytest.approx(serial.scores[key], rel=1e-8), key
+
+
+def test_cattaneo_cylinders_stick_zone():
+    """Identical cylinders pressed, then sheared at Q < mu P (mortar, Coulomb mu = 0.3): the
+    stick half-width against Cattaneo-Mindlin c = a sqrt(1 - Q / (mu P))."""
+    scene = CattaneoCylinders(CattaneoCylinders.Params())
+    res = scene.run(scene.default_numerics(method="mortar"), verbose=False)
+    ref = res.reference
+    assert 0.4 < ref["Q_over_bound"] < 0.8  # partial slip, well inside (0, 1)
+    f = res.friction
+    assert 0.2 < f.slip_fraction < 0.8
+    # the stick half-width is the measure of the stick nodes / 2: each edge is resolved to
+    # about half a slave element (h_s / 2 = 1.7 % of c on the default mesh) on top of the
+    # discretisation error of the tractions (measured c / a 2.3 % below Cattaneo's; 4.6 % at
+    # h_contact = 2e-3, where h_s / 2 is 3.5 % of c); 5 % as the issue asks
+    assert ref["c_over_a_computed"] == pytest.approx(ref["c_over_a"], rel=0.05)
+    # the normal problem is Hertz's (identical materials: no coupling with the shear)
+    assert ref["a_rel_error"] < 0.02
+
+
+def test_cattaneo_cylinders_gross_slip():
+    """Sheared beyond the stick limit the whole contact slides: |q| = mu p everywhere."""
+    scene = CattaneoCylinders(CattaneoCylinders.Params(shift=4e-3))
+    res = scene.run(scene.default_numerics(method="mortar"), verbose=False)
+    assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
+    # in the contact's frame: the sum of |lambda_T| is mu times the sum of lambda, to the
+    # solver's tolerance (measured 2e-13)
+    assert res.scores["tangential_over_bound"] == pytest.approx(1.0, abs=1e-8)
+    # the x component of the force against mu P: the contact normals are tilted by the
+    # shear (the bodies rotate a little), 1.1 % measured
+    assert res.reference["Q_over_bound"] == pytest.approx(1.0, abs=0.02)
