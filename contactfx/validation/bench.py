@@ -78,6 +78,9 @@ CASES: dict[str, BenchCase] = {
     "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
     "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),
     "hertz-spheres": BenchCase("hertz-spheres", {}, 2.0, "two elastic spheres, quarter model"),
+    "cattaneo-cylinders": BenchCase(
+        "cattaneo-cylinders", {}, 2.0, "identical cylinders sheared, Cattaneo-Mindlin, mu 0.3"
+    ),
 }
 
 #: relative errors below this are round-off (e.g. the force under force control): no rate
