@@ -192,7 +192,11 @@ class PointCoupling:
             ST = np.einsum("pacg,phg->pach", sn, P_T).reshape(len(xq), (d + 1) * gdim, gdim)
             ST = np.concatenate([ST, np.zeros((len(xq), d * gdim, gdim))], axis=1)
             extra = dict(Jvec=Jvec, ST=ST, P_T=P_T)
+        # a tie (the law's argument at round-off, as on coinciding flat surfaces at the start)
+        # takes the active branch of the derivative: the branch of a gap within 1e-12 h of 0
+        tie = 1e-12 * scale * dr.h[facet]
         return dict(**extra, rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale, n=n,
+                    tie=tie,
                     x_search=x_search,
                     N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
                     slave_nodes=dr.slave.nodes[facet])  # fmt: skip
@@ -260,12 +264,12 @@ class PointCoupling:
         if law.kind == "penalty":
             arg = -p["scale"] * g
             P = np.maximum(arg, 0.0)
-            dP = (arg > 0.0)[:, None] * p["scale"][:, None] * p["Jn"]
+            dP = (arg > -p["tie"])[:, None] * p["scale"][:, None] * p["Jn"]
             return P, dP, g, None
         sn = np.einsum("pi,pi->p", p["S"], u)
         arg = -sn - p["scale"] * g
         P = np.maximum(arg, 0.0)
-        dP = (arg > 0.0)[:, None] * (p["scale"][:, None] * p["Jn"] - p["S"])
+        dP = (arg > -p["tie"])[:, None] * (p["scale"][:, None] * p["Jn"] - p["S"])
         return P, dP, g, sn
 
     def _friction(self, p: dict, vals: np.ndarray, P: np.ndarray, dP: np.ndarray):

@@ -175,59 +175,74 @@ def test_hertz_cylinders_gauss_point_methods(num):
     assert ref["p0_rel_error"] < 0.01
 
 
-@pytest.mark.parametrize("method", ["nitsche", "penalty"])
-def test_gauss_point_methods_patch_test(method):
+@pytest.mark.parametrize(
+    "method, dim, bound",
+    [("nitsche", 2, 0.05), ("penalty", 2, 0.05), ("nitsche", 3, 0.05), ("penalty", 3, 0.08)],
+)
+def test_gauss_point_methods_patch_test(method, dim, bound):
     """Report, not exactness: quadrature at slave Gauss points does not integrate the master
     basis (kinked inside a slave facet) exactly, so the uniform pressure is not reproduced;
     the force is (the upper block rests on the contact alone: equilibrium)."""
-    scene = PatchTest(PatchTest.Params())
+    scene = PatchTest(PatchTest.Params(dim=dim, h=0.1 if dim == 2 else 0.2))
     res = scene.run(Numerics(method=method), verbose=False)
-    # equilibrium of the upper block: force = q * width to the solver tolerance
-    assert res.force == pytest.approx(scene.p.pressure * scene.p.width, rel=1e-9)
-    # measured 1.1-1.3 % (h = 0.1, ratio 0.7); a 5 % bound catches a wrong coupling
-    assert 1e-6 < res.scores["pressure_deviation"] < 0.05
+    # equilibrium of the upper block: force = q * width^(dim - 1) to the solver tolerance
+    q, width = scene.p.pressure, scene.p.width
+    assert res.force == pytest.approx(q * width ** (dim - 1), rel=1e-9)
+    # measured 1.1-1.3 % in 2D (h = 0.1, ratio 0.7), 2.5 % (nitsche) and 4.5 % (penalty) in
+    # 3D (h = 0.2); the bound catches a wrong coupling (a missing master term is O(1))
+    assert 1e-6 < res.scores["pressure_deviation"] < bound
+    # the flat touching start is a tie of the law's branches, taken as closed: the linear
+    # problem is solved in one Newton step
+    assert res.newton_iterations == 1
 
 
-def test_unbiased_nitsche_patch_force():
-    scene = PatchTest(PatchTest.Params())
+@pytest.mark.parametrize("dim", [2, 3])
+def test_unbiased_nitsche_patch_force(dim):
+    scene = PatchTest(PatchTest.Params(dim=dim, h=0.1 if dim == 2 else 0.2))
     res = scene.run(Numerics(method="nitsche", sides="unbiased"), verbose=False)
     # both bodies carry half of the contact terms; equilibrium holds for their sum
-    assert res.force == pytest.approx(scene.p.pressure * scene.p.width, rel=1e-9)
+    q, width = scene.p.pressure, scene.p.width
+    assert res.force == pytest.approx(q * width ** (dim - 1), rel=1e-9)
 
 
 @pytest.mark.parametrize(
     "num",
-    [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=-1, sides="unbiased"),
-     Numerics(method="penalty"), Numerics(method="mortar", ncp="fb"), Numerics(method="mortar"),
-     Numerics(method="nitsche", friction="coulomb", mu=0.3),
-     Numerics(method="nitsche", theta=0, sides="unbiased", friction="coulomb", mu=0.5),
+    [Numerics(method="nitsche", theta=1), Numerics(method="penalty"),
      Numerics(method="mortar", friction="coulomb", mu=0.3)],
-    ids=["nitsche", "unbiased-skew", "penalty", "mortar-fb", "mortar", "nitsche-coulomb",
-         "unbiased-incomplete-coulomb", "mortar-coulomb"],
+    ids=["nitsche", "penalty", "mortar-coulomb"],
 )  # fmt: skip
-def test_coupling_jacobian_is_consistent(num):
-    """J du against the central difference of the residual (contact terms included) at a
-    state with open and closed points, on a coarse hertz-cylinders mesh."""
+def test_hertz_spheres_coarse(num):
+    """Hertz between two spheres on a coarse mesh (h_contact 0.013, 5.8k dofs)."""
+    scene = HertzSpheres(HertzSpheres.Params(h_contact=0.013))
+    res = scene.run(num, verbose=False)
+    ref = res.reference
+    # a / h ~ 8 on the lower surface (6 on the slave): the radius from the outer rings is
+    # within about 0.3 h (measured 2.5 % for nitsche); the peak within the issue's 3 %
+    # (measured 1.9 % nitsche)
+    assert ref["a_rel_error"] < 0.05
+    assert ref["p0_rel_error"] < 0.03
+    if num.friction == "coulomb":
+        # |lambda_T| <= mu (lambda - c g) holds exactly; against mu lambda it holds to the
+        # weighted gaps of the closed nodes, zero to the solver's tolerance (measured 1.3e-8
+        # relative: the gap rows converge to the residual tolerance 1e-10 times c)
+        assert res.friction.excess < 1e-6
+
+
+def _jacobian_check(scene, num, displace):
+    """(error(eps), coupling, solver): the relative error of J du against the central
+    difference of the residual (contact terms included) at the state ``displace(X)`` (X: the
+    nodes' reference coordinates), the projection frozen at that state."""
     from contactfx.driver import setup
     from contactfx.solvers.snes import ContactSNES
 
-    scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
     pb = setup(scene, num)
     a, L, _, _ = pb.forms()
     solver = ContactSNES(pb.state, stiffness=a, load=L, bcs=[], prefix=f"fd_{num.method}_",
                          coupling=pb.coupling())  # fmt: skip
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     rng = np.random.default_rng(7)
-    # a pressed state: the upper body moved down by 0.004 plus noise
-    X = pb.layout.X.getArray().reshape(-1, 2)
-    u = np.zeros_like(X)
-    u[X[:, 1] > 0, 1] = -4e-3
-    # and sideways: a little near the first contact point (stick: gamma |du_T| < mu P),
-    # much farther out (slip; the mortar's nodal bound mu (lambda - c g) is larger than the
-    # Nitsche bound at these penetrations: a larger slip reaches it)
-    upper = X[:, 1] > 0
-    u[upper, 0] = np.where(X[upper, 0] < 0.01, 1e-7, 5e-3 if num.method == "mortar" else 1e-3)
-    u += 1e-5 * rng.standard_normal(u.shape)
+    X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
+    u = displace(X) + 1e-5 * rng.standard_normal(X.shape)
     x.getArray()[:] = u.ravel()
     x.ghostUpdate()
     solver._sync(x)
@@ -253,21 +268,95 @@ def test_coupling_jacobian_is_consistent(num):
         fd.axpy(-1.0, Jdu)
         return fd.norm() / Jdu.norm()
 
+    return error, solver.coupling, solver
+
+
+def _check_both_friction_branches(num, c) -> None:
+    """Closed points in stick and in slip are both present (Coulomb)."""
+    sticks = ([c.stick[c.xi > 0]] if num.method == "mortar"
+              else [s[3][s[0] > 0] for s in c.state])  # fmt: skip
+    comm = MPI.COMM_WORLD
+    assert comm.allreduce(any(np.any(s) for s in sticks), op=MPI.LOR)
+    assert comm.allreduce(any(np.any(~s) for s in sticks), op=MPI.LOR)
+
+
+@pytest.mark.parametrize(
+    "num",
+    [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=-1, sides="unbiased"),
+     Numerics(method="penalty"), Numerics(method="mortar", ncp="fb"), Numerics(method="mortar"),
+     Numerics(method="nitsche", friction="coulomb", mu=0.3),
+     Numerics(method="nitsche", theta=0, sides="unbiased", friction="coulomb", mu=0.5),
+     Numerics(method="mortar", friction="coulomb", mu=0.3)],
+    ids=["nitsche", "unbiased-skew", "penalty", "mortar-fb", "mortar", "nitsche-coulomb",
+         "unbiased-incomplete-coulomb", "mortar-coulomb"],
+)  # fmt: skip
+def test_coupling_jacobian_is_consistent(num):
+    """J du against the central difference of the residual at a state with open and closed
+    points, on a coarse hertz-cylinders mesh."""
+    scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
+
+    def displace(X):
+        # a pressed state: the upper body moved down by 0.004, and sideways: a little near
+        # the first contact point (stick: gamma |du_T| < mu P), much farther out (slip; the
+        # mortar's nodal bound mu (lambda - c g) is larger than the Nitsche bound at these
+        # penetrations: a larger slip reaches it)
+        u = np.zeros_like(X)
+        upper = X[:, 1] > 0
+        u[upper, 1] = -4e-3
+        far = 5e-3 if num.method == "mortar" else 1e-3
+        u[upper, 0] = np.where(X[upper, 0] < 0.01, 1e-7, far)
+        return u
+
+    error, coupling, solver = _jacobian_check(scene, num, displace)
     # the residual is piecewise linear in u for the min / max laws (a frozen projection,
     # linear elasticity): away from a switch of the active set the central difference is
     # exact up to round-off (measured 2e-11), a switch within eps du would show as an O(1)
     # error; Fischer-Burmeister is smooth: its central difference errs by O(eps^2) (measured
     # 4e-5 at eps = 1e-4), so a consistent Jacobian shows as second-order decay
-    if num.friction == "coulomb":  # both branches of the friction law are present
-        c = solver.coupling
-        sticks = ([c.stick[c.xi > 0]] if num.method == "mortar"
-                  else [s[3][s[0] > 0] for s in c.state])  # fmt: skip
-        comm = MPI.COMM_WORLD
-        assert comm.allreduce(any(np.any(s) for s in sticks), op=MPI.LOR)
-        assert comm.allreduce(any(np.any(~s) for s in sticks), op=MPI.LOR)
+    if num.friction == "coulomb":
+        _check_both_friction_branches(num, coupling)
     e1 = error(1e-4)
     if num.method == "mortar" and num.ncp == "fb":
         assert error(2.5e-5) < e1 / 8.0 + 1e-9
+    else:
+        assert e1 < 1e-9
+    solver.destroy()
+
+
+@pytest.mark.parametrize(
+    "num",
+    [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=0, sides="unbiased"),
+     Numerics(method="penalty"), Numerics(method="mortar"),
+     Numerics(method="nitsche", theta=-1, friction="coulomb", mu=0.3),
+     Numerics(method="mortar", friction="coulomb", mu=0.3)],
+    ids=["nitsche", "unbiased-incomplete", "penalty", "mortar", "nitsche-coulomb",
+         "mortar-coulomb"],
+)  # fmt: skip
+def test_coupling_jacobian_is_consistent_3d(num):
+    """The same in 3D, on the coarse stacked boxes: the upper box tilted into the lower one
+    (closed and open points) and, with friction, moved sideways (stick near the corner
+    x = y = 0, slip elsewhere)."""
+    scene = PatchTest(PatchTest.Params(dim=3, h=0.25))
+
+    def displace(X):
+        u = np.zeros_like(X)
+        up = X[:, 2] > 0.5
+        u[up, 2] = -1e-3 * (1.0 + X[up, 0])
+        if num.friction == "coulomb":
+            for c in (0, 1):
+                u[up, c] = np.where(X[up, c] < 0.5, 1e-7, 3e-4)
+        return u
+
+    error, coupling, solver = _jacobian_check(scene, num, displace)
+    if num.friction == "coulomb":
+        _check_both_friction_branches(num, coupling)
+    # piecewise linear laws: exact central differences away from a switch (measured 1e-11 at
+    # eps = 1e-5); the 3D Coulomb ball projection is smooth in slip: its central difference
+    # errs by O(eps^2) (measured 2e-7 at eps = 1e-4, 2e-9 at 1e-5), so a consistent Jacobian
+    # shows as a small error that falls with eps^2
+    e1, e2 = error(1e-5), error(1e-6)
+    if num.friction == "coulomb":
+        assert e2 < e1 / 50.0 + 1e-10 and e1 < 1e-6
     else:
         assert e1 < 1e-9
     solver.destroy()
