@@ -145,6 +145,8 @@ class _Run:
             run_load_program(solver, problem.apply_load, steps=self.num.steps, on_step=on_step)
             total = time.perf_counter() - t0
         self.timings["assembly"] = solver.timer.assembly
+        if problem.coupling() is not None:  # two bodies: the coupling's share of the assembly
+            self.timings["contact"] = solver.timer.contact
         output = self.timings.get("output", 0.0)
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
         return steps

@@ -117,9 +117,11 @@ class SolveStats:
 
 @dataclass
 class Timer:
-    """Accumulated wall time (s) of the assembly (bulk, loads, contact terms)."""
+    """Accumulated wall time (s) of the assembly (bulk, loads, contact terms) and, within it,
+    of the two-body coupling (its searches, residual and Jacobian terms)."""
 
     assembly: float = 0.0
+    contact: float = 0.0
 
 
 def owned_size(space) -> int:
@@ -258,9 +260,11 @@ class ContactSNES:
             _compat.assemble_vector(self.fc, self._F_c)
             F.axpy(1.0, self.fc)
         if self.coupling is not None:
+            t1 = time.perf_counter()
             if self.coupling.search_each_newton:
                 self._search()
             self.coupling.residual(x, F)
+            self.timer.contact += time.perf_counter() - t1
         dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
         self.timer.assembly += time.perf_counter() - t0
 
@@ -276,7 +280,9 @@ class ContactSNES:
         t0 = time.perf_counter()
         self._sync(x)
         if self.coupling is not None:
+            t1 = time.perf_counter()
             self.coupling.jacobian(x, self.K, J)
+            self.timer.contact += time.perf_counter() - t1
         else:
             self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         if self._a_c is not None:
@@ -319,7 +325,11 @@ class ContactSNES:
         self._sync(x)
         self._late = False
         if self.coupling is not None:  # the search of this load step
+            t0 = time.perf_counter()
             self._search()
+            dt = time.perf_counter() - t0
+            self.timer.assembly += dt
+            self.timer.contact += dt
         try:
             self.snes.solve(None, x)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash

@@ -178,6 +178,9 @@ def run_case(
         t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
         t_run=t["assembly"] + t["solve"],
     )  # fmt: skip
+    if "contact" in t:  # two bodies: search + contact terms against bulk assembly + solve
+        row["t_contact"] = t["contact"]
+        row["contact_over_bulk"] = t["contact"] / max(row["t_run"] - t["contact"], 1e-12)
     for column in MEASURES:
         row[column] = measure(res, column)
     return row, scene, num

@@ -126,7 +126,8 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
                 ("t_mesh", "t mesh"), ("t_compile", "t compile"), ("t_assembly", "t assembly"),
                 ("t_solve", "t solve")]  # fmt: skip
         cols += [(m, MEASURES[m][0]) for m in measures]
-        cols += [(k, k.replace("_", " ")) for k in ("contact_over_linear", "speedup")
+        cols += [(k, k.replace("_", " "))
+                 for k in ("t_contact", "contact_over_bulk", "contact_over_linear", "speedup")
                  if any(k in r for r in case_rows)]  # fmt: skip
         cols.append(("status", "status"))
         md.append(markdown_table(case_rows, cols))
