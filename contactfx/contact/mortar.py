@@ -548,6 +548,12 @@ class MortarCoupling:
                 "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess)),
                 "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1)))}  # fmt: skip
 
+    def nodal_friction(self):
+        """Per node of :meth:`nodal`: |lambda_T|, |weighted slip increment of the step| and the
+        stick mask."""
+        slip = np.where(self.tmask, self._g.getArray()[self.tangent_rows()], 0.0)
+        return np.linalg.norm(self.lam_t, axis=1), np.linalg.norm(slip, axis=1), self.stick
+
     def search_gaps(self) -> np.ndarray:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""
         return self.g0.getArray()[self.normal_rows] + 0.0 if self.g0 is not None else np.zeros(0)

@@ -303,9 +303,11 @@ class PointCoupling:
             r = P[:, None] * p["Jn"]
             if sn is not None and self.law.theta != 0:
                 r -= (self.law.theta / p["scale"])[:, None] * (P + sn)[:, None] * p["S"]
-            t = stick = None
+            t = stick = slip = None
             if self.mu is not None:
                 t, _, stick = self._friction(p, vals, P, dP)
+                du = vals[p["idx"]] - p["u_prev"]
+                slip = np.einsum("pgh,pih,pi->pg", p["P_T"], p["Jvec"], du)
                 tt = (self.law.theta / p["scale"])[:, None]
                 r -= np.einsum("pig,pg->pi", p["Jvec"] - tt[:, :, None] * p["ST"], t)
                 if self.law.theta != 0:
@@ -313,7 +315,7 @@ class PointCoupling:
                     r -= tt * np.einsum("pig,pg->pi", p["ST"], sT)
             r *= p["w"][:, None]
             F.setValues(p["rows"].ravel(), r.ravel(), addv=add)
-            self.state.append((P, g, t, stick))
+            self.state.append((P, g, t, stick, slip))
         F.assemblyBegin()
         F.assemblyEnd()
 
@@ -347,22 +349,37 @@ class PointCoupling:
         return np.concatenate(out) if out else np.zeros(0)
 
     # -- what the post-processing reads ----------------------------------------------------
+    def _lumped(self, columns: list[np.ndarray]):
+        """Owned contact nodes (those whose support has a master on more than half of it) and
+        the N-weighted nodal means of the first direction's point values ``columns``."""
+        p = self.points[0]
+        g = self.state[0][1]
+        Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
+        nodes = p["slave_nodes"].ravel()
+        paired = np.isfinite(g)
+        data = np.stack([Nw.ravel(), (Nw * paired[:, None]).ravel(),
+                         *((Nw * c[:, None]).ravel() for c in columns)], axis=1)  # fmt: skip
+        sums = self.layout.node_sum(nodes, data, 2 + len(columns))
+        on = (sums[:, 0] > 0.0) & (sums[:, 1] > 0.5 * sums[:, 0])
+        return on, sums[on]
+
     def nodal(self):
         """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
         quadrature values lumped to the nodes of the first direction's slave surface."""
-        p = self.points[0]
         P, g = self.state[0][:2]
-        lay = self.layout
-        Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
-        gap = np.where(np.isfinite(g), g, 0.0)
-        nodes = p["slave_nodes"].ravel()
-        data = np.stack([Nw.ravel(), (Nw * P[:, None]).ravel(), (Nw * gap[:, None]).ravel(),
-                         (Nw * np.isfinite(g)[:, None]).ravel()], axis=1)  # fmt: skip
-        sums = lay.node_sum(nodes, data, 4)
-        # nodes whose support has a master (more than half of it): the contact nodes
-        on = (sums[:, 0] > 0.0) & (sums[:, 3] > 0.5 * sums[:, 0])
-        D = sums[on, 0]
-        return np.flatnonzero(on) + lay.start, D, sums[on, 1] / D, sums[on, 2] / sums[on, 3]
+        on, sums = self._lumped([P, np.where(np.isfinite(g), g, 0.0)])
+        D = sums[:, 0]
+        return np.flatnonzero(on) + self.layout.start, D, sums[:, 2] / D, sums[:, 3] / sums[:, 1]
+
+    def nodal_friction(self):
+        """Per node of :meth:`nodal`: |t_T|, |slip increment of the step| and the stick
+        indicator (the fraction of the node's support in stick), lumped like the pressure."""
+        P, _, t, stick, slip = self.state[0]
+        closed_stick = (stick & (P > 0.0)).astype(float)
+        _, sums = self._lumped([np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1),
+                                closed_stick])  # fmt: skip
+        D = sums[:, 0]
+        return sums[:, 2] / D, sums[:, 3] / D, sums[:, 4] / D > 0.5
 
     def slave_force(self) -> np.ndarray:
         """The force vector of the pair on the (first direction's) slave body: the quadrature

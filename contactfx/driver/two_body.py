@@ -156,6 +156,12 @@ class TwoBodyPost:
         self.pressure = dolfinx.fem.Function(self.Q1, name="contact_pressure")
         self.gap = dolfinx.fem.Function(self.Q1, name="gap")
         self.status = dolfinx.fem.Function(self.Q1, name="contact_status")
+        #: with friction: |tangential traction| and |slip increment of the step| on the slave
+        #: nodes; the status is then 0 open, 1 stick, 2 slip
+        self.friction_fields = []
+        if pb.friction is not None:
+            self.friction_fields = [dolfinx.fem.Function(self.Q1, name=name)
+                                    for name in ("tangential_traction", "slip")]  # fmt: skip
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
         self.vm_expr = _compat.expression(pb.material.von_mises(pb.state), DG0)
@@ -184,6 +190,15 @@ class TwoBodyPost:
         peak, closed, penetration, complementarity = nodal_contact(
             self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
         self.status.x.array[:] = closed
+        if self.friction_fields:
+            t_mag, slip, stick = self.pb.coupling().nodal_friction()
+            for f, values in zip(self.friction_fields, (t_mag, slip), strict=True):
+                f.x.array[:] = 0.0
+                f.x.array[local] = values
+                f.x.scatter_forward()
+            status = self.status.x.array
+            status[local] = np.where(closed[local], np.where(stick, 1.0, 2.0), 0.0)
+            self.status.x.scatter_forward()
         sym = self.scene.symmetry
         force = self.pb.coupling().force() * sym
         measure = self.comm.allreduce(float(np.sum(D[closed[local]])), op=MPI.SUM) * sym
@@ -255,7 +270,7 @@ class TwoBodyPost:
 
     def fields(self) -> list:
         self.vm.interpolate(self.vm_expr)
-        return [self.pb.state, self.vm, self.pressure, self.gap, self.status]
+        return [self.pb.state, self.vm, self.pressure, self.gap, self.status, *self.friction_fields]
 
     def finish(self, q: Quantities, out) -> dict:
         reference = closed_form_errors(self.scene, q)

@@ -139,10 +139,17 @@ def test_cattaneo_cylinders_stick_zone():
     assert ref["a_rel_error"] < 0.02
 
 
-def test_cattaneo_cylinders_gross_slip():
+def test_cattaneo_cylinders_gross_slip(tmp_path):
     """Sheared beyond the stick limit the whole contact slides: |q| = mu p everywhere."""
     scene = CattaneoCylinders(CattaneoCylinders.Params(shift=4e-3))
-    res = scene.run(scene.default_numerics(method="mortar"), verbose=False)
+    out = _shared_tmp(tmp_path) / "cattaneo"
+    res = scene.run(scene.default_numerics(method="mortar"), out=out, verbose=False)
+    MPI.COMM_WORLD.barrier()
+    # with friction the ParaView file has the tangential traction and the slip increment,
+    # and the status distinguishes stick from slip
+    xdmf = (out / "cattaneo-cylinders.xdmf").read_text()
+    for name in ("contact_pressure", "contact_status", "tangential_traction", "slip"):
+        assert f'Name="{name}"' in xdmf, name
     assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
     # in the contact's frame: the sum of |lambda_T| is mu times the sum of lambda, to the
     # solver's tolerance (measured 2e-13)
