@@ -117,8 +117,12 @@ def test_punch_foundation_serial_and_parallel_agree():
     # to a relative residual of 1e-10: forces, sizes and scores agree to the solver tolerance
     for key in ("force", "contact_size", "peak_pressure"):
         assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
-    for key in ("normalised_pressure_error", "edge_peak"):
-        assert parallel.scores[key] == pytest.approx(serial.scores[key], rel=1e-8), key
+    assert parallel.scores["edge_peak"] == pytest.approx(serial.scores["edge_peak"], rel=1e-8)
+    # the normalised pressure error is a difference of normalised pressures (about 1e-2): it
+    # moves by the pressures' relative differences, so it agrees in absolute terms (measured
+    # 5.6e-10 on dolfinx 0.9 at 2 ranks, a relative 4e-8 of the score)
+    key = "normalised_pressure_error"
+    assert parallel.scores[key] == pytest.approx(serial.scores[key], abs=1e-8)
 
 
 def test_cattaneo_cylinders_stick_zone():
