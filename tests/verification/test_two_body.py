@@ -253,8 +253,9 @@ def test_hertz_spheres_coarse(num):
 
 def _jacobian_check(scene, num, displace):
     """(error(eps), coupling, solver): the relative error of J du against the central
-    difference of the residual (contact terms included) at the state ``displace(X)`` (X: the
-    nodes' reference coordinates), the projection frozen at that state."""
+    difference of the residual (contact terms included) at the state ``displace(X, upper)``
+    (X: the owned nodes' reference coordinates, upper: the upper body's nodes among them),
+    the projection frozen at that state."""
     from contactfx.driver import setup
     from contactfx.solvers.snes import ContactSNES
 
@@ -265,7 +266,14 @@ def _jacobian_check(scene, num, displace):
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     rng = np.random.default_rng(7)
     X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
-    u = displace(X) + 1e-5 * rng.standard_normal(X.shape)
+    # the upper body's owned nodes (coordinates cannot tell the coinciding contact faces)
+    tags = scene.cell_tags
+    cells = tags.indices[tags.values == scene.cells["upper"]]
+    nodes = np.unique([pb.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
+    upper = np.zeros(len(X), dtype=bool)
+    nodes = np.asarray(nodes, dtype=np.int64)
+    upper[nodes[nodes < len(X)]] = True
+    u = displace(X, upper) + 1e-5 * rng.standard_normal(X.shape)
     x.getArray()[:] = u.ravel()
     x.ghostUpdate()
     solver._sync(x)
@@ -318,13 +326,12 @@ def test_coupling_jacobian_is_consistent(num):
     points, on a coarse hertz-cylinders mesh."""
     scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
 
-    def displace(X):
+    def displace(X, upper):
         # a pressed state: the upper body moved down by 0.004, and sideways: a little near
         # the first contact point (stick: gamma |du_T| < mu P), much farther out (slip; the
         # mortar's nodal bound mu (lambda - c g) is larger than the Nitsche bound at these
         # penetrations: a larger slip reaches it)
         u = np.zeros_like(X)
-        upper = X[:, 1] > 0
         u[upper, 1] = -4e-3
         far = 5e-3 if num.method == "mortar" else 1e-3
         u[upper, 0] = np.where(X[upper, 0] < 0.01, 1e-7, far)
@@ -357,31 +364,27 @@ def test_coupling_jacobian_is_consistent(num):
 )  # fmt: skip
 def test_coupling_jacobian_is_consistent_3d(num):
     """The same in 3D, on the coarse stacked boxes: the upper box tilted into the lower one
-    (closed and open points) and, with friction, moved sideways (stick near the corner
-    x = y = 0, slip elsewhere)."""
+    and, with friction, moved along x where x > 0.5 (stick on x < 0.5, slip beyond)."""
     scene = PatchTest(PatchTest.Params(dim=3, h=0.25))
 
-    def displace(X):
+    def displace(X, up):
         u = np.zeros_like(X)
-        up = X[:, 2] > 0.5
         u[up, 2] = -1e-3 * (1.0 + X[up, 0])
         if num.friction == "coulomb":
-            for c in (0, 1):
-                u[up, c] = np.where(X[up, c] < 0.5, 1e-7, 3e-4)
+            # gamma |du_T| against mu P: about 0 against 12 for x < 0.5 (stick), 40 against
+            # 12 beyond (slip, in directions that vary with y), whatever the noise
+            slide = X[up, 0] >= 0.5
+            u[up, 0] = np.where(slide, 1e-3, 0.0)
+            u[up, 1] = np.where(slide, 1e-3 * X[up, 1], 0.0)
         return u
 
     error, coupling, solver = _jacobian_check(scene, num, displace)
     if num.friction == "coulomb":
         _check_both_friction_branches(num, coupling)
-    # piecewise linear laws: exact central differences away from a switch (measured 1e-11 at
-    # eps = 1e-5); the 3D Coulomb ball projection is smooth in slip: its central difference
-    # errs by O(eps^2) (measured 2e-7 at eps = 1e-4, 2e-9 at 1e-5), so a consistent Jacobian
-    # shows as a small error that falls with eps^2
-    e1, e2 = error(1e-5), error(1e-6)
-    if num.friction == "coulomb":
-        assert e2 < e1 / 50.0 + 1e-10 and e1 < 1e-6
-    else:
-        assert e1 < 1e-9
+    # exact central differences up to round-off away from a switch of the active set or of
+    # stick / slip (measured 1e-11 frictionless, 7e-11 with Coulomb, at 1 to 3 ranks): the
+    # ball projection's curvature term, O(eps^2 |du|^2 / |z|^2), is far below that
+    assert error(1e-4) < 1e-9
     solver.destroy()
 
 
