@@ -9,7 +9,10 @@ A :class:`Coupling` is what a two-body method gives the nonlinear solver
   residual evaluation with ``--search-update newton``);
 * ``residual(u, F)``: on entry F holds the bulk residual K u - b (owned rows, before the
   Dirichlet rows); the coupling adds to it or transforms it in place;
-* ``jacobian(u, K, J)``: J receives the Jacobian of that residual; K is the bulk stiffness.
+* ``jacobian(u, K, J)``: J receives the Jacobian of that residual; K is the bulk stiffness;
+* ``missed(u)``: how many contact points a search at u would find that the last search did
+  not (the solver searches again and continues Newton while there are any: a step's search
+  at its start only reaches points about a facet size apart).
 
 Global numbering: the P1 vector space's node (dof block) i, component c is the global row
 ``i * bs + c``. Values for rows that another rank owns go through PETSc's stash
@@ -39,6 +42,8 @@ class Coupling(Protocol):
     def residual(self, u: PETSc.Vec, F: PETSc.Vec) -> None: ...
 
     def jacobian(self, u: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None: ...
+
+    def missed(self, u) -> int: ...
 
 
 def aij(comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:

@@ -264,6 +264,26 @@ class MortarCoupling:
         m_rows, (m_cols, m_vals) = _to_owners(comm, self.ranges, rows, [cols, vals])
         self._assemble(j_nodes, j_data, m_rows, m_cols, m_vals)
 
+    def missed(self, u: np.ndarray) -> int:
+        """The number of slave nodes (all ranks) that a search at x = X + u makes contact
+        nodes (their support more than half over the master surface) and the last search did
+        not. Collective; the coupling is not changed."""
+        lay, pair, comm = self.layout, self.pair, self.comm
+        ub = u.reshape(-1, lay.bs)[:, : lay.gdim]
+        slave, master = pair.slave.current(ub), pair.master.current(ub)
+        near, pairs = pair.search(slave, master)
+        D, _, (rows, _, vals) = mortar_matrices(slave, near, pairs)
+        j_nodes, (j_data,) = _to_owners(comm, self.ranges, slave.nodes.reshape(-1),
+                                        [D.reshape(-1, 1)])  # fmt: skip
+        m_rows, (m_vals,) = _to_owners(comm, self.ranges, rows, [vals])
+        uniq, inv = np.unique(j_nodes, return_inverse=True)
+        Dj = np.bincount(inv, weights=j_data[:, 0], minlength=len(uniq))
+        Msum = np.bincount(np.searchsorted(uniq, m_rows), weights=m_vals, minlength=len(uniq))
+        covered = uniq[Msum > 0.5 * Dj]
+        from mpi4py import MPI
+
+        return comm.allreduce(len(np.setdiff1d(covered, self.covered)), op=MPI.SUM)
+
     def _assemble(self, j_nodes, j_data, m_rows, m_cols, m_vals) -> None:
         lay = self.layout
         gdim, bs = lay.gdim, lay.bs
@@ -278,6 +298,7 @@ class MortarCoupling:
         np.add.at(Msum, key, m_vals)
         coverage = Msum / Dj
         contact = coverage > 0.5
+        self.covered = uniq[contact]  # what the next search is compared with (missed)
         scale = np.where(contact, Dj / np.where(Msum > 0, Msum, 1.0), 0.0)
         m_w = m_vals * scale[key] / Dj[key]  # M_jk / D_j, rescaled to sum to 1
         # frames on the free components (a Dirichlet row is overwritten by its condition)

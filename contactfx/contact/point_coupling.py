@@ -124,6 +124,19 @@ class PointCoupling:
             if u_prev is not None:
                 p["u_prev"] = u_prev[p["idx"]]
 
+    def missed(self, u: np.ndarray) -> int:
+        """The number of Gauss points (all ranks) that a search at x = X + u pairs with the
+        master surface and the last search did not. Collective; the coupling is unchanged."""
+        from mpi4py import MPI
+
+        lay = self.layout
+        ub = u.reshape(-1, lay.bs)[:, : lay.gdim]
+        new = 0
+        for dr, old in zip(self.dirs, self.points, strict=True):
+            now = self._points(dr, ub)["paired"]
+            new += int(np.sum(now & ~old["paired"]))
+        return self.comm.allreduce(new, op=MPI.SUM)
+
     def _points(self, dr: _Directed, ub: np.ndarray) -> dict:
         lay, pair = self.layout, self.pair
         gdim, bs = lay.gdim, lay.bs

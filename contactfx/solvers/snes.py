@@ -324,28 +324,55 @@ class ContactSNES:
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
         self._late = False
-        if self.coupling is not None:  # the search of this load step
-            t0 = time.perf_counter()
-            self._search()
-            dt = time.perf_counter() - t0
-            self.timer.assembly += dt
-            self.timer.contact += dt
-        try:
-            self.snes.solve(None, x)
-        except PETSc.Error as err:  # e.g. a singular factorisation: a failed step, not a crash
-            raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
-        if self._late:
-            raise TimeLimitExceeded()
-        self._sync(x)
-        reason = self.snes.getConvergedReason()
-        stats = SolveStats(
-            newton=self.snes.getIterationNumber(),
-            ksp=self.snes.getLinearSolveIterations(),
-            reason=snes_reason_name(reason),
-        )
-        if reason <= 0:
-            raise ConvergenceError(stats.reason)
+        newton = ksp = 0
+        # the search of this load step; once converged, a search at the solution that finds
+        # contact points the step's search could not reach (farther apart at its start than
+        # the candidates' padding) continues Newton from there, up to SEARCH_ROUNDS times
+        for rounds in range(self.SEARCH_ROUNDS):
+            if self.coupling is not None and (rounds == 0 or not self._searched_all()):
+                self._timed_search()
+            elif rounds > 0:
+                break
+            try:
+                self.snes.solve(None, x)
+            except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
+                raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
+            if self._late:
+                raise TimeLimitExceeded()
+            self._sync(x)
+            reason = self.snes.getConvergedReason()
+            newton += self.snes.getIterationNumber()
+            ksp += self.snes.getLinearSolveIterations()
+            stats = SolveStats(newton=newton, ksp=ksp, reason=snes_reason_name(reason))
+            if reason <= 0:
+                raise ConvergenceError(stats.reason)
+            if self.coupling is None or self.coupling.search_each_newton:
+                break
+        else:
+            if not self._searched_all():
+                raise ConvergenceError("the search found new contact points after "
+                                       f"{self.SEARCH_ROUNDS} rounds")  # fmt: skip
         return stats
+
+    #: searches per load step at most (``--search-update step``)
+    SEARCH_ROUNDS = 5
+
+    def _timed_search(self) -> None:
+        t0 = time.perf_counter()
+        self._search()
+        dt = time.perf_counter() - t0
+        self.timer.assembly += dt
+        self.timer.contact += dt
+
+    def _searched_all(self) -> bool:
+        """Whether a search at the current u finds no contact point that the last search
+        missed (collective)."""
+        t0 = time.perf_counter()
+        missed = self.coupling.missed(self.u.x.array)
+        dt = time.perf_counter() - t0
+        self.timer.assembly += dt
+        self.timer.contact += dt
+        return missed == 0
 
     def destroy(self) -> None:
         for obj in (self.snes, self.K, self.J, self.Jc, self.b, self.fc, self.residual_vec):
