@@ -142,6 +142,15 @@ def dual_triangle(lam: np.ndarray) -> np.ndarray:
     return 4.0 * lam - 1.0
 
 
+def nodal_weights(x: np.ndarray) -> np.ndarray:
+    """(m, d) int_F N_j over every P1 facet F of the vertices x (m, d, gdim): half its length
+    (segments), a third of its area (triangles)."""
+    if x.shape[1] == 2:
+        return np.repeat(0.5 * np.linalg.norm(x[:, 1] - x[:, 0], axis=1)[:, None], 2, axis=1)
+    area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+    return np.repeat(area[:, None] / 3.0, 3, axis=1)
+
+
 def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
     """The local mortar integrals of P1 facets (segments in 2D, triangles in 3D, from
     ``slave.x.shape[1]``): D contributions (m_s, d) per slave facet node (int N_j),
@@ -155,8 +164,8 @@ def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
     xs, xm = slave.x, master.x
     length = np.linalg.norm(xs[:, 1] - xs[:, 0], axis=1)
     ns = facet_normals(xs)
-    D = np.repeat(0.5 * length[:, None], 2, axis=1)
-    normals = np.repeat((0.5 * length[:, None] * ns)[:, None], 2, axis=1)
+    D = nodal_weights(xs)
+    normals = D[:, :, None] * ns[:, None, :]
     i, k = pairs
     facing = np.einsum("ij,ij->i", ns[i], facet_normals(xm[k])) < 0.0
     i, k = i[facing], k[facing]
@@ -186,9 +195,8 @@ def _mortar_triangles(slave: Facets, master: Facets, pairs):
     normals."""
     xs, xm = slave.x, master.x
     ns = facet_normals(xs)
-    area = 0.5 * np.linalg.norm(np.cross(xs[:, 1] - xs[:, 0], xs[:, 2] - xs[:, 0]), axis=1)
-    D = np.repeat(area[:, None] / 3.0, 3, axis=1)
-    normals = np.repeat((area[:, None] / 3.0 * ns)[:, None], 3, axis=1)
+    D = nodal_weights(xs)
+    normals = D[:, :, None] * ns[:, None, :]
     i, k = pairs
     nm = facet_normals(xm) if len(xm) else np.zeros((0, 3))
     # per facet once: centroid and radius (largest centroid-vertex distance); a master whose
@@ -245,6 +253,9 @@ class MortarCoupling:
         self.search_each_newton = pair.search_each_newton
         self.ranges = owners(self.layout.imap, self.comm)
         self.T = self.G = self.TK = self.g0 = None
+        #: the reference weights D0_j (the slave surface at X) of this rank's slave nodes
+        #: (sorted global nodes, weights), for the nominal pressure (:meth:`nodal`)
+        self._reference: tuple[np.ndarray, np.ndarray] | None = None
         #: Coulomb coefficient (None: frictionless) and the last converged displacement
         self.mu, self.previous = pair.mu, pair.previous
 
@@ -255,9 +266,14 @@ class MortarCoupling:
         gdim = lay.gdim
         ub = u.reshape(-1, lay.bs)[:, :gdim]
         slave, master = pair.slave.current(ub), pair.master.current(ub)
+        nodes = slave.nodes.reshape(-1)
+        if self._reference is None:
+            w0 = nodal_weights(pair.slave.current(np.zeros_like(ub)).x).reshape(-1, 1)
+            j0, (d0,) = _to_owners(comm, self.ranges, nodes, [w0])
+            uniq0, inv0 = np.unique(j0, return_inverse=True)
+            self._reference = uniq0, np.bincount(inv0, weights=d0[:, 0], minlength=len(uniq0))
         near, pairs = pair.search(slave, master)
         D, normals, (rows, cols, vals) = mortar_matrices(slave, near, pairs)
-        nodes = slave.nodes.reshape(-1)
         # nodal sums on the owners: D_j and sum of weighted normals
         node_data = np.concatenate([D.reshape(-1, 1), normals.reshape(-1, gdim)], axis=1)
         j_nodes, (j_data,) = _to_owners(comm, self.ranges, nodes, [node_data])
@@ -311,6 +327,8 @@ class MortarCoupling:
         contact &= np.linalg.norm(n_free, axis=1) > 0.5
         keep = contact[key]
         self.nodes, self.D = uniq[contact], Dj[contact]
+        uniq0, D0 = self._reference
+        self.D0 = D0[np.searchsorted(uniq0, self.nodes)]
         self.normal, self.comp = nj[contact], comp[contact]
         n_free, tangents, free = n_free[contact], tangents[contact], free[contact]
         self.h = self.D ** (1.0 / max(gdim - 1, 1))
@@ -558,30 +576,37 @@ class MortarCoupling:
         return self.comm.allreduce(np.asarray(local, dtype=float).reshape(-1), op=MPI.SUM)
 
     def friction_state(self) -> dict:
-        """Sums over this rank's contact nodes (weights D_j): the contact measure (the nodes
-        where the friction bound is positive), the stick measure, the bound mu lambda and the
-        excess of |lambda_T| over it, and the sum of |lambda_T|."""
+        """Sums over this rank's contact nodes: the contact measure (the nodes where the
+        friction bound is positive) and the stick measure on the reference surface (weights
+        D0_j, as :meth:`nodal`), the bound mu lambda, the excess of |lambda_T| over it and the
+        sum of |lambda_T| as forces (weights D_j)."""
         closed = self.xi > 0.0
         bound = self.mu * self.lam
         excess = np.maximum(np.linalg.norm(self.lam_t, axis=1) - bound, 0.0)
-        D = self.D
-        return {"measure": float(np.sum(D[closed])), "stick": float(np.sum(D[self.stick])),
+        D, D0 = self.D, self.D0
+        return {"measure": float(np.sum(D0[closed])), "stick": float(np.sum(D0[self.stick])),
                 "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess)),
                 "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1)))}  # fmt: skip
 
     def nodal_friction(self):
-        """Per node of :meth:`nodal`: |lambda_T|, |weighted slip increment of the step| and the
-        stick mask."""
+        """Per node of :meth:`nodal`: the nominal |lambda_T| (D_j |lambda_T| / D0_j), |weighted
+        slip increment of the step| and the stick mask."""
         slip = np.where(self.tmask, self._g.getArray()[self.tangent_rows()], 0.0)
-        return np.linalg.norm(self.lam_t, axis=1), np.linalg.norm(slip, axis=1), self.stick
+        traction = self.D * np.linalg.norm(self.lam_t, axis=1) / self.D0
+        return traction, np.linalg.norm(slip, axis=1), self.stick
 
     def search_gaps(self) -> np.ndarray:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""
         return self.g0.getArray()[self.normal_rows] + 0.0 if self.g0 is not None else np.zeros(0)
 
     def nodal(self):
-        """Owned contact nodes: (global node, weight D_j, pressure lambda_j, gap g_j)."""
-        return self.nodes, self.D, self.lam, self.gap
+        """Owned contact nodes: (global node, reference weight D0_j, nominal pressure
+        D_j lambda_j / D0_j, gap g_j). The nodal force D_j lambda_j per the node's support
+        measured on the reference surface (D0_j = int N_j over it): the bulk is small-strain, its
+        tractions sigma n are per reference area, while lambda_j is per current area (the
+        surface strain apart: about 1 % under the Hertz contacts' pressures, and lambda_j
+        would depend on whether the last search was at the start or the end of a step)."""
+        return self.nodes, self.D0, self.D * self.lam / self.D0, self.gap
 
 
 def _owned_matrix(lay: NodeLayout, rows, cols, vals) -> PETSc.Mat:

@@ -37,8 +37,11 @@ __all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "Cont
 class ConvergenceError(RuntimeError):
     """The nonlinear solve failed; names the SNES reason, the load step and the load factor."""
 
-    def __init__(self, reason: str, step: int | None = None, load: float | None = None):
+    def __init__(self, reason: str, step: int | None = None, load: float | None = None,
+                 stats: SolveStats | None = None):  # fmt: skip
         self.reason = reason
+        #: the iteration counts up to the failure, when known
+        self.stats = stats
         self.step = step
         self.load = load
         where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
@@ -319,43 +322,79 @@ class ContactSNES:
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self) -> SolveStats:
-        """Solve from the current u (its Dirichlet values are set first); raise on failure."""
+        """Solve from the current u (its Dirichlet values are set first); raise on failure.
+
+        With a two-body coupling searched once per step: the search at the step's start, and
+        once Newton has converged, a search at the solution that finds contact points the
+        step's search could not reach (farther apart at its start than the candidates'
+        padding). With new points, Newton continues from the solution with the new pairing
+        (a few iterations when the contact set grew by a few nodes), and if that fails
+        (semi-smooth Newton can cycle between two active sets when many nodes change status at
+        once, as with Coulomb friction), it solves the step again from its start with that
+        pairing; up to SEARCH_ROUNDS searches."""
         x = _compat.petsc_vec(self.u)
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
         self._late = False
-        newton = ksp = 0
-        # the search of this load step; once converged, a search at the solution that finds
-        # contact points the step's search could not reach (farther apart at its start than
-        # the candidates' padding) continues Newton from there, up to SEARCH_ROUNDS times
-        for rounds in range(self.SEARCH_ROUNDS):
-            if self.coupling is not None and (rounds == 0 or not self._searched_all()):
+        stats = SolveStats(newton=0, ksp=0, reason="")
+        if self.coupling is None or self.coupling.search_each_newton:
+            if self.coupling is not None:
                 self._timed_search()
-            elif rounds > 0:
-                break
-            try:
-                self.snes.solve(None, x)
-            except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
-                raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
-            if self._late:
-                raise TimeLimitExceeded()
-            self._sync(x)
-            reason = self.snes.getConvergedReason()
-            newton += self.snes.getIterationNumber()
-            ksp += self.snes.getLinearSolveIterations()
-            stats = SolveStats(newton=newton, ksp=ksp, reason=snes_reason_name(reason))
-            if reason <= 0:
-                raise ConvergenceError(stats.reason)
-            if self.coupling is None or self.coupling.search_each_newton:
-                break
-        else:
+            return self._newton(x, stats)
+        start = x.copy()
+        try:
+            self._timed_search()
+            stats = self._newton(x, stats)
+            for _ in range(self.SEARCH_ROUNDS - 1):
+                if self._searched_all():
+                    return stats
+                self._timed_search()
+                try:
+                    stats = self._newton(x, stats, max_it=self.CONTINUE_MAX_IT)
+                except TimeLimitExceeded:
+                    raise
+                except ConvergenceError as err:
+                    stats = err.stats or stats
+                    start.copy(x)
+                    self._sync(x)
+                    stats = self._newton(x, stats)
             if not self._searched_all():
                 raise ConvergenceError("the search found new contact points after "
                                        f"{self.SEARCH_ROUNDS} rounds")  # fmt: skip
+            return stats
+        finally:
+            start.destroy()
+
+    def _newton(self, x: PETSc.Vec, before: SolveStats, max_it: int | None = None) -> SolveStats:
+        """One SNES solve from x (at most ``max_it`` iterations when given and below the
+        SNES's own limit); the counts added to ``before``. Raises ConvergenceError (with the
+        counts) on divergence, TimeLimitExceeded past the time limit."""
+        limit = self.snes.getTolerances()[3]
+        if max_it is not None and max_it < limit:
+            self.snes.setTolerances(max_it=max_it)
+        try:
+            self.snes.solve(None, x)
+        except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
+            raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
+        finally:
+            self.snes.setTolerances(max_it=limit)
+        if self._late:
+            raise TimeLimitExceeded()
+        self._sync(x)
+        reason = self.snes.getConvergedReason()
+        stats = SolveStats(newton=before.newton + self.snes.getIterationNumber(),
+                           ksp=before.ksp + self.snes.getLinearSolveIterations(),
+                           reason=snes_reason_name(reason))  # fmt: skip
+        if reason <= 0:
+            raise ConvergenceError(stats.reason, stats=stats)
         return stats
 
     #: searches per load step at most (``--search-update step``)
     SEARCH_ROUNDS = 5
+    #: Newton iterations at most when continuing from a solution with a new pairing (a
+    #: converging continuation takes a few; a cycling one is solved again from the step's
+    #: start)
+    CONTINUE_MAX_IT = 15
 
     def _timed_search(self) -> None:
         t0 = time.perf_counter()

@@ -182,3 +182,55 @@ def _moments(area, sb, mb):
     ls = np.einsum("qv,fvc->fqc", points, sb)
     lm = np.einsum("qv,fvc->fqc", points, mb)
     return np.einsum("f,q,fqj,fqk->jk", area, weights, ls, lm)
+
+
+def test_mortar_search_across_ranks_matches_serial():
+    """The facets of both surfaces dealt to the ranks by two different cuts (slave facet i on
+    rank floor(p x), master on rank floor(p ((x + 1 / 2p) mod 1)), x the facet's midpoint): at
+    p >= 2 slave facets face master facets of the same and of other ranks. The search gathers
+    the master facets near each rank's slave facets (``gather_near``, one alltoall), and the
+    mortar triplets of all ranks together equal those of one rank holding every facet."""
+    from mpi4py import MPI
+
+    from contactfx.contact.pair import gather_near
+
+    comm = MPI.COMM_WORLD
+    p = comm.size
+    rng = np.random.default_rng(3)
+    xs = np.r_[0.0, np.sort(rng.uniform(0, 1, 16)), 1.0]
+    xm = np.r_[-0.1, np.sort(rng.uniform(0, 1, 23)), 1.1]
+    slave = _line(xs, 0.0, 0)
+    master = _line(xm, 0.0, 100, reverse=True)
+
+    def rank_of(f: Facets, shift: float) -> np.ndarray:
+        mid = np.clip(f.x.mean(axis=1)[:, 0], 0.0, 1.0 - 1e-12)
+        return np.floor(p * ((mid + shift) % 1.0)).astype(int)
+
+    s_rank, m_rank = rank_of(slave, 0.0), rank_of(master, 0.5 / p)
+    mine_s = Facets(slave.x[s_rank == comm.rank], slave.nodes[s_rank == comm.rank])
+    mine_m = Facets(master.x[m_rank == comm.rank], master.nodes[m_rank == comm.rank])
+    radius = max(np.ptp(slave.x[:, :, 0], axis=1).max(), np.ptp(master.x[:, :, 0], axis=1).max())
+    near = gather_near(comm, mine_m, mine_s, radius)
+    pairs = FacetTree(near.x, radius).collide(FacetTree(mine_s.x, 0.0))
+    _, _, triplets = mortar_matrices(mine_s, near, pairs)
+
+    def dense(rows, cols, vals) -> np.ndarray:
+        M = np.zeros((len(xs), len(xm)))
+        np.add.at(M, (rows, cols - 100), vals)
+        return M
+
+    parallel = comm.allreduce(dense(*triplets), op=MPI.SUM)
+    pairs_all = FacetTree(master.x, radius).collide(FacetTree(slave.x, 0.0))
+    serial = dense(*mortar_matrices(slave, master, pairs_all)[2])
+    # the same Gauss points summed in another order: equal to round-off
+    assert np.allclose(parallel, serial, rtol=0.0, atol=1e-15)
+    # and a non-trivial coupling: every slave node has its partition of unity
+    assert np.all(serial.sum(axis=1) > 0.0)
+    # at 2 ranks and more the overlapping (slave, master) facet pairs are both on one rank
+    # and across ranks (by the cuts' construction; counted from the x-intervals)
+    lo = np.maximum(slave.x[:, :, 0].min(axis=1)[:, None], master.x[:, :, 0].min(axis=1)[None])
+    hi = np.minimum(slave.x[:, :, 0].max(axis=1)[:, None], master.x[:, :, 0].max(axis=1)[None])
+    overlap = hi > lo
+    across = overlap & (s_rank[:, None] != m_rank[None, :])
+    if p > 1:
+        assert np.any(across) and np.any(overlap & ~across)
