@@ -120,8 +120,8 @@ def coulomb_nitsche_residual(s, theta, gamma0, mu):
 
 # -
 
-# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take an
-# arbitrary state (random nodal values) and compare the assembled vectors.
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take
+# an arbitrary state (random nodal values) and compare the assembled vectors.
 
 
 # +

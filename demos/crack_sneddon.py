@@ -116,8 +116,8 @@ def crack_nitsche_residual(s, theta, gamma0):
 
 # -
 
-# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
-# fluid pressure, take an arbitrary state (random nodal values of $u$ and $a$) and compare the
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply
+# the fluid pressure, take an arbitrary state (random nodal values of $u$ and $a$) and compare the
 # assembled vectors.
 
 

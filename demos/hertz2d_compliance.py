@@ -96,8 +96,8 @@ def compliance_residual(s, kappa0, m):
 
 # -
 
-# The check that this is what the run assembles: build the problem `scene.run` solves (`setup`), put the
-# indenter at its final depth, take an arbitrary state (random nodal values) and compare the
+# The check that this is what the run assembles: build the problem `scene.run` solves (`setup`), put
+# the indenter at its final depth, take an arbitrary state (random nodal values) and compare the
 # assembled residual vectors, for $m = 1.5$ and, at $m = 1$, with the penalty method's.
 
 

@@ -104,9 +104,9 @@ def nitsche_residual(s, theta, gamma0):
 
 # -
 
-# This is the residual the run uses: build the problem `scene.run` solves (`setup`), put the indenter at
-# its final depth, take an arbitrary state (random nodal values) and compare the assembled
-# vectors of `method.residual(s)` and of the formula above.
+# This is the residual the run uses: build the problem `scene.run` solves (`setup`), put the
+# indenter at its final depth, take an arbitrary state (random nodal values) and compare the
+# assembled vectors of `method.residual(s)` and of the formula above.
 
 
 # +

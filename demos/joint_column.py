@@ -113,8 +113,8 @@ def uzawa_residual(s, r0, Kni, Vm):
 
 # -
 
-# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
-# loads, take an arbitrary state (random nodal values of the displacement and the multiplier)
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply
+# the loads, take an arbitrary state (random nodal values of the displacement and the multiplier)
 # and compare the assembled vectors.
 
 

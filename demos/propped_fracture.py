@@ -117,9 +117,9 @@ def al_ssn_residual(s, r0):
 
 # -
 
-# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take an
-# arbitrary state (random nodal values of the displacement and the multiplier) and compare
-# the assembled vectors.
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), take
+# an arbitrary state (random nodal values of the displacement and the multiplier) and compare the
+# assembled vectors.
 
 
 # +

@@ -106,8 +106,8 @@ def nitsche_residual(s, theta, gamma0):
 
 # -
 
-# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply the
-# full load, take an arbitrary state (random nodal values) and compare the assembled vectors.
+# The check that it is what the run assembles: build the problem `scene.run` solves (`setup`), apply
+# the full load, take an arbitrary state (random nodal values) and compare the assembled vectors.
 
 
 # +
