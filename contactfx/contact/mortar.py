@@ -268,10 +268,7 @@ class MortarCoupling:
         slave, master = pair.slave.current(ub), pair.master.current(ub)
         nodes = slave.nodes.reshape(-1)
         if self._reference is None:
-            w0 = nodal_weights(pair.slave.current(np.zeros_like(ub)).x).reshape(-1, 1)
-            j0, (d0,) = _to_owners(comm, self.ranges, nodes, [w0])
-            uniq0, inv0 = np.unique(j0, return_inverse=True)
-            self._reference = uniq0, np.bincount(inv0, weights=d0[:, 0], minlength=len(uniq0))
+            self._reference = self._node_sums(nodes, nodal_weights(pair.slave.X))
         near, pairs = pair.search(slave, master)
         D, normals, (rows, cols, vals) = mortar_matrices(slave, near, pairs)
         # nodal sums on the owners: D_j and sum of weighted normals
@@ -279,6 +276,13 @@ class MortarCoupling:
         j_nodes, (j_data,) = _to_owners(comm, self.ranges, nodes, [node_data])
         m_rows, (m_cols, m_vals) = _to_owners(comm, self.ranges, rows, [cols, vals])
         self._assemble(j_nodes, j_data, m_rows, m_cols, m_vals)
+
+    def _node_sums(self, nodes: np.ndarray, values: np.ndarray):
+        """(sorted owned nodes, sums): the per-facet-node ``values`` (same shape as the facets'
+        nodes) summed on the nodes' owners. Collective."""
+        j, (d,) = _to_owners(self.comm, self.ranges, nodes, [values.reshape(-1, 1)])
+        uniq, inv = np.unique(j, return_inverse=True)
+        return uniq, np.bincount(inv, weights=d[:, 0], minlength=len(uniq))
 
     def missed(self, u: np.ndarray) -> int:
         """The number of slave nodes (all ranks) that a search at x = X + u makes contact
@@ -289,11 +293,8 @@ class MortarCoupling:
         slave, master = pair.slave.current(ub), pair.master.current(ub)
         near, pairs = pair.search(slave, master)
         D, _, (rows, _, vals) = mortar_matrices(slave, near, pairs)
-        j_nodes, (j_data,) = _to_owners(comm, self.ranges, slave.nodes.reshape(-1),
-                                        [D.reshape(-1, 1)])  # fmt: skip
+        uniq, Dj = self._node_sums(slave.nodes.reshape(-1), D)
         m_rows, (m_vals,) = _to_owners(comm, self.ranges, rows, [vals])
-        uniq, inv = np.unique(j_nodes, return_inverse=True)
-        Dj = np.bincount(inv, weights=j_data[:, 0], minlength=len(uniq))
         Msum = np.bincount(np.searchsorted(uniq, m_rows), weights=m_vals, minlength=len(uniq))
         covered = uniq[Msum > 0.5 * Dj]
         from mpi4py import MPI
