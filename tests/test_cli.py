@@ -1,10 +1,11 @@
 """The command line as a user runs it (subprocesses, serial and mpirun -n 2)."""
 
 import json
+import subprocess
 
 import pytest
 
-from conftest import run_cli
+from conftest import clean_env, contactfx_cmd, run_cli
 
 pytestmark = pytest.mark.serial_only
 
@@ -134,3 +135,19 @@ def test_bench_command_line(tmp_path):
     assert "nitsche(-1)" in res.stdout and "penalty(100)" in res.stdout
     rows = (tmp_path / "bench.csv").read_text().splitlines()
     assert rows[0].startswith("case,method,degree,level,h") and len(rows) == 3
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_first_run_prints_no_compiler_chatter(tmp_path, ranks):
+    """An empty form cache (XDG_CACHE_HOME: dolfinx's JIT cache is $XDG_CACHE_HOME/fenics):
+    every form is compiled, and the build's log (cffi, distutils) stays out of the output."""
+    env = {**clean_env(), "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    cmd = contactfx_cmd("run", "bar1d", "--out", str(tmp_path / "out"), ranks=ranks)
+    if ranks > 1:
+        cmd[1:1] = ["-x", "XDG_CACHE_HOME"]  # mpirun passes the variable to every rank
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
+    assert res.returncode == 0, res.stderr
+    assert "contact force" in res.stdout  # our own output is all there
+    output = res.stdout + res.stderr
+    assert not [line for line in output.splitlines() if "INFO:" in line], output
+    assert any((tmp_path / "cache" / "fenics").glob("*.so"))  # the forms were compiled, cached

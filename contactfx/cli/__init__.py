@@ -7,6 +7,7 @@ Errors are one line on rank 0 and a non-zero exit status on every rank.
 
 from __future__ import annotations
 
+import logging
 import sys
 
 from contactfx.cli.args import petsc_dict, split_petsc
@@ -41,8 +42,26 @@ def _dispatch(command: str, rest: list[str], petsc_options: dict, comm) -> int:
     raise ValueError(f"unknown command '{command}' ({USAGE})")
 
 
+def _below_warning_on_root(record: logging.LogRecord) -> bool:
+    return record.levelno >= logging.WARNING
+
+
+def _quiet_compiler() -> None:
+    """No compiler chatter on a first run (empty form cache). FFCx builds each form through
+    cffi, which runs setuptools' distutils with verbose=True: cffi lowers the root logger to
+    INFO for the build, and distutils logs every step ("running build_ext", the gcc command
+    lines) to the root logger, which FFCx's import gave a stderr handler (logging.basicConfig).
+    A level set on the root logger does not hold (cffi sets it for each build); a filter on it
+    does: it sees only the records logged on the root logger itself, so the named loggers
+    (ffcx, UFL, py.warnings) keep their levels, and the form cache is untouched."""
+    root = logging.getLogger()
+    if _below_warning_on_root not in root.filters:
+        root.addFilter(_below_warning_on_root)
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
+    _quiet_compiler()
     argv, petsc_args = split_petsc(argv)
 
     import petsc4py
