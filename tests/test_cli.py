@@ -6,6 +6,7 @@ import subprocess
 import pytest
 
 from conftest import clean_env, contactfx_cmd, run_cli
+from contactfx.cli.args import Parser
 
 pytestmark = pytest.mark.serial_only
 
@@ -72,6 +73,14 @@ BAD = [
     (["run", "crack-inclined", "--nu", "0.5"], "Poisson's ratio nu must lie in (-1, 0.5)"),
     (["run", "crack-inclined", "--boundary", "free"], "--boundary must be one of"),
     (["run", "propped-fracture", "--proppant-thickness=-1e-4"], "--proppant-thickness must be > 0"),
+    # negative numbers in scientific notation are values, without '=' (Python 3.11 too)
+    (
+        ["run", "propped-fracture", "--proppant-thickness", "-1e-4"],
+        "--proppant-thickness must be > 0",
+    ),
+    (["run", "hertz2d", "--E", "-2.1E+11"], "--E must be > 0"),
+    (["run", "hertz2d", "--gap0", "-x"], "argument --gap0: expected one argument"),
+    (["stress", "--time-limit", "-1e2"], "--time-limit must be > 0"),
     (
         ["run", "propped-fracture", "--proppant-half-length", "1.5"],
         "--proppant-half-length (1.5) must be < --crack-half-length",
@@ -151,3 +160,38 @@ def test_first_run_prints_no_compiler_chatter(tmp_path, ranks):
     output = res.stdout + res.stderr
     assert not [line for line in output.splitlines() if "INFO:" in line], output
     assert any((tmp_path / "cache" / "fenics").glob("*.so"))  # the forms were compiled, cached
+
+
+def _number_parser() -> Parser:
+    parser = Parser(prog="test")
+    parser.add_argument("--gap0", type=float, default=0.0)
+    parser.add_argument("--quiet", action="store_true")
+    return parser
+
+
+@pytest.mark.parametrize("text", ["-3e-3", "-1E+6", "-2.5e-1", "-1", "-.5", "-7.", "-1e6"])
+def test_negative_numbers_are_option_values(text):
+    assert _number_parser().parse_args(["--gap0", text]).gap0 == float(text)
+    assert _number_parser().parse_args(["--gap0", text, "--quiet"]).gap0 == float(text)
+    assert _number_parser().parse_args(["--gap", text]).gap0 == float(text)  # abbreviated
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["-x"], "unrecognized arguments: -x"),
+        (["--gap0", "1", "-x"], "unrecognized arguments: -x"),
+        (["--gap0", "-x"], "argument --gap0: expected one argument"),
+        (["--gap0", "-1e-3", "-2e-3"], "unrecognized arguments: -2e-3"),
+        (["--quiet", "-1e-3"], "--quiet: ignored explicit argument '-1e-3'"),
+    ],
+)
+def test_unknown_options_still_fail(args, message):
+    with pytest.raises(ValueError, match=message):
+        _number_parser().parse_args(args)
+
+
+def test_negative_scientific_value_reaches_the_run(tmp_path):
+    res = run_cli("run", "hertz2d", *FAST, "--gap0", "-3e-4", "--quiet", "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    assert json.loads((tmp_path / "run.json").read_text())["parameters"]["gap0"] == -3e-4

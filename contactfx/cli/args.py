@@ -5,18 +5,48 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 import time
 
 from contactfx.params import option_name
 
-__all__ = ["Parser", "split_petsc", "petsc_dict", "add_options", "int_list", "finish_table"]
+__all__ = [
+    "Parser", "attach_negative_numbers", "split_petsc", "petsc_dict", "add_options", "int_list",
+    "finish_table",
+]  # fmt: skip
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse that raises ValueError (reported once, on rank 0) instead of exiting."""
+    """argparse that raises ValueError (reported once, on rank 0) instead of exiting, and
+    takes negative numbers in any float notation as option values (``--gap0 -3e-3``)."""
 
     def error(self, message: str):
         raise ValueError(message)
+
+    def parse_known_args(self, args=None, namespace=None):
+        # Python 3.11 (Debian 12) takes '-3e-3' or '-1E+6' for an option: its negative-number
+        # pattern (private, _negative_number_matcher) knows '-1' and '-.5' only; 3.13 (Debian
+        # 13) accepts them. Rather than patch argparse's private attributes, which differ
+        # between versions, the value is attached to its option ('--gap0=-3e-3', argparse's
+        # documented form), so the parsing is the same on every Python. parse_args calls
+        # parse_known_args on 3.11 and 3.13 alike.
+        args = sys.argv[1:] if args is None else list(args)
+        return super().parse_known_args(attach_negative_numbers(args), namespace)
+
+
+def attach_negative_numbers(args: list[str]) -> list[str]:
+    """['--gap0', '-3e-3'] -> ['--gap0=-3e-3']: a negative number right after an option
+    (no '=' in it) becomes that option's value; everything else is left to argparse (an
+    unknown '-x' is still an error, a flag followed by a number too)."""
+    out: list[str] = []
+    for arg in args:
+        prev = out[-1] if out else ""
+        if (arg.startswith("-") and _is_number(arg) and prev.startswith("-") and "=" not in prev
+                and not _is_number(prev)):  # fmt: skip
+            out[-1] = f"{prev}={arg}"
+        else:
+            out.append(arg)
+    return out
 
 
 def split_petsc(argv: list[str]) -> tuple[list[str], list[str]]:
