@@ -2,6 +2,8 @@
 
 import json
 import subprocess
+import tomllib
+from pathlib import Path
 
 import pytest
 
@@ -195,3 +197,46 @@ def test_negative_scientific_value_reaches_the_run(tmp_path):
     res = run_cli("run", "hertz2d", *FAST, "--gap0", "-3e-4", "--quiet", "--out", str(tmp_path))
     assert res.returncode == 0, res.stderr
     assert json.loads((tmp_path / "run.json").read_text())["parameters"]["gap0"] == -3e-4
+
+
+def test_module_runs_from_another_directory(tmp_path):
+    """``python -m contactfx`` of the installed package (here the test's interpreter, the venv),
+    not of the source folder in the current directory."""
+    res = run_cli("list", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "hertz2d" in res.stdout and "--gamma0" in res.stdout
+
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_subpackage_is_installed():
+    """A wheel (non-editable install) holds only the packages pyproject.toml lists."""
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    found = {
+        ".".join(init.parent.relative_to(ROOT).parts)
+        for init in (ROOT / "contactfx").rglob("__init__.py")
+    }
+    assert found | {"contactfx.meshes"} == listed
+
+
+SYSTEM_PYTHON = Path("/usr/bin/python3")
+
+
+@pytest.mark.skipif(not SYSTEM_PYTHON.exists(), reason="no Debian /usr/bin/python3")
+def test_module_in_checkout_without_install_says_which_interpreter():
+    """In the source folder an interpreter without contactfx installed finds the folder's
+    contactfx/ (without contactfx.meshes): one line saying to use the venv, no traceback."""
+    installed = subprocess.run([str(SYSTEM_PYTHON), "-c", "import contactfx.meshes"], cwd="/",
+                               capture_output=True, env=clean_env())  # fmt: skip
+    if installed.returncode == 0:
+        pytest.skip("contactfx is installed for /usr/bin/python3")
+    res = subprocess.run([str(SYSTEM_PYTHON), "-m", "contactfx", "list"], cwd=ROOT,
+                         capture_output=True, text=True, env=clean_env(), timeout=60)  # fmt: skip
+    assert res.returncode == 1
+    assert res.stderr.splitlines() == [
+        "contactfx: error: contactfx is not installed for /usr/bin/python3: use the venv of "
+        "scripts/install.sh (.venv/bin/python -m contactfx, or source .venv/bin/activate)"
+    ]
