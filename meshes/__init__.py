@@ -26,7 +26,16 @@ stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block
 --out mesh.msh``.
 """
 
-from contactfx.meshes._build import Builder, MeshData, MshInfo, build, write_msh
+from contactfx.meshes._build import (
+    Builder,
+    Group,
+    MeshData,
+    MshInfo,
+    build,
+    build_file,
+    file_groups,
+    write_msh,
+)
 from contactfx.meshes.box import BoxCells, BoxFacets, box
 from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
@@ -60,6 +69,7 @@ __all__ = [
     "CrackPlateFacets",
     "CylindersCells",
     "CylindersFacets",
+    "Group",
     "JointColumnCells",
     "JointColumnFacets",
     "MeshData",
@@ -78,6 +88,8 @@ __all__ = [
     "StackedBoxesFacets",
     "box",
     "build",
+    "build_file",
+    "file_groups",
     "crack_plate",
     "cylinders",
     "joint_column",

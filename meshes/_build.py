@@ -52,10 +52,13 @@ if TYPE_CHECKING:
 __all__ = [
     "GMSH_RANK",
     "Builder",
+    "Group",
     "MeshData",
     "MshInfo",
     "add_physical_groups",
     "build",
+    "build_file",
+    "file_groups",
     "check_finite",
     "check_less",
     "check_less_equal",
@@ -335,3 +338,82 @@ def set_graded_size(
 def matheval_number(value: float) -> str:
     """Format ``value`` for a gmsh MathEval expression: full precision, in parentheses."""
     return f"({float(value)!r})"
+
+
+@dataclass(frozen=True)
+class Group:
+    """A named physical group of a mesh file: its dimension, tag and number of elements."""
+
+    name: str
+    dim: int
+    tag: int
+    elements: int
+
+
+def file_groups(path: str | os.PathLike[str], size_factor: float = 1.0):
+    """A builder that loads a ``.msh`` file or meshes a ``.geo`` file (gmsh's own parser, the
+    element sizes scaled by ``size_factor``), and the list it fills, on the rank that runs it,
+    with the file's named physical groups (:class:`Group`). The mesh dimension is the highest
+    dimension of a physical group."""
+    path = Path(path)
+    groups: list[Group] = []
+
+    def builder(model: type[gmsh.model]) -> None:
+        import gmsh
+
+        if path.suffix == ".geo":
+            gmsh.option.setNumber("Mesh.MeshSizeFactor", float(size_factor))
+        gmsh.merge(str(path))
+        dims = [d for d, _ in model.getPhysicalGroups()]
+        if not dims:
+            raise ValueError(f"{path}: the mesh has no physical group (name the bodies and "
+                             "the boundaries with Physical Curve / Surface / Volume)")  # fmt: skip
+        top = max(dims)
+        if path.suffix == ".geo":
+            model.mesh.generate(top)
+        for dim, tag in model.getPhysicalGroups():
+            name = model.getPhysicalName(dim, tag) or str(tag)
+            count = 0
+            for entity in model.getEntitiesForPhysicalGroup(dim, tag):
+                _, element_tags, _ = model.mesh.getElements(dim, entity)
+                count += sum(len(t) for t in element_tags)
+            groups.append(Group(name, dim, tag, count))
+
+    return builder, groups
+
+
+def build_file(comm: MPI.Comm, path: str | os.PathLike[str], size_factor: float,
+               name: str) -> tuple[MeshData, list[Group]]:  # fmt: skip
+    """:func:`build` for a mesh file (:func:`file_groups`): the distributed mesh and, on every
+    rank, the file's physical groups. The dimension is the file's (a 2D mesh in the plane z = 0
+    gives a 2D mesh). Collective; a missing file raises FileNotFoundError on every rank."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file {str(path)!r} not found")
+    if path.suffix not in (".msh", ".geo"):
+        raise ValueError(f"mesh file {str(path)!r}: expected a .msh or .geo file")
+    import gmsh
+
+    builder, groups = file_groups(path, size_factor)
+    on_gmsh_rank = comm.rank == GMSH_RANK
+    session = _gmsh_session(name) if on_gmsh_rank else contextlib.nullcontext(gmsh.model)
+    with session as model:
+        failure: Exception | None = None
+        if on_gmsh_rank:
+            try:
+                builder(model)
+            except Exception as exc:
+                failure = exc
+        shared = comm.bcast((failure, groups), root=GMSH_RANK)
+        if failure is not None:
+            raise failure
+        if shared[0] is not None:
+            raise shared[0]
+        groups = shared[1]
+        gdim = max(g.dim for g in groups)
+        _check_gdim(gdim)
+        mesh, cell_tags, facet_tags = model_to_mesh(model, comm, GMSH_RANK, gdim)
+    mesh.name = name
+    cell_tags.name = "cells"
+    facet_tags.name = "facets"
+    return MeshData(mesh, cell_tags, facet_tags), groups

@@ -17,7 +17,9 @@ __all__ = ["main"]
 USAGE = (
     "usage: contactfx {list | run SCENE [options] [-- PETSc options] | "
     "bench [--scene CASES] [--method M,...] [--levels N] [--degree 1,2] [--out DIR] | "
-    "stress [--quick] [--axis AXES] [--out DIR]}"
+    "stress [--quick] [--axis AXES] [--out DIR] | "
+    "solve PROBLEM.toml [--set KEY=VALUE] [--out DIR] [-- PETSc options] | "
+    "check PROBLEM.toml}"
 )
 
 
@@ -39,6 +41,10 @@ def _dispatch(command: str, rest: list[str], petsc_options: dict, comm) -> int:
         from contactfx.cli.stress import cmd_stress
 
         return cmd_stress(rest, petsc_options, comm)
+    if command in ("solve", "check"):
+        from contactfx.cli.solve import cmd_check, cmd_solve
+
+        return (cmd_solve if command == "solve" else cmd_check)(rest, petsc_options, comm)
     raise ValueError(f"unknown command '{command}' ({USAGE})")
 
 

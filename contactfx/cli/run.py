@@ -14,7 +14,7 @@ from contactfx.results import RunSummary
 from contactfx.scenes import SCENES, get_scene
 from contactfx.solvers.snes import ConvergenceError
 
-__all__ = ["cmd_list", "cmd_run", "table"]
+__all__ = ["cmd_list", "cmd_run", "table", "write_failed"]
 
 
 def _scene_parser(scene_cls) -> Parser:
@@ -137,7 +137,7 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
                         verbose=not ns["quiet"])  # fmt: skip
     except ConvergenceError:
         if ns["out"] is not None:
-            _write_failed(ns["out"], scene, numerics, sys.exc_info()[1], comm)
+            write_failed(ns["out"], scene, numerics, sys.exc_info()[1], comm)
         raise
     if comm.rank == 0:
         print(table(res))
@@ -147,7 +147,7 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
     return 0
 
 
-def _write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
+def write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
     """run.json marked failed, with the error: no half-written result presented as complete."""
     data = {"status": "failed", "error": str(error), "scene": scene.name,
             "parameters": dataclasses.asdict(scene.p), "numerics": dataclasses.asdict(numerics),

@@ -109,6 +109,7 @@ class ObstacleProblem(Problem):
     # -- load program --------------------------------------------------------------------------
     def apply_load(self, t: float) -> None:
         self.tload.value = t
+        self.scene.set_load(t)
         self.offset.value[:] = self.scene.obstacle_offset(t, self.gdim)
 
     def start(self, solver) -> None:

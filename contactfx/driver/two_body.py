@@ -242,7 +242,7 @@ class TwoBodyPost:
     def pair_force(self) -> np.ndarray:
         """The force of the pair on the upper body (the coupling's force on the slave body,
         with the sign of the slave side), times the scene's symmetry. Collective."""
-        sign = 1.0 if self.scene.p.slave == "upper" else -1.0
+        sign = 1.0 if self.scene.slave_is_upper else -1.0
         return sign * self.scene.symmetry * self.pb.coupling().slave_force()
 
     def tangential_nodal_force(self, solver, local: np.ndarray) -> float:

@@ -82,6 +82,14 @@ class Scene:
         """The element size at the contact surface."""
         return self.p.h_contact
 
+    def set_load(self, t: float) -> None:
+        """Set the load program's constants (prescribed displacements, load amplitudes) for
+        load factor t."""
+
+    def on_step(self, problem, solver, load: float) -> None:
+        """Called at every converged load step (after the post-processor's evaluation), e.g.
+        to record reactions."""
+
     @classmethod
     def default_numerics(cls, **overrides) -> Numerics:
         """The scene's default numerics (what the command line starts from), overridden."""

@@ -62,6 +62,12 @@ class TwoBodyScene(Scene):
         other = "lower" if self.p.slave == "upper" else "upper"
         return int(self.surfaces[other])
 
+    @property
+    def slave_is_upper(self) -> bool:
+        """Whether the slave surface is the upper body's (the pair's force is reported on the
+        upper body)."""
+        return self.p.slave == "upper"
+
     def materials(self) -> dict[str, Elastic]:
         p = self.p
         return {"lower": Elastic(p.E_lower, p.nu_lower), "upper": Elastic(p.E_upper, p.nu_upper)}
@@ -90,9 +96,6 @@ class TwoBodyScene(Scene):
 
     def dirichlet(self, V, facet_tags) -> list:
         raise NotImplementedError
-
-    def set_load(self, t: float) -> None:
-        """Set the load program's constants (prescribed displacements) for load factor t."""
 
     def contact_size(self, measure: float) -> float:
         """Contact half-width / radius from the measure of the contact set (full model)."""

@@ -1,0 +1,132 @@
+"""``contactfx solve problem.toml`` and ``contactfx check problem.toml``: a problem file over
+the user's own mesh (:mod:`contactfx.scenes.problem_file`)."""
+
+from __future__ import annotations
+
+import csv
+import sys
+from pathlib import Path
+
+from contactfx.cli.args import Parser
+from contactfx.cli.run import table, write_failed
+from contactfx.scenes.problem_file import load_problem
+from contactfx.solvers.snes import ConvergenceError
+
+__all__ = ["cmd_solve", "cmd_check"]
+
+
+def _parser(command: str, about: str) -> Parser:
+    parser = Parser(prog=f"contactfx {command}", description=about,
+                    epilog="PETSc options go after '--', e.g. -- -snes_monitor")  # fmt: skip
+    parser.add_argument("problem", type=Path, help="the problem file (TOML)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a key of the file, e.g. numerics.method=al-ssn or "
+                        "bodies.0.E=2e5 (repeatable)")  # fmt: skip
+    return parser
+
+
+def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
+    parser = _parser("solve", "solve the contact problem of a problem file")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output folder (default: results/<title> beside the file)",
+    )
+    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    ns = parser.parse_args(argv)
+    scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
+    out = ns.out if ns.out is not None else ns.problem.parent / "results" / scene.name
+    options = {**file_petsc, **petsc_options}
+    if comm.rank == 0 and not ns.quiet:
+        print(f"contactfx: {ns.problem} ({scene.summary}), method {numerics.method}, "
+              f"{comm.size} rank(s)", flush=True)  # fmt: skip
+    try:
+        res = scene.run(numerics, comm=comm, out=out, petsc_options=options,
+                        verbose=not ns.quiet)  # fmt: skip
+    except ConvergenceError:
+        write_failed(out, scene, numerics, sys.exc_info()[1], comm)
+        raise
+    written = _write_reactions(scene, out, comm)
+    if comm.rank == 0:
+        print(table(res))
+        for g, values in _last_reactions(scene).items():
+            print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
+        if written:
+            print(f"  reactions: {written}")
+        if res.xdmf:
+            print(f"  ParaView: {res.xdmf}")
+            print(f"  summary:  {Path(res.xdmf).parent / 'run.json'}")
+    return 0
+
+
+def _last_reactions(scene) -> dict[str, list[float]]:
+    if not scene.reaction_rows:
+        return {}
+    row = scene.reaction_rows[-1]
+    return {g: [v for k, v in row.items() if k.startswith(g + "_")]
+            for g in scene.spec.reactions}  # fmt: skip
+
+
+def _write_reactions(scene, out: Path, comm) -> Path | None:
+    """reactions.csv: the load factor and each group's reaction components per step."""
+    if not scene.reaction_rows:
+        return None
+    path = out / "reactions.csv"
+    if comm.rank == 0:
+        with path.open("w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=list(scene.reaction_rows[0]))
+            writer.writeheader()
+            writer.writerows(scene.reaction_rows)
+    comm.barrier()
+    return path
+
+
+def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
+    """Validate the file and its mesh and print a summary, without solving."""
+    import numpy as np
+
+    ns = _parser("check", "validate a problem file and summarise it without solving").parse_args(
+        argv
+    )
+    scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
+    from contactfx.driver.pipeline import setup
+
+    problem = setup(scene, numerics, comm=comm)
+    if comm.rank != 0:
+        return 0
+    pb = scene.spec
+    print(f"{ns.problem}: valid")
+    print(f"  mesh       {pb.mesh_file} (size factor {pb.size}), {scene.gdim}D, "
+          f"{problem.dofs()} dofs")  # fmt: skip
+    print("  groups     " + scene.group_list())
+    for group, mat in pb.bodies:
+        print(f"  body       {group}: E = {mat.E:g}, nu = {mat.nu:g}")
+    for b in pb.boundary:
+        what = []
+        if b.fix:
+            what.append("fixed " + ",".join("xyz"[c] for c in b.fix))
+        if b.displacement:
+            what.append(
+                "displacement "
+                + ", ".join(f"{'xyz'[c]} = {v:g}" for c, v in b.displacement.items())
+            )
+        if b.traction is not None:
+            what.append(f"traction {np.array2string(b.traction, separator=', ')}")
+        if b.pressure is not None:
+            what.append(f"pressure {b.pressure:g}")
+        amp = "" if b.amplitude == [(0.0, 0.0), (1.0, 1.0)] else f" x amplitude {b.amplitude}"
+        print(f"  boundary   {b.group}: {'; '.join(what)}{amp}")
+    if pb.obstacle is not None:
+        ob = pb.obstacle
+        print(f"  obstacle   {ob['shape']} touching {ob['contact']}, from "
+              f"{scene.position.tolist()} moving by {scene.motion.tolist()}")  # fmt: skip
+    if pb.contact is not None:
+        print(f"  contact    slave {pb.contact[0]}, master {pb.contact[1]}")
+    print(f"  numerics   method {numerics.method}, friction {numerics.friction}, "
+          f"{numerics.steps} step(s), solver {numerics.solver}")  # fmt: skip
+    if file_petsc:
+        print(f"  petsc      {file_petsc}")
+    if pb.reactions:
+        print(f"  output     reactions of {', '.join(pb.reactions)}")
+    return 0

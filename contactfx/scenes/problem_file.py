@@ -1,0 +1,602 @@
+"""Problem files: a contact problem described by a TOML file over the user's own gmsh mesh.
+
+The file names a mesh (a ``.msh`` file, or a ``.geo`` file meshed at run time with a size
+factor), the bodies (a cell group each, with E and nu), the boundary conditions on named facet
+groups (fixed components, prescribed displacement components, tractions, normal pressures, each
+scaled by a piecewise-linear load amplitude), and either a rigid obstacle touching one facet
+group or a contact pair between two bodies; then the numerics, PETSc options and outputs::
+
+    [mesh]
+    file = "block.geo"                 # relative to the problem file
+    size = 1.0                         # element size factor (.geo only)
+
+    [[bodies]]
+    group = "block"
+    E = 1000.0
+    nu = 0.3
+
+    [[boundary]]
+    group = "bottom"
+    fix = ["x", "y"]
+
+    [[boundary]]
+    group = "right"
+    traction = [0.0, -1.0]
+    amplitude = [[0.0, 0.0], [1.0, 1.0]]   # (load factor, multiplier) pairs; default t
+
+    [obstacle]
+    shape = "plane"                    # plane, circle / cylinder (2D), sphere (3D)
+    contact = "top"
+    position = [0.0, 0.0]              # the obstacle's lowest point at the start
+    motion = [0.0, -0.01]              # its rigid displacement at the end of the program
+
+    [numerics]
+    method = "nitsche"
+    steps = 2
+
+    [petsc]
+    snes_monitor = ""
+
+    [output]
+    reactions = ["bottom"]             # reaction force per group and step: reactions.csv
+
+Groups are the gmsh physical names. Everything is validated before anything is computed: an
+unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error
+lists those it has) or of the wrong dimension is one error naming the file and the key.
+
+:func:`load_problem` reads and validates a file (``--set key=value`` overrides applied first) and
+returns the scene, the numerics and the PETSc options; the scene is an
+:class:`contactfx.scenes.base.ObstacleScene` or a
+:class:`contactfx.scenes.two_body_base.TwoBodyScene`, solved by the one pipeline like any
+built-in scene.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import dolfinx
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from contactfx import _compat
+from contactfx.contact.obstacles import Ball, HalfSpace, Obstacle
+from contactfx.mechanics.elasticity import Elastic
+from contactfx.meshes import build_file
+from contactfx.numerics import Numerics
+from contactfx.params import Params, param
+from contactfx.scenes._common import fix_component, prescribe_component
+from contactfx.scenes.base import ObstacleScene
+from contactfx.scenes.two_body_base import TwoBodyScene
+
+__all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
+
+AXES = ("x", "y", "z")
+SECTIONS = ("title", "mesh", "bodies", "boundary", "obstacle", "contact", "numerics", "petsc",
+            "output")  # fmt: skip
+KEYS = {
+    "mesh": ("file", "size"),
+    "bodies": ("group", "E", "nu"),
+    "boundary": ("group", "fix", "displacement", "traction", "pressure", "amplitude"),
+    "obstacle": ("shape", "contact", "radius", "position", "motion", "amplitude"),
+    "contact": ("slave", "master"),
+    "output": ("xdmf", "reactions"),
+}
+SHAPES = ("plane", "circle", "cylinder", "sphere")
+
+
+@dataclass(frozen=True)
+class FileParams(Params):
+    """What run.json records of a problem-file run: the file and the mesh size factor."""
+
+    problem: str = param("", "the problem file")
+    size: float = param(1.0, "element size factor of a .geo mesh", positive=True)
+
+
+class ProblemError(ValueError):
+    pass
+
+
+# -- reading and validation ---------------------------------------------------------------
+
+
+def _parse_value(text: str):
+    """A --set value: TOML syntax when it parses (numbers, booleans, arrays, quoted strings),
+    else the bare text as a string."""
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+
+
+def apply_sets(data: dict, sets: list[str], where: str) -> dict:
+    """``data`` with the ``key.sub=value`` overrides applied (arrays of tables by index:
+    ``bodies.0.E=2e5``)."""
+    data = copy.deepcopy(data)
+    for item in sets:
+        if "=" not in item:
+            raise ProblemError(f"{where}: --set expects key=value, got '{item}'")
+        key, text = item.split("=", 1)
+        parts = key.strip().split(".")
+        node = data
+        for i, part in enumerate(parts[:-1]):
+            if isinstance(node, list):
+                if not part.isdigit() or int(part) >= len(node):
+                    raise ProblemError(f"{where}: --set {key}: no entry {part} in "
+                                       f"'{'.'.join(parts[:i])}'")  # fmt: skip
+                node = node[int(part)]
+            else:
+                node = node.setdefault(part, {})
+            if not isinstance(node, dict | list):
+                raise ProblemError(f"{where}: --set {key}: '{part}' is not a table")
+        if isinstance(node, list):
+            raise ProblemError(f"{where}: --set {key}: give the entry's index")
+        node[parts[-1]] = _parse_value(text.strip())
+    return data
+
+
+class _Reader:
+    """Typed access to the file's tables with errors that name the file and the key."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, key: str, message: str):
+        raise ProblemError(f"{self.path}: {key}: {message}")
+
+    def table(self, data, key: str, allowed: tuple[str, ...]) -> dict:
+        if not isinstance(data, dict):
+            self.fail(key, f"expected a table, got {data!r}")
+        for k in data:
+            if k not in allowed:
+                self.fail(f"{key}.{k}", f"unknown key (allowed: {', '.join(allowed)})")
+        return data
+
+    def number(self, data: dict, key: str, name: str, default=None, positive=False) -> float:
+        value = data.get(name, default)
+        if value is None:
+            self.fail(f"{key}.{name}", "missing (a number)")
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            self.fail(f"{key}.{name}", f"expected a number, got {value!r}")
+        if not np.isfinite(value):
+            self.fail(f"{key}.{name}", f"must be finite, got {value}")
+        if positive and not value > 0:
+            self.fail(f"{key}.{name}", f"must be > 0, got {value}")
+        return float(value)
+
+    def string(self, data: dict, key: str, name: str, choices=None, default=None) -> str:
+        value = data.get(name, default)
+        if not isinstance(value, str):
+            self.fail(f"{key}.{name}", f"expected a string, got {value!r}" if value is not None
+                      else "missing (a string)")  # fmt: skip
+        if choices is not None and value not in choices:
+            self.fail(f"{key}.{name}", f"must be one of {', '.join(choices)}, got '{value}'")
+        return value
+
+    def vector(self, data: dict, key: str, name: str, gdim: int, default=None) -> np.ndarray:
+        value = data.get(name, default)
+        ok = isinstance(value, list) and len(value) == gdim and all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in value)  # fmt: skip
+        if not ok:
+            self.fail(f"{key}.{name}", f"expected {gdim} numbers, got {value!r}")
+        return np.asarray(value, dtype=np.float64)
+
+    def amplitude(self, data: dict, key: str) -> list[tuple[float, float]]:
+        value = data.get("amplitude", [[0.0, 0.0], [1.0, 1.0]])
+        ok = isinstance(value, list) and len(value) >= 1 and all(
+            isinstance(r, list) and len(r) == 2
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
+            for r in value)  # fmt: skip
+        if not ok:
+            self.fail(f"{key}.amplitude", "expected a table of [load factor, multiplier] pairs, "
+                      f"got {value!r}")  # fmt: skip
+        ts = [r[0] for r in value]
+        if any(b <= a for a, b in zip(ts, ts[1:], strict=False)):
+            self.fail(f"{key}.amplitude", f"load factors must increase, got {ts}")
+        return [(float(a), float(b)) for a, b in value]
+
+
+def _amplitude(table: list[tuple[float, float]], t: float) -> float:
+    ts, vs = zip(*table, strict=True)
+    return float(np.interp(t, ts, vs))
+
+
+@dataclass
+class Boundary:
+    group: str
+    fix: tuple[int, ...] = ()
+    displacement: dict[int, float] = dataclasses.field(default_factory=dict)
+    traction: np.ndarray | None = None
+    pressure: float | None = None
+    amplitude: list = dataclasses.field(default_factory=list)
+
+
+@dataclass
+class ProblemFile:
+    """A validated problem file: what the scene needs (groups by name, checked against the
+    mesh when it is built)."""
+
+    path: Path
+    mesh_file: Path
+    size: float
+    bodies: list[tuple[str, Elastic]]
+    boundary: list[Boundary]
+    obstacle: dict | None
+    contact: tuple[str, str] | None
+    reactions: list[str]
+    xdmf: bool
+    title: str
+
+
+def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
+    """(problem, numerics overrides, PETSc options) of the file, without the mesh."""
+    if not path.is_file():
+        raise FileNotFoundError(f"problem file {str(path)!r} not found")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise ProblemError(f"{path}: not valid TOML: {err}") from None
+    data = apply_sets(data, sets, str(path))
+    r = _Reader(path)
+    for key in data:
+        if key not in SECTIONS:
+            r.fail(key, f"unknown section (allowed: {', '.join(SECTIONS)})")
+    mesh = r.table(data.get("mesh", {}), "mesh", KEYS["mesh"])
+    mesh_name = r.string(mesh, "mesh", "file")
+    mesh_file = (path.parent / mesh_name).resolve()
+    size = r.number(mesh, "mesh", "size", 1.0, positive=True)
+
+    bodies_data = data.get("bodies")
+    if not isinstance(bodies_data, list) or not bodies_data:
+        r.fail("bodies", "expected at least one [[bodies]] table (group, E, nu)")
+    bodies = []
+    for i, b in enumerate(bodies_data):
+        key = f"bodies.{i}"
+        b = r.table(b, key, KEYS["bodies"])
+        group = r.string(b, key, "group")
+        E = r.number(b, key, "E", positive=True)
+        nu = r.number(b, key, "nu")
+        if not -1.0 < nu < 0.5:
+            r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
+        bodies.append((group, Elastic(E, nu)))
+
+    boundary = []
+    for i, b in enumerate(data.get("boundary", [])):
+        key = f"boundary.{i}"
+        b = r.table(b, key, KEYS["boundary"])
+        entry = Boundary(r.string(b, key, "group"), amplitude=r.amplitude(b, key))
+        kinds = [k for k in ("fix", "displacement", "traction", "pressure") if k in b]
+        if not kinds:
+            r.fail(key, "give one of fix, displacement, traction, pressure")
+        if "fix" in b:
+            fixv = b["fix"]
+            if not isinstance(fixv, list) or not fixv or any(c not in AXES for c in fixv):
+                r.fail(f"{key}.fix", f"expected a list of components among x, y, z, got {fixv!r}")
+            entry.fix = tuple(sorted({AXES.index(c) for c in fixv}))
+        if "displacement" in b:
+            disp = b["displacement"]
+            if not isinstance(disp, dict) or not disp or any(c not in AXES for c in disp):
+                r.fail(f"{key}.displacement", "expected a table of components, e.g. "
+                       f"{{ y = -0.01 }}, got {disp!r}")  # fmt: skip
+            entry.displacement = {AXES.index(c): r.number(disp, f"{key}.displacement", c)
+                                   for c in disp}  # fmt: skip
+            both = set(entry.fix) & set(entry.displacement)
+            if both:
+                r.fail(key, f"component {AXES[min(both)]} is both fixed and prescribed")
+        if "traction" in b:
+            t = b["traction"]
+            if not isinstance(t, list) or not all(isinstance(v, int | float) for v in t):
+                r.fail(f"{key}.traction", f"expected a list of numbers, got {t!r}")
+            entry.traction = np.asarray(t, dtype=np.float64)
+        if "pressure" in b:
+            entry.pressure = r.number(b, key, "pressure")
+        boundary.append(entry)
+
+    obstacle = data.get("obstacle")
+    contact_list = data.get("contact")
+    if obstacle is None and contact_list is None:
+        r.fail("obstacle", "a problem needs an [obstacle] or a [[contact]] pair")
+    if obstacle is not None and contact_list is not None:
+        r.fail("contact", "give an [obstacle] or a [[contact]] pair, not both (one contact "
+               "kind per problem)")  # fmt: skip
+    if obstacle is not None:
+        obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
+        obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
+        obstacle["contact"] = r.string(obstacle, "obstacle", "contact")
+        if obstacle["shape"] != "plane":
+            obstacle["radius"] = r.number(obstacle, "obstacle", "radius", positive=True)
+        obstacle["amplitude"] = r.amplitude(obstacle, "obstacle")
+    contact = None
+    if contact_list is not None:
+        if not isinstance(contact_list, list) or len(contact_list) != 1:
+            r.fail("contact", "expected one [[contact]] pair (slave, master)")
+        c = r.table(contact_list[0], "contact.0", KEYS["contact"])
+        contact = (r.string(c, "contact.0", "slave"), r.string(c, "contact.0", "master"))
+        if contact[0] == contact[1]:
+            r.fail("contact.0", "the slave and master surfaces of a pair must differ")
+        if len(bodies) != 2:
+            r.fail("bodies", f"a contact pair needs two bodies, got {len(bodies)}")
+    output = r.table(data.get("output", {}), "output", KEYS["output"])
+    reactions = output.get("reactions", [])
+    if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
+        r.fail("output.reactions", f"expected a list of group names, got {reactions!r}")
+    xdmf = output.get("xdmf", True)
+    if not isinstance(xdmf, bool):
+        r.fail("output.xdmf", f"expected true or false, got {xdmf!r}")
+    title = data.get("title", path.stem)
+    if not isinstance(title, str):
+        r.fail("title", f"expected a string, got {title!r}")
+
+    numerics = r.table(data.get("numerics", {}), "numerics",
+                       tuple(f.name for f in dataclasses.fields(Numerics)))  # fmt: skip
+    petsc = data.get("petsc", {})
+    if not isinstance(petsc, dict):
+        r.fail("petsc", f"expected a table of PETSc options, got {petsc!r}")
+    petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
+             for k, v in petsc.items()}  # fmt: skip
+    problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact,
+                          list(reactions), xdmf, title)  # fmt: skip
+    return problem, numerics, petsc
+
+
+def load_problem(path, sets: list[str] = ()):
+    """(scene, numerics, PETSc options) of the problem file ``path`` with the ``--set``
+    overrides; the mesh is read when the scene builds it (its groups are checked then)."""
+    path = Path(path)
+    problem, overrides, petsc = _read(path, list(sets))
+    try:
+        numerics = Numerics(**overrides)
+    except (TypeError, ValueError) as err:
+        msg = str(err).replace("--", "numerics.")
+        raise ProblemError(f"{path}: {msg}") from None
+    cls = FileTwoBodyScene if problem.contact is not None else FileObstacleScene
+    return cls(problem), numerics, petsc
+
+
+# -- the scenes -------------------------------------------------------------------------------
+
+
+class _FileMesh:
+    """What both file scenes share: the mesh and its named groups, the boundary conditions
+    and loads of the file, the reactions per group."""
+
+    symmetry = 1.0
+
+    def _init(self, problem: ProblemFile) -> None:
+        self.spec = problem
+        self.p = FileParams(problem=str(problem.path), size=problem.size)
+        # the name makes the output files and the PETSc options prefix
+        self.name = re.sub(r"[^A-Za-z0-9_-]", "_", problem.title)
+        self.summary = f"problem file {problem.path.name}"
+        self.reaction_rows: list[dict] = []
+        self._constants: list[tuple[dolfinx.fem.Constant, list, np.ndarray]] = []
+
+    def _fail(self, key: str, message: str):
+        raise ProblemError(f"{self.spec.path}: {key}: {message}")
+
+    def read_mesh(self, comm):
+        data, groups = build_file(comm, self.spec.mesh_file, self.spec.size, self.name)
+        self.groups = {g.name: g for g in groups}
+        self._mesh = data.mesh
+        self.gdim = max(g.dim for g in groups)
+        self.cell_tags = data.cell_tags
+        self._check_groups()
+        return data.mesh, data.facet_tags
+
+    def group_list(self) -> str:
+        return ", ".join(f"{g.name} ({g.dim}D)" for g in self.groups.values())
+
+    def tag(self, key: str, name: str, dim: int) -> int:
+        g = self.groups.get(name)
+        if g is None:
+            self._fail(key, f"no physical group '{name}' in {self.spec.mesh_file.name} (it "
+                       f"has: {self.group_list()})")  # fmt: skip
+        if g.dim != dim:
+            what = "cells (a body)" if dim == self.gdim else "facets (a boundary)"
+            self._fail(key, f"group '{name}' has dimension {g.dim}, expected {dim}: {what}")
+        if g.elements == 0:
+            self._fail(key, f"group '{name}' has no element")
+        return g.tag
+
+    def _check_groups(self) -> None:
+        pb, fdim = self.spec, self.gdim - 1
+        self.body_tags = [self.tag(f"bodies.{i}.group", g, self.gdim)
+                          for i, (g, _) in enumerate(pb.bodies)]  # fmt: skip
+        for i, b in enumerate(pb.boundary):
+            self.tag(f"boundary.{i}.group", b.group, fdim)
+            comps = [*b.fix, *b.displacement]
+            if any(c >= self.gdim for c in comps):
+                self._fail(f"boundary.{i}", f"component z in a {self.gdim}D problem")
+            if b.traction is not None and len(b.traction) != self.gdim:
+                self._fail(f"boundary.{i}.traction", f"expected {self.gdim} numbers")
+        if pb.obstacle is not None and not any(b.fix or b.displacement for b in pb.boundary):
+            self._fail("boundary", "the body has no support (fix or displacement on a group): "
+                       "frictionless contact alone leaves it free to slide, the solve would be "
+                       "singular")  # fmt: skip
+        for i, g in enumerate(pb.reactions):
+            self.tag(f"output.reactions.{i}", g, fdim)
+
+    # -- supports and loads -----------------------------------------------------------------
+    def dirichlet(self, V, facet_tags) -> list:
+        bcs = []
+        for b in self.spec.boundary:
+            tag = self.groups[b.group].tag
+            bcs += [fix_component(V, facet_tags, tag, c) for c in b.fix]
+            for c, value in b.displacement.items():
+                const = dolfinx.fem.Constant(V.mesh, 0.0)
+                self._constants.append((const, b.amplitude, np.array(value)))
+                bcs.append(prescribe_component(V, facet_tags, tag, c, const))
+        return bcs
+
+    def load(self, v, ds, t):
+        L = None
+        for b in self.spec.boundary:
+            if b.traction is None and b.pressure is None:
+                continue
+            amp = dolfinx.fem.Constant(self._mesh, 0.0)
+            self._constants.append((amp, b.amplitude, np.array(1.0)))
+            term = 0
+            if b.traction is not None:
+                term = ufl.dot(ufl.as_vector(b.traction.tolist()), v)
+            if b.pressure is not None:  # a pressure pushes into the body: -p n
+                term = term - b.pressure * ufl.dot(ufl.FacetNormal(self._mesh), v)
+            form = amp * term * ds(self.groups[b.group].tag)
+            L = form if L is None else L + form
+        return L
+
+    def set_load(self, t: float) -> None:
+        for const, table, value in self._constants:
+            const.value = value * _amplitude(table, t)
+
+    def h_contact(self) -> float:
+        return self._h
+
+    def contact_size(self, measure: float) -> float:
+        """The contact half-width (2D) or the radius of the disc of the same area (3D)."""
+        return 0.5 * measure if self.gdim == 2 else float(np.sqrt(measure / np.pi))
+
+    def _facet_size(self, mesh, facet_tags, tags: list[int]) -> float:
+        """The longest edge of the facets of the groups ``tags`` (all ranks)."""
+        fdim = mesh.topology.dim - 1
+        mesh.topology.create_connectivity(fdim, 0)
+        f2v = mesh.topology.connectivity(fdim, 0)
+        V = _compat.function_space(mesh, "Lagrange", 1)
+        X = _compat.dof_coordinates(V)
+        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+        mesh.topology.create_connectivity(mesh.topology.dim, 0)
+        f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
+        c2v = mesh.topology.connectivity(mesh.topology.dim, 0)
+        h = 0.0
+        for f in facet_tags.indices[np.isin(facet_tags.values, tags)]:
+            c = f2c.links(f)[0]
+            dofs, verts = V.dofmap.cell_dofs(c), c2v.links(c)
+            pts = X[[dofs[np.flatnonzero(verts == v)[0]] for v in f2v.links(f)]]
+            for i in range(len(pts)):
+                for j in range(i):
+                    h = max(h, float(np.linalg.norm(pts[i] - pts[j])))
+        return mesh.comm.allreduce(h, op=MPI.MAX)
+
+    # -- reactions -----------------------------------------------------------------------
+    def on_step(self, problem, solver, load: float) -> None:
+        """Reaction force of each group of ``output.reactions``: the sum over the group's
+        owned dofs of -(K u - b), the bulk's internal minus external forces (the force the
+        support exerts on the body), per component."""
+        if not self.spec.reactions:
+            return
+        r = solver.K.createVecLeft()
+        solver.K.mult(_compat.petsc_vec(problem.state), r)
+        r.axpy(-1.0, solver.b)
+        values = r.getArray()
+        n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
+        row = {"load": load}
+        for g in self.spec.reactions:
+            facets = self._facet_tags.indices[self._facet_tags.values == self.groups[g].tag]
+            for c in range(self.gdim):
+                dofs = np.asarray(
+                    _compat.locate_dofs_topological(problem.V.sub(c), self.gdim - 1, facets)
+                )
+                owned = dofs[dofs < n_owned]
+                total = -float(np.sum(values[owned]))
+                row[f"{g}_{AXES[c]}"] = problem.mesh.comm.allreduce(total, op=MPI.SUM)
+        r.destroy()
+        self.reaction_rows.append(row)
+
+
+class FileObstacleScene(_FileMesh, ObstacleScene):
+    """A problem file with a rigid obstacle."""
+
+    Params = FileParams
+
+    def __init__(self, problem: ProblemFile) -> None:
+        self._init(problem)
+
+    def build_mesh(self, comm):
+        mesh, facet_tags = self.read_mesh(comm)
+        self._facet_tags = facet_tags
+        ob = self.spec.obstacle
+        self.contact_tag = self.tag("obstacle.contact", ob["contact"], self.gdim - 1)
+        if ob["shape"] in ("circle", "cylinder") and self.gdim != 2:
+            self._fail("obstacle.shape", f"{ob['shape']} is a 2D obstacle (in 3D: sphere)")
+        if ob["shape"] == "sphere" and self.gdim != 3:
+            self._fail("obstacle.shape", "sphere is a 3D obstacle (in 2D: circle)")
+        r = _Reader(self.spec.path)
+        zero = [0.0] * self.gdim
+        self.position = r.vector(ob, "obstacle", "position", self.gdim, zero)
+        self.motion = r.vector(ob, "obstacle", "motion", self.gdim, zero)
+        self._h = self._facet_size(mesh, facet_tags, [self.contact_tag])
+        if len(self.spec.bodies) > 1 and len({m.nu for _, m in self.spec.bodies}) > 1:
+            self._fail("bodies", "bodies of different nu against an obstacle are not supported "
+                       "(one nu, E per body)")  # fmt: skip
+        return mesh, facet_tags
+
+    def material(self) -> Elastic:
+        return self.spec.bodies[0][1]
+
+    def modulus(self, mesh):
+        if len(self.spec.bodies) == 1:
+            return None
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        E = dolfinx.fem.Function(DG0)
+        for tag, (_, mat) in zip(self.body_tags, self.spec.bodies, strict=True):
+            cells = self.cell_tags.indices[self.cell_tags.values == tag]
+            E.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = mat.E
+        E.x.scatter_forward()
+        return E
+
+    def contact_modulus(self) -> float:
+        return max(m.E for _, m in self.spec.bodies)
+
+    def obstacle(self) -> Obstacle:
+        ob = self.spec.obstacle
+        if ob["shape"] == "plane":
+            return HalfSpace(0.0)
+        return Ball(ob["radius"])
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return self.position + self.motion * _amplitude(self.spec.obstacle["amplitude"], t)
+
+
+class FileTwoBodyScene(_FileMesh, TwoBodyScene):
+    """A problem file with a contact pair between two bodies."""
+
+    Params = FileParams
+
+    def __init__(self, problem: ProblemFile) -> None:
+        self._init(problem)
+
+    def build_mesh(self, comm):
+        mesh, facet_tags = self.read_mesh(comm)
+        self._facet_tags = facet_tags
+        slave, master = self.spec.contact
+        fdim = self.gdim - 1
+        self._slave = self.tag("contact.0.slave", slave, fdim)
+        self._master = self.tag("contact.0.master", master, fdim)
+        self.cells = {g: t for (g, _), t in zip(self.spec.bodies, self.body_tags,
+                                                strict=True)}  # fmt: skip
+        self._h = self._facet_size(mesh, facet_tags, [self._slave, self._master])
+        return mesh, facet_tags
+
+    # (before the mesh is read the tags are unknown; the file's names were checked distinct)
+    @property
+    def slave_tag(self) -> int:
+        return getattr(self, "_slave", -1)
+
+    @property
+    def master_tag(self) -> int:
+        return getattr(self, "_master", -2)
+
+    @property
+    def slave_is_upper(self) -> bool:
+        return True
+
+    def materials(self) -> dict[str, Elastic]:
+        return dict(self.spec.bodies)
+
+    def material(self) -> Elastic:
+        return max((m for _, m in self.spec.bodies), key=lambda m: m.E)

@@ -1,0 +1,34 @@
+// A block pressed onto a wider plinth: two bodies meshed independently (their contact lines
+// share no node: different element sizes), 2D plane strain.
+hl = 0.05;    // plinth, along its top
+hu = 0.035;   // block
+Point(1) = {-1, 0, 0, 0.2};
+Point(2) = {1, 0, 0, 0.2};
+Point(3) = {1, 1, 0, hl * 2};
+Point(4) = {-1, 1, 0, hl * 2};
+Point(5) = {-0.4, 1, 0, hl};
+Point(6) = {0.4, 1, 0, hl};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 6};
+Line(4) = {6, 5};
+Line(5) = {5, 4};
+Line(6) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4, 5, 6};
+Plane Surface(1) = {1};
+Point(11) = {-0.3, 1, 0, hu};
+Point(12) = {0.3, 1, 0, hu};
+Point(13) = {0.3, 1.4, 0, hu * 2};
+Point(14) = {-0.3, 1.4, 0, hu * 2};
+Line(11) = {11, 12};
+Line(12) = {12, 13};
+Line(13) = {13, 14};
+Line(14) = {14, 11};
+Curve Loop(2) = {11, 12, 13, 14};
+Plane Surface(2) = {2};
+Physical Surface("plinth") = {1};
+Physical Surface("block") = {2};
+Physical Curve("plinth_bottom") = {1};
+Physical Curve("plinth_top") = {3, 4, 5};
+Physical Curve("block_bottom") = {11};
+Physical Curve("block_top") = {13};

@@ -1,0 +1,147 @@
+"""Problem files (contactfx solve): the demos of demos/problems solve and balance their
+reactions against the contact force; 1 and 2 ranks agree; bad files fail with one error naming
+the file and the key."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mpi4py import MPI
+
+from contactfx.scenes.problem_file import load_problem
+
+DEMOS = Path(__file__).resolve().parents[2] / "demos" / "problems"
+
+
+def _solve(name: str, comm=MPI.COMM_WORLD, sets=()):
+    scene, numerics, petsc = load_problem(DEMOS / name, list(sets))
+    res = scene.run(numerics, comm=comm, petsc_options=petsc, verbose=False)
+    return scene, res
+
+
+@pytest.mark.parametrize("name, radius", [("holed-pad.toml", 2.0), ("bored-block.toml", 1.0)])
+def test_obstacle_problem_reaction_balances_contact_force(name, radius):
+    scene, res = _solve(name)
+    d = "xyz"[scene.gdim - 1]
+    reaction = scene.reaction_rows[-1][f"bottom_{d}"]
+    assert res.force > 0.0
+    # the support carries the whole contact force. The contact force is the integral of the
+    # normal pressure, the reaction its vertical component: on the obstacle's surface the
+    # normal tilts by at most a / R from the vertical, so they differ by at most
+    # 1 - cos(a / R) <= (a / R)^2 / 2 (plus the solver tolerance)
+    tol = 0.5 * (res.contact_size / radius) ** 2 + 1e-8
+    assert abs(reaction + res.force) <= tol * res.force
+
+
+def test_contact_pair_problem_reactions_balance():
+    scene, res = _solve("block-on-plinth.toml")
+    row = scene.reaction_rows[-1]
+    bottom, top = row["plinth_bottom_y"], row["block_top_y"]
+    # the two bodies' supports balance each other: every residual row vanishes to the solver
+    # tolerance (snes_rtol 1e-10 of the initial residual)
+    assert abs(bottom + top) <= 1e-8 * abs(top)
+    # and carry the pair's force: the mortar force sums the nominal nodal pressures (reference
+    # surface), the reactions the current tractions; they differ by the surface strain, at most
+    # the approach over the block height, 0.004 / 0.4 = 1e-2 (measured 2e-6)
+    assert abs(top - res.force) <= 1e-2 * res.force
+    assert res.force > 0.0
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
+@pytest.mark.parametrize("name", ["holed-pad.toml", "block-on-plinth.toml"])
+def test_problem_file_ranks_agree(name):
+    _, parallel = _solve(name)
+    _, serial = _solve(name, comm=MPI.COMM_SELF)
+    # the same discrete problem solved to snes_rtol 1e-10: forces agree to 1e-8
+    assert parallel.force == pytest.approx(serial.force, rel=1e-8)
+    assert parallel.contact_size == pytest.approx(serial.contact_size, rel=1e-8)
+
+
+def test_set_overrides_a_key():
+    scene, res = _solve("holed-pad.toml", sets=["obstacle.motion=[0.0, -0.005]",
+                                                "numerics.steps=1"])  # fmt: skip
+    _, full = _solve("holed-pad.toml", sets=["numerics.steps=1"])
+    assert len(res.steps) == 1
+    # half the indentation: a smaller force (Hertz-like growth, faster than linear)
+    assert 0.2 * full.force < res.force < 0.5 * full.force
+
+
+def _write(tmp_path: Path, text: str) -> Path:
+    (tmp_path / "holed-pad.geo").write_text((DEMOS / "holed-pad.geo").read_text())
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    return path
+
+
+GOOD = (DEMOS / "holed-pad.toml").read_text()
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t + "\n[solver]\nx = 1\n", "solver: unknown section"),
+    (lambda t: t.replace('nu = 0.3', 'nu = 0.5'), "bodies.0.nu: Poisson's ratio"),
+    (lambda t: t.replace('E = 1000.0', 'E = -1.0'), "bodies.0.E: must be > 0"),
+    (lambda t: t.replace('E = 1000.0', 'E = "soft"'), "bodies.0.E: expected a number"),
+    (lambda t: t.replace('fix = ["x", "y"]', 'fix = ["x", "w"]'), "boundary.0.fix"),
+    (lambda t: t.replace('radius = 2.0', 'radius = 2.0\ncolour = 1'), "obstacle.colour: unknown"),
+    (lambda t: t.replace('method = "nitsche"', 'method = "magic"'), "numerics.method"),
+    (lambda t: t.replace('steps = 2', 'steps = 2\nspeed = 1'), "numerics.speed: unknown"),
+    (lambda t: t.replace("holed-pad.geo", "nowhere.geo"), "nowhere.geo' not found"),
+    (lambda t: t.replace('shape = "cylinder"', 'shape = "cone"'), "obstacle.shape: must be one"),
+    (lambda t: t.replace('[obstacle]', '[nothing]'), "nothing: unknown section"),
+    (lambda t: t.replace('fix = ["x", "y"]', 'traction = [0.0, -1.0]'), "boundary: the body has no "
+     "support"),
+])  # fmt: skip
+def test_bad_problem_files(tmp_path, edit, message):
+    path = _write(tmp_path, edit(GOOD))
+    with pytest.raises((ValueError, OSError)) as err:
+        scene, _, _ = load_problem(path)
+        scene.build_mesh(MPI.COMM_SELF)
+    assert message in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace('group = "bottom"', 'group = "base"'),
+     "boundary.0.group: no physical group 'base' in holed-pad.geo (it has: bottom (1D), top"),
+    (lambda t: t.replace('group = "bottom"', 'group = "pad"'),
+     "boundary.0.group: group 'pad' has dimension 2, expected 1"),
+    (lambda t: t.replace('group = "pad"', 'group = "top"'),
+     "bodies.0.group: group 'top' has dimension 1, expected 2"),
+    (lambda t: t.replace('contact = "top"', 'contact = "hull"'), "obstacle.contact: no physical"),
+])  # fmt: skip
+def test_problem_file_groups_checked_against_the_mesh(tmp_path, edit, message):
+    scene, _, _ = load_problem(_write(tmp_path, edit(GOOD)))
+    with pytest.raises(ValueError) as err:
+        scene.build_mesh(MPI.COMM_SELF)
+    assert message in str(err.value)
+
+
+def test_bad_set():
+    with pytest.raises(ValueError, match="--set expects key=value"):
+        load_problem(DEMOS / "holed-pad.toml", ["numerics.steps"])
+    with pytest.raises(ValueError, match="numerics.steps must be > 0"):
+        load_problem(DEMOS / "holed-pad.toml", ["numerics.steps=0"])
+
+
+@pytest.mark.serial_only
+def test_cli_check_solve_and_bad_file(tmp_path, capsys):
+    from contactfx.cli import main
+
+    assert main(["check", str(DEMOS / "holed-pad.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "valid" in out and "boundary   bottom: fixed x,y" in out
+    assert main(["solve", str(DEMOS / "holed-pad.toml"), "--set", "numerics.steps=1",
+                 "--out", str(tmp_path / "res"), "--quiet"]) == 0  # fmt: skip
+    out = capsys.readouterr().out
+    assert "reaction on bottom" in out
+    rows = (tmp_path / "res" / "reactions.csv").read_text().splitlines()
+    assert rows[0] == "load,bottom_x,bottom_y" and len(rows) == 2
+    assert (tmp_path / "res" / "run.json").is_file()
+    bad = _write(tmp_path, GOOD.replace('group = "bottom"', 'group = "base"'))
+    assert main(["solve", str(bad), "--out", str(tmp_path / "bad")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no physical group 'base'" in err[0]
+    assert not (tmp_path / "bad" / "run.json").exists()
