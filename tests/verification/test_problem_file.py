@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from mpi4py import MPI
 
@@ -31,7 +32,7 @@ def test_obstacle_problem_reaction_balances_contact_force(name, radius):
     # normal tilts by at most a / R from the vertical, so they differ by at most
     # 1 - cos(a / R) <= (a / R)^2 / 2 (plus the solver tolerance)
     tol = 0.5 * (res.contact_size / radius) ** 2 + 1e-8
-    assert abs(reaction + res.force) <= tol * res.force
+    assert abs(reaction - res.force) <= tol * res.force
 
 
 def test_contact_pair_problem_reactions_balance():
@@ -41,10 +42,10 @@ def test_contact_pair_problem_reactions_balance():
     # the two bodies' supports balance each other: every residual row vanishes to the solver
     # tolerance (snes_rtol 1e-10 of the initial residual)
     assert abs(bottom + top) <= 1e-8 * abs(top)
-    # and carry the pair's force: the mortar force sums the nominal nodal pressures (reference
+    # and carry the pair's force (the plinth's support pushes up): the mortar force sums the nominal nodal pressures (reference
     # surface), the reactions the current tractions; they differ by the surface strain, at most
     # the approach over the block height, 0.004 / 0.4 = 1e-2 (measured 2e-6)
-    assert abs(top - res.force) <= 1e-2 * res.force
+    assert abs(bottom - res.force) <= 1e-2 * res.force
     assert res.force > 0.0
 
 
@@ -145,3 +146,47 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no physical group 'base'" in err[0]
     assert not (tmp_path / "bad" / "run.json").exists()
+
+
+@pytest.mark.parametrize("load, per_length", [("traction = [0.0, -2.0]", 2.0),
+                                              ("pressure = 3.0", 3.0)])  # fmt: skip
+def test_loads_and_amplitude_reach_the_support(tmp_path, load, per_length):
+    """No contact (the obstacle stays 1 above the pad): the bottom carries the load on the top
+    (length 2) scaled by the amplitude table at each step, exactly (to solver tolerance)."""
+    text = GOOD.replace("position = [0.0, 1.0]", "position = [0.0, 2.0]").replace(
+        '[obstacle]',
+        f'[[boundary]]\ngroup = "top"\n{load}\namplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 0.5]]'
+        '\n\n[obstacle]')  # fmt: skip
+    path = _write(tmp_path, text)  # (each rank has its own tmp_path)
+    scene, numerics, petsc = load_problem(path)
+    res = scene.run(numerics, petsc_options=petsc, verbose=False)
+    assert res.force == 0.0
+    ys = [row["bottom_y"] for row in scene.reaction_rows]
+    xs = [row["bottom_x"] for row in scene.reaction_rows]
+    # amplitude 1 at load 0.5, 0.5 at load 1; the reaction pushes up (+y)
+    assert ys == pytest.approx([2.0 * per_length, 1.0 * per_length], rel=1e-9)
+    assert np.max(np.abs(xs)) <= 1e-9 * per_length
+
+
+@pytest.mark.serial_only
+def test_msh_file_gives_the_geo_result(tmp_path):
+    """The .geo meshed by gmsh and written as .msh: the same mesh, the same solution."""
+    import gmsh
+
+    _write(tmp_path, GOOD)
+    gmsh.initialize(readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.merge(str(tmp_path / "holed-pad.geo"))
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(tmp_path / "pad.msh"))
+    finally:
+        gmsh.finalize()
+    msh = tmp_path / "msh.toml"
+    msh.write_text(GOOD.replace('file = "holed-pad.geo"', 'file = "pad.msh"'))
+    scene, numerics, petsc = load_problem(msh, ["numerics.steps=1"])
+    res = scene.run(numerics, comm=MPI.COMM_SELF, petsc_options=petsc, verbose=False)
+    scene, numerics, petsc = load_problem(tmp_path / "p.toml", ["numerics.steps=1"])
+    ref = scene.run(numerics, comm=MPI.COMM_SELF, petsc_options=petsc, verbose=False)
+    assert res.dofs == ref.dofs
+    assert res.force == pytest.approx(ref.force, rel=1e-10)
