@@ -484,9 +484,10 @@ class _FileMesh:
 
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float) -> None:
-        """Reaction force of each group of ``output.reactions``: the sum over the group's
-        owned dofs of -(K u - b), the bulk's internal minus external forces (the force the
-        support exerts on the body), per component."""
+        """Reaction force of each group of ``output.reactions``: the force the supports exert
+        on the body there, per component. At a solution K u = b + R with R nonzero on the
+        supported dofs only, so R is the bulk residual K u - b summed over the group's owned
+        dofs."""
         if not self.spec.reactions:
             return
         r = solver.K.createVecLeft()
@@ -502,7 +503,7 @@ class _FileMesh:
                     _compat.locate_dofs_topological(problem.V.sub(c), self.gdim - 1, facets)
                 )
                 owned = dofs[dofs < n_owned]
-                total = -float(np.sum(values[owned]))
+                total = float(np.sum(values[owned]))
                 row[f"{g}_{AXES[c]}"] = problem.mesh.comm.allreduce(total, op=MPI.SUM)
         r.destroy()
         self.reaction_rows.append(row)
