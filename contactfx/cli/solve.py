@@ -53,7 +53,7 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         for g, values in _last_reactions(scene).items():
             print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
         if written:
-            print(f"  reactions: {written}")
+            print(f"  forces per step: {written} (and history.png)")
         if res.xdmf:
             print(f"  ParaView: {res.xdmf}")
             print(f"  summary:  {Path(res.xdmf).parent / 'run.json'}")
@@ -64,22 +64,45 @@ def _last_reactions(scene) -> dict[str, list[float]]:
     if not scene.reaction_rows:
         return {}
     row = scene.reaction_rows[-1]
-    return {g: [v for k, v in row.items() if k.startswith(g + "_")]
-            for g in scene.spec.reactions}  # fmt: skip
+    return {g: [row[f"{g}_{c}"] for c in "xyz"[: scene.gdim]] for g in scene.spec.reactions}
 
 
 def _write_reactions(scene, out: Path, comm) -> Path | None:
-    """reactions.csv: the load factor and each group's reaction components per step."""
-    if not scene.reaction_rows:
+    """history.csv: per step the load factor, the contact force and each group's reaction
+    components; history.png: them against the load factor."""
+    rows = scene.reaction_rows
+    if not rows:
         return None
-    path = out / "reactions.csv"
+    path = out / "history.csv"
     if comm.rank == 0:
         with path.open("w", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(scene.reaction_rows[0]))
+            writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
             writer.writeheader()
-            writer.writerows(scene.reaction_rows)
+            writer.writerows(rows)
+        _plot_history(rows, out / "history.png", scene.name)
     comm.barrier()
     return path
+
+
+def _plot_history(rows: list[dict], path: Path, title: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    loads = [0.0] + [r["load"] for r in rows]
+    for key in rows[0]:
+        if key != "load":
+            ax.plot(loads, [0.0] + [r[key] for r in rows], "o-", label=key)
+    ax.set_xlabel("load factor")
+    ax.set_ylabel("force")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:

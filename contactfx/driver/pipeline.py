@@ -131,7 +131,7 @@ class _Run:
 
             def on_step(rec: StepRecord) -> None:
                 quantities = post.evaluate(solver)
-                self.scene.on_step(problem, solver, rec.load)
+                self.scene.on_step(problem, solver, rec.load, quantities)
                 s = rec.stats
                 steps.append(StepLog(rec.step, rec.load, s.newton, s.ksp, s.outer,
                                      rec.cutbacks, s.reason, quantities))  # fmt: skip

@@ -86,9 +86,9 @@ class Scene:
         """Set the load program's constants (prescribed displacements, load amplitudes) for
         load factor t."""
 
-    def on_step(self, problem, solver, load: float) -> None:
-        """Called at every converged load step (after the post-processor's evaluation), e.g.
-        to record reactions."""
+    def on_step(self, problem, solver, load: float, quantities) -> None:
+        """Called at every converged load step with its contact quantities
+        (:class:`contactfx.results.Quantities`), e.g. to record reactions."""
 
     @classmethod
     def default_numerics(cls, **overrides) -> Numerics:

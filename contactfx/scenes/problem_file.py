@@ -38,7 +38,7 @@ group or a contact pair between two bodies; then the numerics, PETSc options and
     snes_monitor = ""
 
     [output]
-    reactions = ["bottom"]             # reaction force per group and step: reactions.csv
+    reactions = ["bottom"]             # reaction per group and step: history.csv
 
 Groups are the gmsh physical names. Everything is validated before anything is computed: an
 unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error
@@ -483,19 +483,21 @@ class _FileMesh:
         return mesh.comm.allreduce(h, op=MPI.MAX)
 
     # -- reactions -----------------------------------------------------------------------
-    def on_step(self, problem, solver, load: float) -> None:
-        """Reaction force of each group of ``output.reactions``: the force the supports exert
+    def on_step(self, problem, solver, load: float, quantities) -> None:
+        """The step's contact force and the reaction force of each group of
+        ``output.reactions``: the force the supports exert
         on the body there, per component. At a solution K u = b + R with R nonzero on the
         supported dofs only, so R is the bulk residual K u - b summed over the group's owned
         dofs."""
+        row = {"load": load, "contact_force": quantities.force}
         if not self.spec.reactions:
+            self.reaction_rows.append(row)
             return
         r = solver.K.createVecLeft()
         solver.K.mult(_compat.petsc_vec(problem.state), r)
         r.axpy(-1.0, solver.b)
         values = r.getArray()
         n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
-        row = {"load": load}
         for g in self.spec.reactions:
             facets = self._facet_tags.indices[self._facet_tags.values == self.groups[g].tag]
             for c in range(self.gdim):

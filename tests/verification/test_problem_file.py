@@ -42,8 +42,8 @@ def test_contact_pair_problem_reactions_balance():
     # the two bodies' supports balance each other: every residual row vanishes to the solver
     # tolerance (snes_rtol 1e-10 of the initial residual)
     assert abs(bottom + top) <= 1e-8 * abs(top)
-    # and carry the pair's force (the plinth's support pushes up): the mortar force sums the nominal nodal pressures (reference
-    # surface), the reactions the current tractions; they differ by the surface strain, at most
+    # and carry the pair's force (the plinth's support pushes up): the mortar force sums the
+    # nominal nodal pressures (reference surface), the reactions the current tractions; they differ by the surface strain, at most
     # the approach over the block height, 0.004 / 0.4 = 1e-2 (measured 2e-6)
     assert abs(bottom - res.force) <= 1e-2 * res.force
     assert res.force > 0.0
@@ -138,8 +138,9 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
                  "--out", str(tmp_path / "res"), "--quiet"]) == 0  # fmt: skip
     out = capsys.readouterr().out
     assert "reaction on bottom" in out
-    rows = (tmp_path / "res" / "reactions.csv").read_text().splitlines()
-    assert rows[0] == "load,bottom_x,bottom_y" and len(rows) == 2
+    rows = (tmp_path / "res" / "history.csv").read_text().splitlines()
+    assert rows[0] == "load,contact_force,bottom_x,bottom_y" and len(rows) == 2
+    assert (tmp_path / "res" / "history.png").is_file()
     assert (tmp_path / "res" / "run.json").is_file()
     bad = _write(tmp_path, GOOD.replace('group = "bottom"', 'group = "base"'))
     assert main(["solve", str(bad), "--out", str(tmp_path / "bad")]) == 1
