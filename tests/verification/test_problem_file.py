@@ -43,8 +43,9 @@ def test_contact_pair_problem_reactions_balance():
     # tolerance (snes_rtol 1e-10 of the initial residual)
     assert abs(bottom + top) <= 1e-8 * abs(top)
     # and carry the pair's force (the plinth's support pushes up): the mortar force sums the
-    # nominal nodal pressures (reference surface), the reactions the current tractions; they differ by the surface strain, at most
-    # the approach over the block height, 0.004 / 0.4 = 1e-2 (measured 2e-6)
+    # nominal nodal pressures (reference surface), the reactions the current tractions; they
+    # differ by the surface strain, at most the approach over the block height,
+    # 0.004 / 0.4 = 1e-2 (measured 2e-6)
     assert abs(bottom - res.force) <= 1e-2 * res.force
     assert res.force > 0.0
 
