@@ -50,6 +50,9 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
     written = _write_reactions(scene, out, comm)
     if comm.rank == 0:
         print(table(res))
+        if res.interface is not None:
+            for key, value in res.interface.extra.items():
+                print(f"  {key.replace('_', ' '):<42s}  {value:.6g}")
         for g, values in _last_reactions(scene).items():
             print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
         if written:

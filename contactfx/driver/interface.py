@@ -156,6 +156,7 @@ class InterfaceProblem(Problem):
     # -- load program --------------------------------------------------------------------------
     def apply_load(self, t: float) -> None:
         self.tload.value = t
+        self.scene.set_load(t)
         if self.fluid is not None:
             self.fluid.value = t * self.fluid_value
 

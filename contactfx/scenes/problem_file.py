@@ -73,19 +73,21 @@ from contactfx.numerics import Numerics
 from contactfx.params import Params, param
 from contactfx.scenes._common import fix_component, prescribe_component
 from contactfx.scenes.base import ObstacleScene
+from contactfx.scenes.interface_base import InterfaceScene
 from contactfx.scenes.two_body_base import TwoBodyScene
 
 __all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
 
 AXES = ("x", "y", "z")
-SECTIONS = ("title", "mesh", "bodies", "boundary", "obstacle", "contact", "numerics", "petsc",
-            "output")  # fmt: skip
+SECTIONS = ("title", "mesh", "bodies", "boundary", "obstacle", "contact", "interface",
+            "numerics", "petsc", "output")  # fmt: skip
 KEYS = {
     "mesh": ("file", "size"),
     "bodies": ("group", "E", "nu"),
     "boundary": ("group", "fix", "displacement", "traction", "pressure", "amplitude"),
     "obstacle": ("shape", "contact", "radius", "position", "motion", "amplitude"),
     "contact": ("slave", "master"),
+    "interface": ("group", "fluid_pressure"),
     "output": ("xdmf", "reactions"),
 }
 SHAPES = ("plane", "circle", "cylinder", "sphere")
@@ -229,6 +231,7 @@ class ProblemFile:
     boundary: list[Boundary]
     obstacle: dict | None
     contact: tuple[str, str] | None
+    interface: dict | None
     reactions: list[str]
     xdmf: bool
     title: str
@@ -300,11 +303,24 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
 
     obstacle = data.get("obstacle")
     contact_list = data.get("contact")
-    if obstacle is None and contact_list is None:
-        r.fail("obstacle", "a problem needs an [obstacle] or a [[contact]] pair")
-    if obstacle is not None and contact_list is not None:
-        r.fail("contact", "give an [obstacle] or a [[contact]] pair, not both (one contact "
-               "kind per problem)")  # fmt: skip
+    interface = data.get("interface")
+    given = [k for k in ("obstacle", "contact", "interface") if data.get(k) is not None]
+    if not given:
+        r.fail("obstacle", "a problem needs an [obstacle], a [[contact]] pair or an [interface]")
+    if len(given) > 1:
+        r.fail(given[1], "give one of [obstacle], [[contact]], [interface], not "
+               f"{' and '.join(given)} (one contact kind per problem)")  # fmt: skip
+    if interface is not None:
+        interface = dict(r.table(interface, "interface", KEYS["interface"]))
+        interface["group"] = r.string(interface, "interface", "group")
+        if "fluid_pressure" in interface:
+            interface["fluid_pressure"] = r.number(interface, "interface", "fluid_pressure")
+        if len(bodies) != 1:
+            r.fail("bodies", f"an interface lies inside one body, got {len(bodies)} bodies")
+        for i, b in enumerate(boundary):
+            if b.displacement:
+                r.fail(f"boundary.{i}.displacement", "prescribed displacements are not offered "
+                       "with an [interface] yet (fix, traction, pressure are)")  # fmt: skip
     if obstacle is not None:
         obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
         obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
@@ -340,7 +356,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         r.fail("petsc", f"expected a table of PETSc options, got {petsc!r}")
     petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
              for k, v in petsc.items()}  # fmt: skip
-    problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact,
+    problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
                           list(reactions), xdmf, title)  # fmt: skip
     return problem, numerics, petsc
 
@@ -355,7 +371,13 @@ def load_problem(path, sets: list[str] = ()):
     except (TypeError, ValueError) as err:
         msg = str(err).replace("--", "numerics.")
         raise ProblemError(f"{path}: {msg}") from None
-    cls = FileTwoBodyScene if problem.contact is not None else FileObstacleScene
+    cls = (
+        FileTwoBodyScene
+        if problem.contact is not None
+        else FileInterfaceScene
+        if problem.interface is not None
+        else FileObstacleScene
+    )
     return cls(problem), numerics, petsc
 
 
@@ -415,7 +437,7 @@ class _FileMesh:
                 self._fail(f"boundary.{i}", f"component z in a {self.gdim}D problem")
             if b.traction is not None and len(b.traction) != self.gdim:
                 self._fail(f"boundary.{i}.traction", f"expected {self.gdim} numbers")
-        if pb.obstacle is not None and not any(b.fix or b.displacement for b in pb.boundary):
+        if pb.contact is None and not any(b.fix or b.displacement for b in pb.boundary):
             self._fail("boundary", "the body has no support (fix or displacement on a group): "
                        "frictionless contact alone leaves it free to slide, the solve would be "
                        "singular")  # fmt: skip
@@ -603,3 +625,111 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
 
     def material(self) -> Elastic:
         return max((m for _, m in self.spec.bodies), key=lambda m: m.E)
+
+
+class FileInterfaceScene(_FileMesh, InterfaceScene):
+    """A problem file with a straight fitted interface (a crack, a fracture with fluid
+    pressure) on an interior facet group of one body, in 2D. The interface's line, its sides
+    and its tips (the group's end points that are not on the body's boundary) are read from
+    the mesh; ``crack_volume`` reports the integral of the opening along it."""
+
+    Params = FileParams
+
+    def __init__(self, problem: ProblemFile) -> None:
+        self._init(problem)
+
+    def build_mesh(self, comm):
+        mesh, facet_tags = self.read_mesh(comm)
+        self._facet_tags = facet_tags
+        if self.gdim != 2:
+            self._fail("interface", "interfaces in problem files are 2D (plane strain) for now")
+        self.interface_tag = self.tag("interface.group", self.spec.interface["group"], 1)
+        segments = self._segments(mesh, facet_tags, [self.interface_tag])
+        pts = segments.reshape(-1, 2)
+        lo, hi = mesh.geometry.x[:, :2].min(axis=0), mesh.geometry.x[:, :2].max(axis=0)
+        lo = np.min(comm.allgather(lo), axis=0)
+        hi = np.max(comm.allgather(hi), axis=0)
+        self._length = float(np.linalg.norm(hi - lo))
+        centre = pts.mean(axis=0)
+        _, _, vt = np.linalg.svd(pts - centre)
+        self._origin, self._dir = centre, vt[0]
+        self._normal = np.array([-vt[0][1], vt[0][0]])
+        off = np.abs((pts - centre) @ self._normal).max()
+        if off > 1e-8 * self._length:
+            self._fail("interface.group", f"the group '{self.spec.interface['group']}' is not "
+                       f"straight ({off:.3g} off its line): curved interfaces are not offered "
+                       "yet")  # fmt: skip
+        tol = 1e-9 * self._length
+        keys = np.round(pts / tol).astype(np.int64)
+        uniq, count = np.unique(keys, axis=0, return_counts=True)
+        ends = uniq[count == 1] * tol
+        fdim = mesh.topology.dim - 1
+        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+        exterior = _compat_exterior(mesh)
+        outer = self._segments(mesh, None, exterior).reshape(-1, 2)
+        self._tips = [e for e in ends
+                      if not np.any(np.linalg.norm(outer - e, axis=1) < 1e3 * tol)]  # fmt: skip
+        self._h = self._facet_size(mesh, facet_tags, [self.interface_tag])
+        return mesh, facet_tags
+
+    def _segments(self, mesh, facet_tags, selection) -> np.ndarray:
+        """(m, 2, gdim) vertex coordinates of the facets (of the groups ``selection``, or the
+        facet indices ``selection`` when facet_tags is None) of every rank."""
+        fdim = mesh.topology.dim - 1
+        mesh.topology.create_connectivity(fdim, 0)
+        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+        mesh.topology.create_connectivity(mesh.topology.dim, 0)
+        f2v = mesh.topology.connectivity(fdim, 0)
+        f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
+        c2v = mesh.topology.connectivity(mesh.topology.dim, 0)
+        V = _compat.function_space(mesh, "Lagrange", 1)
+        X = _compat.dof_coordinates(V)[:, : self.gdim]
+        facets = (selection if facet_tags is None
+                  else facet_tags.indices[np.isin(facet_tags.values, selection)])  # fmt: skip
+        out = []
+        for f in facets:
+            c = f2c.links(f)[0]
+            dofs, verts = V.dofmap.cell_dofs(c), c2v.links(c)
+            out.append(X[[dofs[np.flatnonzero(verts == v)[0]] for v in f2v.links(f)]])
+        local = np.array(out).reshape(-1, 2, self.gdim)
+        # ghost facets appear on two ranks: keep each facet once
+        every = np.concatenate(mesh.comm.allgather(local))
+        keys = np.round(np.sort(every.reshape(len(every), -1), axis=1) * 1e9).astype(np.int64)
+        _, first = np.unique(keys, axis=0, return_index=True)
+        return every[np.sort(first)]
+
+    def length_scale(self) -> float:
+        return self._length
+
+    def supports(self):
+        return [(self.groups[b.group].tag, c) for b in self.spec.boundary for c in b.fix]
+
+    def side(self, x):
+        return self._normal[0] * (x[0] - self._origin[0]) + self._normal[1] * (
+            x[1] - self._origin[1]
+        )
+
+    def tips(self):
+        return list(self._tips)
+
+    def frame(self):
+        return self._origin, self._dir
+
+    def material(self) -> Elastic:
+        return self.spec.bodies[0][1]
+
+    def fluid_pressure(self):
+        return self.spec.interface.get("fluid_pressure")
+
+    def extra_quantities(self, mesh, w, ds):
+        """crack_volume: the integral of the opening -[w] . n+ along the interface (the + cell's
+        outward normal points to the other face, so the opening is independent of which cell
+        is +)."""
+        dS = ufl.Measure("dS", domain=mesh, subdomain_data=self._facet_tags)
+        n = ufl.FacetNormal(mesh)
+        return {"crack_volume": -ufl.dot(ufl.jump(w), n("+")) * dS(self.interface_tag)}
+
+
+def _compat_exterior(mesh) -> np.ndarray:
+    """The exterior facets of this rank (local indices)."""
+    return np.asarray(dolfinx.mesh.exterior_facet_indices(mesh.topology), dtype=np.int32)

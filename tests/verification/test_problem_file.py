@@ -51,13 +51,17 @@ def test_contact_pair_problem_reactions_balance():
 
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
-@pytest.mark.parametrize("name", ["holed-pad.toml", "block-on-plinth.toml"])
+@pytest.mark.parametrize("name", ["holed-pad.toml", "block-on-plinth.toml",
+                                  "pressurised-crack.toml"])  # fmt: skip
 def test_problem_file_ranks_agree(name):
     _, parallel = _solve(name)
     _, serial = _solve(name, comm=MPI.COMM_SELF)
     # the same discrete problem solved to snes_rtol 1e-10: forces agree to 1e-8
-    assert parallel.force == pytest.approx(serial.force, rel=1e-8)
-    assert parallel.contact_size == pytest.approx(serial.contact_size, rel=1e-8)
+    assert parallel.force == pytest.approx(serial.force, rel=1e-8, abs=1e-12)
+    assert parallel.contact_size == pytest.approx(serial.contact_size, rel=1e-8, abs=1e-12)
+    if serial.interface is not None:
+        for key, value in serial.interface.extra.items():
+            assert parallel.interface.extra[key] == pytest.approx(value, rel=1e-8)
 
 
 def test_set_overrides_a_key():
@@ -192,3 +196,16 @@ def test_msh_file_gives_the_geo_result(tmp_path):
     ref = scene.run(numerics, comm=MPI.COMM_SELF, petsc_options=petsc, verbose=False)
     assert res.dofs == ref.dofs
     assert res.force == pytest.approx(ref.force, rel=1e-10)
+
+
+def test_interface_problem_crack_volume_sneddon():
+    """A fluid-pressurised crack in a user's mesh: the crack volume against Sneddon's
+    infinite-plate 2 pi (1 - nu^2) p a^2 / E (docs/verification.md). The plate's half-width is
+    10 a (a finite plate changes the volume by O((a / W)^2), about 1 %) and the P1 opening
+    misses part of the sqrt profile in the last elements (h_tip / a = 0.004): 2 %; measured
+    -0.7 %."""
+    scene, res = _solve("pressurised-crack.toml")
+    assert len(scene.tips()) == 2 and scene.interface_tag > 0
+    E, nu, p, a = 10e9, 0.25, 1e6, 1.0
+    exact = 2.0 * np.pi * (1.0 - nu**2) * p * a**2 / E
+    assert res.interface.extra["crack_volume"] == pytest.approx(exact, rel=2e-2)
