@@ -26,6 +26,7 @@ def test_writer_every_field_surface_and_split(tmp_path):
     out = Path(comm.bcast(str(tmp_path), root=0))
     mesh = dolfinx.mesh.create_unit_square(comm, N, N)
     fdim = mesh.topology.dim - 1
+    mesh.topology.create_connectivity(fdim, mesh.topology.dim)
     bottom = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[1], 0.0))
     middle = dolfinx.mesh.locate_entities(mesh, fdim, lambda x: np.isclose(x[1], 0.5))
     Q1 = _compat.function_space(mesh, "Lagrange", 1)
