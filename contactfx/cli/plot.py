@@ -92,6 +92,8 @@ def plot_run(run: Path, field: str | None = None, step: int = -1, scale: float |
 
     x = grid["points"]
     u = pdata.get("displacement", np.zeros_like(x))
+    if u.ndim == 1:  # a bar's scalar displacement: along x
+        u = np.column_stack([u, np.zeros((len(u), 2))])
     size = float(np.linalg.norm(x.max(axis=0) - x.min(axis=0))) or 1.0
     umax = float(np.max(np.linalg.norm(u, axis=1), initial=0.0))
     if scale is None:
