@@ -80,6 +80,7 @@ class ResultsWriter:
         self.surface_path = None if facets is None else self.out / f"{name}_surface.pvd"
         self._out: dict[str, dolfinx.fem.Function] = {}
         self._steps: list[tuple[float, str, str | None]] = []
+        self._surface: tuple[np.ndarray, np.ndarray] | None = None  # the facets' cells, fixed
         tdim = mesh.topology.dim
         self.cell_name = mesh.topology.cell_type.name
         if self.cell_name not in VTK_CELLS:
@@ -102,8 +103,11 @@ class ResultsWriter:
             self.split_nodes = np.unique(np.concatenate(self.comm.allgather(mine)))
 
     def __enter__(self) -> ResultsWriter:
-        if self.comm.rank == 0:
+        if self.comm.rank == 0:  # a previous run's steps would linger next to the new ones
             self.out.mkdir(parents=True, exist_ok=True)
+            for pattern in ("_[0-9][0-9][0-9][0-9].vtu", "_surface_[0-9][0-9][0-9][0-9].vtu"):
+                for old in self.out.glob(self.name + pattern):
+                    old.unlink()
         return self
 
     def __exit__(self, *exc) -> None:
@@ -159,7 +163,9 @@ class ResultsWriter:
         surface = None
         if self.facets is not None:
             surface = f"{self.name}_surface_{step:04d}.vtu"
-            cells, local = self._surface_cells(side)
+            if self._surface is None:
+                self._surface = self._surface_cells(side)
+            cells, local = self._surface
             self._write(self.out / surface, _FACET[self.cell_name], cells, local, point, cell,
                         None)  # fmt: skip
         self._steps.append((t, body, surface))
