@@ -26,8 +26,8 @@ __all__ = [
     "create_matrix",
     "create_vector",
     "assemble_vector",
-    "write_function",
     "dof_coordinates",
+    "cell_dofs",
     "bc_dofs",
     "locate_dofs_topological",
     "dirichletbc",
@@ -122,8 +122,13 @@ def assemble_vector(b: PETSc.Vec, form) -> PETSc.Vec:
     return b
 
 
-def write_function(xdmf, u: dolfinx.fem.Function, t: float) -> None:
-    xdmf.write_function(u, t)
+def cell_dofs(space) -> np.ndarray:
+    """The dofmap as an array (cells incl. ghosts, dofs per cell) of local (block) dofs."""
+    dofmap = space.dofmap.list
+    if isinstance(dofmap, np.ndarray):  # dolfinx >= 0.7
+        return dofmap
+    n = space.dofmap.cell_dofs(0).size if dofmap.num_nodes else 0
+    return dofmap.array.reshape(-1, n)
 
 
 def dof_coordinates(space) -> np.ndarray:

@@ -155,7 +155,10 @@ class RunSummary:
     reference: dict[str, float] = field(default_factory=dict)
     scores: dict[str, float] = field(default_factory=dict)
     errors: dict[str, float] = field(default_factory=dict)
-    xdmf: str | None = None
+    #: the ParaView files: the body (PVD series, one dataset per load step with every field)
+    #: and the contact surface alone
+    paraview: str | None = None
+    paraview_surface: str | None = None
     plot: str | None = None
 
     # -- named views of the final state ---------------------------------------------------
@@ -223,7 +226,8 @@ class RunSummary:
                    ksp_iterations=self.ksp_iterations, outer_iterations=self.outer_iterations,
                    steps=[s.to_json() for s in self.steps], timings=dict(self.timings))  # fmt: skip
         out.update(self.quantities.to_json())
-        out.update(xdmf=self.xdmf, reference=self.reference, scores=self.scores,
+        out.update(paraview=self.paraview, paraview_surface=self.paraview_surface,
+                   reference=self.reference, scores=self.scores,
                    errors=self.errors)  # fmt: skip
         if self.interface is not None or self.plot is not None:
             out["plot"] = self.plot

@@ -20,7 +20,7 @@
 # - write Nitsche's contact residual on the crack faces (jumps and averages) and check that it
 #   is the one the run assembles,
 # - read the opening error, $K_I$ and the contact force from the typed run summary,
-# - write the XDMF file and the line plot along the crack.
+# - write the ParaView files and the line plot along the crack.
 #
 # ## Equations
 #
@@ -130,9 +130,10 @@ F_run = method.residual(s)
 mismatch = relative_difference(F_run, crack_nitsche_residual(s, num.theta, num.gamma0))
 # -
 
-# Solve the pressurised crack, writing the XDMF file (fields `displacement` $u$ and `enrichment`
-# $a$: the faces sit at $u \pm a$), `interface.png`, `interface.csv` and `run.json` into
-# `out/crack-sneddon`; then the crack under suction.
+# Solve the pressurised crack, writing the ParaView files (`crack-sneddon.pvd`: the crack faces
+# as separate nodes, `displacement` $u \pm a$ on each face, so that Warp By Vector opens the
+# crack; `crack-sneddon_surface.pvd`: the crack line), `interface.png`, `interface.csv` and
+# `run.json` into `out/crack-sneddon`; then the crack under suction.
 
 # +
 res = pressurised.run(num, verbose=False, out="out/crack-sneddon")
@@ -153,5 +154,5 @@ if MPI.COMM_WORLD.rank == 0:
         f"p < 0: contact force {suction.force:.4e} (2 a |p| = 2.0000e+06), relative error "
         f"{suction.reference['force_rel_error']:.1e}, opening L2 {suction.errors['opening_L2']:.1e}"
     )
-    print(f"wrote {res.xdmf} and {res.plot}")
+    print(f"wrote {res.paraview} and {res.plot}")
 # -

@@ -9,6 +9,7 @@ import pytest
 
 from conftest import clean_env, contactfx_cmd, run_cli
 from contactfx.cli.args import Parser
+from contactfx.io.vtk import read_pvd, read_vtu
 
 pytestmark = pytest.mark.serial_only
 
@@ -119,17 +120,25 @@ def test_run_two_ranks_writes_results(tmp_path):
                   ranks=2)  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert "SNES Function norm" in res.stdout  # command-line PETSc options reach PETSc
-    assert "peak pressure p0" in res.stdout and "hertz2d.xdmf" in res.stdout
+    assert "peak pressure p0" in res.stdout and "ParaView: " in res.stdout
     data = json.loads((tmp_path / "run.json").read_text())
     assert data["status"] == "completed" and data["ranks"] == 2
     assert data["petsc_options"] == {"snes_monitor": "None"}
     for key in ("mesh", "compile", "assembly", "solve"):
         assert data["timings"][key] >= 0.0
     assert data["steps"][0]["newton"] == data["newton_iterations"]
-    assert (tmp_path / "hertz2d.xdmf").exists() and (tmp_path / "hertz2d.h5").exists()
-    xdmf = (tmp_path / "hertz2d.xdmf").read_text()
-    for name in ("displacement", "von_mises", "contact_pressure", "gap", "contact_status"):
-        assert f'Name="{name}"' in xdmf
+    # the printed path is the file to open: one dataset per step with every field, the
+    # points gathered from both ranks
+    assert f"ParaView: {tmp_path / 'hertz2d.pvd'}" in res.stdout
+    assert data["paraview"] == str(tmp_path / "hertz2d.pvd")
+    ((t, vtu),) = read_pvd(tmp_path / "hertz2d.pvd")
+    grid = read_vtu(vtu)
+    assert t == 1.0 and grid["cells"].shape[0] == data["cells"]
+    for name in ("displacement", "contact_pressure", "gap", "contact_status"):
+        assert name in grid["point_data"], name
+    assert "von_mises" in grid["cell_data"]
+    p = grid["point_data"]["contact_pressure"]
+    assert p.max() == pytest.approx(data["peak_pressure"], rel=1e-9)
 
 
 def test_module_entry_point_westergaard():

@@ -1,4 +1,5 @@
-"""Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench | stress``.
+"""Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench | stress |
+plot RUN``.
 
 PETSc options after ``--`` reach PETSc: they initialise petsc4py before dolfinx is imported and
 are copied under the solver's options prefix, so ``-- -snes_monitor -ksp_type gmres`` works.
@@ -19,7 +20,8 @@ USAGE = (
     "bench [--scene CASES] [--method M,...] [--levels N] [--degree 1,2] [--out DIR] | "
     "stress [--quick] [--axis AXES] [--out DIR] | "
     "solve PROBLEM.toml [--set KEY=VALUE] [--out DIR] [-- PETSc options] | "
-    "check PROBLEM.toml}"
+    "check PROBLEM.toml | "
+    "plot RUN [--field NAME] [--step N] [--scale S] [--out PNG]}"
 )
 
 
@@ -45,6 +47,10 @@ def _dispatch(command: str, rest: list[str], petsc_options: dict, comm) -> int:
         from contactfx.cli.solve import cmd_check, cmd_solve
 
         return (cmd_solve if command == "solve" else cmd_check)(rest, petsc_options, comm)
+    if command == "plot":
+        from contactfx.cli.plot import cmd_plot
+
+        return cmd_plot(rest, comm)
     raise ValueError(f"unknown command '{command}' ({USAGE})")
 
 

@@ -14,7 +14,7 @@ from contactfx.results import RunSummary
 from contactfx.scenes import SCENES, get_scene
 from contactfx.solvers.snes import ConvergenceError
 
-__all__ = ["cmd_list", "cmd_run", "table", "write_failed"]
+__all__ = ["cmd_list", "cmd_run", "table", "write_failed", "print_outputs"]
 
 
 def _scene_parser(scene_cls) -> Parser:
@@ -25,7 +25,7 @@ def _scene_parser(scene_cls) -> Parser:
     )
     add_options(parser.add_argument_group("scene parameters"), scene_cls.Params, {})
     add_options(parser.add_argument_group("numerics"), Numerics, scene_cls.numerics_defaults)
-    parser.add_argument("--out", type=Path, default=None, help="output folder (XDMF, run.json)")
+    parser.add_argument("--out", type=Path, default=None, help="output folder (ParaView, run.json)")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     return parser
 
@@ -141,10 +141,16 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
         raise
     if comm.rank == 0:
         print(table(res))
-        if res.xdmf:
-            print(f"  ParaView: {res.xdmf}")
-            print(f"  summary:  {Path(res.xdmf).parent / 'run.json'}")
+        print_outputs(res)
     return 0
+
+
+def print_outputs(res: RunSummary) -> None:
+    """The files a run wrote (rank 0)."""
+    if res.paraview:
+        print(f"  ParaView: {res.paraview}")
+        print(f"  surface:  {res.paraview_surface}")
+        print(f"  summary:  {Path(res.paraview).parent / 'run.json'}")
 
 
 def write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import table, write_failed
+from contactfx.cli.run import print_outputs, table, write_failed
 from contactfx.scenes.problem_file import load_problem
 from contactfx.solvers.snes import ConvergenceError
 
@@ -57,9 +57,7 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
             print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
         if written:
             print(f"  forces per step: {written} (and history.png)")
-        if res.xdmf:
-            print(f"  ParaView: {res.xdmf}")
-            print(f"  summary:  {Path(res.xdmf).parent / 'run.json'}")
+        print_outputs(res)
     return 0
 
 

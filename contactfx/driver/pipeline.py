@@ -18,7 +18,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from contactfx.io.provenance import versions, write_json
-from contactfx.io.xdmf import ResultsWriter
+from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog
 from contactfx.solvers.loadstep import StepRecord, run_load_program
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
@@ -28,9 +28,10 @@ __all__ = ["run", "setup", "prepare_output"]
 
 def run(scene, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
         verbose: bool = True) -> RunSummary:  # fmt: skip
-    """Solve ``scene`` with ``numerics``; write XDMF, run.json (and the kind's extra output)
-    into ``out`` when given. Raises ValueError on a request the method or the problem kind
-    does not support (before any collective), ConvergenceError when the solve fails."""
+    """Solve ``scene`` with ``numerics``; write the ParaView files, run.json (and the kind's
+    extra output) into ``out`` when given. Raises ValueError on a request the method or the
+    problem kind does not support (before any collective), ConvergenceError when the solve
+    fails."""
     method = _checked_method(scene, numerics)
     run_ = _Run(scene, numerics, method, comm, None if out is None else Path(out),
                 dict(petsc_options or {}), verbose)  # fmt: skip
@@ -125,9 +126,12 @@ class _Run:
         """Solve at the load factors of the program; at each converged step evaluate the
         contact quantities, write the fields and keep the step as the history of the next."""
         steps: list[StepLog] = []
-        xdmf = None if self.out is None else self.out / f"{self.scene.name}.xdmf"
-        writer = ResultsWriter(xdmf, problem.mesh) if xdmf is not None else nullcontext()
-        with writer:
+        writer = None
+        if self.out is not None:
+            writer = ResultsWriter(self.out, self.scene.name, problem.mesh,
+                                   facets=getattr(problem, "contact_facets", None),
+                                   split=problem.output_split())  # fmt: skip
+        with writer or nullcontext():
 
             def on_step(rec: StepRecord) -> None:
                 quantities = post.evaluate(solver)
@@ -135,7 +139,7 @@ class _Run:
                 s = rec.stats
                 steps.append(StepLog(rec.step, rec.load, s.newton, s.ksp, s.outer,
                                      rec.cutbacks, s.reason, quantities))  # fmt: skip
-                if xdmf is not None:
+                if writer is not None:
                     with self.timed("output"):
                         writer.write(rec.load, post.fields())
                 problem.converged()
@@ -151,6 +155,9 @@ class _Run:
         output = self.timings.get("output", 0.0)
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
         return steps
+
+    def _output(self, suffix: str) -> str | None:
+        return None if self.out is None else str(self.out / f"{self.scene.name}{suffix}")
 
     # -- record --------------------------------------------------------------------------
     def record(self, problem, mesh, steps: list[StepLog], extra: dict) -> RunSummary:
@@ -168,7 +175,8 @@ class _Run:
             steps=steps,
             timings=dict(self.timings),
             quantities=steps[-1].quantities,
-            xdmf=None if self.out is None else str(self.out / f"{self.scene.name}.xdmf"),
+            paraview=self._output(".pvd"),
+            paraview_surface=self._output("_surface.pvd"),
             **extra,
         )
         if self.out is not None:

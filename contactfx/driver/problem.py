@@ -128,6 +128,11 @@ class Problem:
     def extra_load(self, L):
         return L
 
+    def output_split(self):
+        """How the ParaView output splits the body's nodes (:class:`contactfx.io.vtk.Split`):
+        None, one body with continuous fields."""
+        return None
+
     def coupling(self):
         """The solver's two-body coupling (:mod:`contactfx.contact.coupling`), or None."""
         return None

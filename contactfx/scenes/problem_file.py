@@ -88,7 +88,7 @@ KEYS = {
     "obstacle": ("shape", "contact", "radius", "position", "motion", "amplitude"),
     "contact": ("slave", "master"),
     "interface": ("group", "fluid_pressure"),
-    "output": ("xdmf", "reactions"),
+    "output": ("reactions",),
 }
 SHAPES = ("plane", "circle", "cylinder", "sphere")
 
@@ -233,7 +233,6 @@ class ProblemFile:
     contact: tuple[str, str] | None
     interface: dict | None
     reactions: list[str]
-    xdmf: bool
     title: str
 
 
@@ -342,9 +341,6 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     reactions = output.get("reactions", [])
     if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
         r.fail("output.reactions", f"expected a list of group names, got {reactions!r}")
-    xdmf = output.get("xdmf", True)
-    if not isinstance(xdmf, bool):
-        r.fail("output.xdmf", f"expected true or false, got {xdmf!r}")
     title = data.get("title", path.stem)
     if not isinstance(title, str):
         r.fail("title", f"expected a string, got {title!r}")
@@ -357,7 +353,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
              for k, v in petsc.items()}  # fmt: skip
     problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
-                          list(reactions), xdmf, title)  # fmt: skip
+                          list(reactions), title)  # fmt: skip
     return problem, numerics, petsc
 
 

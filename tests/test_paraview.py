@@ -1,0 +1,161 @@
+"""What a ParaView user sees: each problem kind's output opened with ParaView's own reader.
+
+A run per kind (rigid obstacle: hertz2d; fitted interface: crack-sneddon; two bodies:
+patch-test in 2D and 3D), on two ranks, coarse. ``pvpython`` opens ``<scene>.pvd`` and
+``<scene>_surface.pvd`` at the last load step and reports, as JSON, the dataset's class, sizes,
+the range of every point and cell array, the time steps, and the largest displacement jump
+between coincident points (the crack's opening); then it warps the body by ``displacement``,
+colours it by a field and saves a PNG. Checks: one vtkUnstructuredGrid per step carrying every
+field (so colouring by any of them works at once), the run's cells and load steps, the peak
+contact pressure of run.json (the same nodal values: to 1e-9), the crack opened by Warp By
+Vector (face jump = the aperture field, to 1e-6) against Sneddon's closed form (5 %), and the
+surface dataset carrying the same contact fields.
+
+Needs ``pvpython`` (Debian: ``apt-get install paraview python3-paraview``) and, without a
+display, ``xvfb-run`` (``xvfb xauth``): ParaView 5.11 of Debian 12 renders through X even with
+``--force-offscreen-rendering``. Launches subprocesses: ``serial_only``.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import clean_env, run_cli
+
+PVPYTHON = shutil.which("pvpython")
+XVFB = shutil.which("xvfb-run")
+pytestmark = [
+    pytest.mark.serial_only,
+    pytest.mark.skipif(
+        PVPYTHON is None, reason="pvpython is not installed (Debian: paraview python3-paraview)"
+    ),
+    pytest.mark.skipif(
+        not os.environ.get("DISPLAY") and XVFB is None,
+        reason="no display and no xvfb-run (Debian: xvfb xauth) to render",
+    ),
+]
+
+#: the probe run by pvpython: argv = body.pvd surface.pvd png POINTS|CELLS scale field; prints
+#: one JSON line
+PROBE = r"""
+import json, sys
+import numpy as np
+from paraview.simple import OpenDataFile, WarpByVector, CreateRenderView, Show, ColorBy
+from paraview.simple import ResetCamera, SaveScreenshot, servermanager
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+def probe(path):
+    reader = OpenDataFile(path)
+    times = list(reader.TimestepValues) if reader.TimestepValues else [0.0]
+    reader.UpdatePipeline(times[-1])
+    data = servermanager.Fetch(reader)
+    out = {"class": data.GetClassName(), "times": times}
+    if not data.IsA("vtkDataSet"):
+        return reader, out
+    out.update(points=data.GetNumberOfPoints(), cells=data.GetNumberOfCells())
+    for key, arrays in (("point", data.GetPointData()), ("cell", data.GetCellData())):
+        out[key] = {arrays.GetArrayName(i): list(arrays.GetArray(i).GetRange(-1))
+                    for i in range(arrays.GetNumberOfArrays())}
+    x = vtk_to_numpy(data.GetPoints().GetData())
+    _, inverse, count = np.unique(np.round(x, 12), axis=0, return_inverse=True,
+                                  return_counts=True)
+    inverse = inverse.ravel()
+    jump = 0.0
+    u = data.GetPointData().GetArray("displacement")
+    if u is not None and (count > 1).any():
+        u = vtk_to_numpy(u)
+        for k in np.flatnonzero(count > 1):
+            same = np.flatnonzero(inverse == k)
+            jump = max(jump, float(np.ptp(u[same], axis=0).max()))
+    out["coincident"] = int((count > 1).sum())
+    out["jump"] = jump
+    return reader, out
+
+body, result = probe(sys.argv[1])
+result["surface"] = probe(sys.argv[2])[1]
+warp = WarpByVector(Input=body, Vectors=["POINTS", "displacement"], ScaleFactor=float(sys.argv[5]))
+view = CreateRenderView()
+view.ViewSize = [800, 600]
+shown = Show(warp, view)
+ColorBy(shown, (sys.argv[4], sys.argv[6]))
+shown.RescaleTransferFunctionToDataRange(True)
+ResetCamera(view)
+SaveScreenshot(sys.argv[3], view, ImageResolution=[800, 600])
+print("PROBE " + json.dumps(result))
+"""
+
+OBSTACLE = {"displacement", "contact_pressure", "gap", "contact_status"}
+INTERFACE = {"displacement", "enrichment", "aperture", "slip", "normal_traction", "gap",
+             "interface_status"}  # fmt: skip
+
+#: kind -> (command-line arguments, point fields, cell fields, colour by, warp scale)
+CASES = {
+    "obstacle": (["hertz2d", "--h-contact", "0.01", "--h-far", "0.2", "--steps", "2"],
+                 OBSTACLE, {"von_mises"}, "contact_pressure", 50.0),
+    "interface": (["crack-sneddon", "--h-crack", "0.1", "--h-tip", "0.02", "--h-far", "2"],
+                  INTERFACE, {"von_mises"}, "aperture", 2000.0),
+    "two-body": (["patch-test"], OBSTACLE, {"von_mises"}, "contact_pressure", 50.0),
+    "two-body-3d": (["patch-test", "--dim", "3", "--h", "0.2"], OBSTACLE, {"von_mises"},
+                    "contact_pressure", 50.0),
+}  # fmt: skip
+
+
+def _probe(out, scene, field, scale):
+    png = out / f"{scene}-paraview.png"
+    script = out / "probe.py"
+    script.write_text(PROBE)
+    cmd = [PVPYTHON, "--force-offscreen-rendering", str(script), str(out / f"{scene}.pvd"),
+           str(out / f"{scene}_surface.pvd"), str(png), "POINTS", str(scale), field]  # fmt: skip
+    if not os.environ.get("DISPLAY"):
+        cmd = [XVFB, "-a", "-s", "-screen 0 1024x768x24", *cmd]
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=clean_env())
+    lines = [ln for ln in res.stdout.splitlines() if ln.startswith("PROBE ")]
+    assert res.returncode == 0 and lines, res.stdout + res.stderr
+    return json.loads(lines[-1][len("PROBE ") :]), png
+
+
+@pytest.mark.parametrize("kind", list(CASES))
+def test_paraview_opens_one_dataset_with_every_field(kind, tmp_path):
+    args, point, cell, field, scale = CASES[kind]
+    scene = args[0]
+    res = run_cli("run", *args, "--quiet", "--out", str(tmp_path), ranks=2)
+    assert res.returncode == 0, res.stderr
+    run = json.loads((tmp_path / "run.json").read_text())
+    assert run["paraview"] == str(tmp_path / f"{scene}.pvd")
+    probe, png = _probe(tmp_path, scene, field, scale)
+
+    # one unstructured grid per step (not a multiblock of per-field grids), every field on it
+    assert probe["class"] == "vtkUnstructuredGrid"
+    assert probe["cells"] == run["cells"]
+    assert probe["times"] == pytest.approx([s["load"] for s in run["steps"]])
+    assert set(probe["point"]) == point and set(probe["cell"]) == cell
+    surface = probe["surface"]
+    assert surface["class"] == "vtkUnstructuredGrid" and 0 < surface["cells"] < probe["cells"]
+    assert point <= set(surface["point"])
+    # ... and the PNG of the warped body coloured by the field
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 2000
+
+    if kind == "interface":
+        aperture = probe["point"]["aperture"][1]
+        # Warp By Vector opens the crack: the crack faces are separate points whose
+        # displacements differ by the aperture
+        assert probe["coincident"] > 0
+        assert probe["jump"] == pytest.approx(aperture, rel=1e-6)
+        assert aperture == pytest.approx(surface["point"]["aperture"][1], rel=1e-12)
+        opening = np.loadtxt(tmp_path / "interface.csv", delimiter=",", skiprows=1)[:, 3]
+        assert aperture == pytest.approx(opening.max(), rel=1e-9)
+        # Sneddon: the centre opening 4 (1 - nu^2) p a / E (1.7 % low on this coarse mesh)
+        p = run["parameters"]
+        sneddon = 4 * (1 - p["nu"] ** 2) * p["pressure"] * p["crack_half_length"] / p["E"]
+        assert aperture == pytest.approx(sneddon, rel=0.05)
+    else:
+        peak = probe["point"]["contact_pressure"][1]
+        assert peak > 0
+        assert peak == pytest.approx(run["peak_pressure"], rel=1e-9)
+        assert surface["point"]["contact_pressure"][1] == pytest.approx(peak, rel=1e-12)
+        if kind == "obstacle":
+            assert probe["coincident"] == 0  # one body, no duplicated nodes
