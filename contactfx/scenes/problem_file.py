@@ -53,6 +53,7 @@ built-in scene.
 
 from __future__ import annotations
 
+import ast
 import copy
 import dataclasses
 import re
@@ -66,6 +67,7 @@ import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
+from contactfx.contact.interface import BartonBandis
 from contactfx.contact.obstacles import Ball, HalfSpace, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import build_file
@@ -85,12 +87,12 @@ KEYS = {
     "mesh": ("file", "size"),
     "bodies": ("group", "E", "nu"),
     "boundary": ("group", "fix", "displacement", "traction", "pressure", "amplitude"),
-    "obstacle": ("shape", "contact", "radius", "position", "motion", "amplitude"),
+    "obstacle": ("shape", "contact", "radius", "distance", "position", "motion", "amplitude"),
     "contact": ("slave", "master"),
-    "interface": ("group", "fluid_pressure"),
+    "interface": ("group", "fluid_pressure", "proppant_thickness", "joint"),
     "output": ("reactions",),
 }
-SHAPES = ("plane", "circle", "cylinder", "sphere")
+SHAPES = ("plane", "circle", "cylinder", "sphere", "distance")
 
 
 @dataclass(frozen=True)
@@ -314,6 +316,18 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         interface["group"] = r.string(interface, "interface", "group")
         if "fluid_pressure" in interface:
             interface["fluid_pressure"] = r.number(interface, "interface", "fluid_pressure")
+        if "proppant_thickness" in interface:
+            interface["proppant_thickness"] = r.number(
+                interface, "interface", "proppant_thickness", positive=True
+            )
+        if "joint" in interface:
+            j = r.table(interface["joint"], "interface.joint", ("Kni", "Vm", "w0"))
+            values = {k: r.number(j, "interface.joint", k, positive=True)
+                      for k in ("Kni", "Vm", "w0")}  # fmt: skip
+            try:
+                interface["joint"] = BartonBandis(**values)
+            except ValueError as err:
+                r.fail("interface.joint", str(err))
         if len(bodies) != 1:
             r.fail("bodies", f"an interface lies inside one body, got {len(bodies)} bodies")
         for i, b in enumerate(boundary):
@@ -324,8 +338,14 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
         obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
         obstacle["contact"] = r.string(obstacle, "obstacle", "contact")
-        if obstacle["shape"] != "plane":
+        if obstacle["shape"] in ("circle", "cylinder", "sphere"):
             obstacle["radius"] = r.number(obstacle, "obstacle", "radius", positive=True)
+        if obstacle["shape"] == "distance":
+            text = r.string(obstacle, "obstacle", "distance")
+            try:
+                obstacle["distance"] = parse_expression(text)
+            except ValueError as err:
+                r.fail("obstacle.distance", str(err))
         obstacle["amplitude"] = r.amplitude(obstacle, "obstacle")
     contact = None
     if contact_list is not None:
@@ -375,6 +395,68 @@ def load_problem(path, sets: list[str] = ()):
         else FileObstacleScene
     )
     return cls(problem), numerics, petsc
+
+
+# -- signed distance expressions -------------------------------------------------------------
+
+_FUNCTIONS = {"sqrt": ufl.sqrt, "sin": ufl.sin, "cos": ufl.cos, "tan": ufl.tan,
+              "exp": ufl.exp, "ln": ufl.ln, "abs": abs, "atan2": _compat.ufl_math.atan2,
+              "min": ufl.min_value, "max": ufl.max_value}  # fmt: skip
+_BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
+           ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
+           ast.Pow: lambda a, b: a**b}  # fmt: skip
+
+
+def parse_expression(text: str):
+    """A function y -> UFL of the expression ``text`` in x, y, z (the coordinates of the point
+    in the obstacle's frame), numbers, + - * / **, pi and the functions sqrt, sin, cos, tan,
+    exp, ln, abs, atan2, min, max. Anything else is refused (nothing is evaluated as Python)."""
+    try:
+        tree = ast.parse(text, mode="eval")
+    except SyntaxError:
+        raise ValueError(f"not an expression: '{text}'") from None
+
+    def build(node, y):
+        if isinstance(node, ast.Expression):
+            return build(node.body, y)
+        if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
+            return float(node.value)
+        if isinstance(node, ast.Name) and node.id in ("x", "y", "z"):
+            i = "xyz".index(node.id)
+            if i >= ufl.shape(y)[0]:
+                raise ValueError(f"'{node.id}' in a {ufl.shape(y)[0]}D problem")
+            return y[i]
+        if isinstance(node, ast.Name) and node.id == "pi":
+            return float(np.pi)
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            return _BINARY[type(node.op)](build(node.left, y), build(node.right, y))
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
+            v = build(node.operand, y)
+            return -v if isinstance(node.op, ast.USub) else v
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in _FUNCTIONS and not node.keywords):  # fmt: skip
+            return _FUNCTIONS[node.func.id](*(build(a, y) for a in node.args))
+        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{text}' (numbers, x, y, z, "
+                         "pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+
+    # check the names and operators once, in 3D
+    build(tree, ufl.as_vector([1.0, 1.0, 1.0]))
+    return lambda y: build(tree, y)
+
+
+class DistanceObstacle(Obstacle):
+    """A rigid obstacle given by a signed distance expression phi(y) (> 0 outside it) in the
+    obstacle's frame; the normal is -grad phi / |grad phi|."""
+
+    def __init__(self, phi) -> None:
+        self._phi = phi
+
+    def phi(self, y):
+        return self._phi(y)
+
+    def height(self, t: np.ndarray) -> np.ndarray:
+        raise ValueError("the vi method needs an obstacle with a height function (plane, "
+                         "circle, cylinder, sphere), not a distance expression")  # fmt: skip
 
 
 # -- the scenes -------------------------------------------------------------------------------
@@ -577,6 +659,8 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         ob = self.spec.obstacle
         if ob["shape"] == "plane":
             return HalfSpace(0.0)
+        if ob["shape"] == "distance":
+            return DistanceObstacle(ob["distance"])
         return Ball(ob["radius"])
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
@@ -716,6 +800,14 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
 
     def fluid_pressure(self):
         return self.spec.interface.get("fluid_pressure")
+
+    def floor(self, s):
+        """A proppant layer of uniform thickness along the whole interface."""
+        t = self.spec.interface.get("proppant_thickness")
+        return None if t is None else t + 0.0 * s
+
+    def joint(self):
+        return self.spec.interface.get("joint")
 
     def extra_quantities(self, mesh, w, ds):
         """crack_volume: the integral of the opening -[w] . n+ along the interface (the + cell's

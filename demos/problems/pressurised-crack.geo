@@ -22,4 +22,5 @@ Line{5, 6} In Surface{1};
 Physical Surface("plate") = {1};
 Physical Curve("bottom") = {1};
 Physical Curve("left") = {4};
+Physical Curve("top") = {3};
 Physical Curve("crack") = {5, 6};

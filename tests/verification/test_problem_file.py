@@ -209,3 +209,102 @@ def test_interface_problem_crack_volume_sneddon():
     E, nu, p, a = 10e9, 0.25, 1e6, 1.0
     exact = 2.0 * np.pi * (1.0 - nu**2) * p * a**2 / E
     assert res.interface.extra["crack_volume"] == pytest.approx(exact, rel=2e-2)
+
+
+def test_distance_expression_obstacle_matches_the_cylinder():
+    """The cylinder written as a signed distance expression (the same circle: centre (0, 2)
+    in the obstacle's frame, radius 2) gives the cylinder's run to round-off."""
+    sets = ["numerics.steps=1"]
+    _, ref = _solve("holed-pad.toml", sets=sets)
+    _, res = _solve(
+        "holed-pad.toml",
+        sets=[*sets, "obstacle.shape=distance", 'obstacle.distance="sqrt(x**2 + (y - 2)**2) - 2"'],
+    )
+    assert res.force == pytest.approx(ref.force, rel=1e-9)
+    assert res.peak_pressure == pytest.approx(ref.peak_pressure, rel=1e-9)
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("text, message", [
+    ("__import__('os').getcwd()", "is not allowed"),
+    ("sqrt(x**2 + w**2)", "'w' is not allowed"),
+    ("x +", "not an expression"),
+])  # fmt: skip
+def test_distance_expression_refused(text, message):
+    with pytest.raises(ValueError, match=message):
+        load_problem(DEMOS / "holed-pad.toml", ["obstacle.shape=distance",
+                                                f'obstacle.distance="{text}"'])  # fmt: skip
+
+
+def test_interface_problem_proppant_holds_the_faces(tmp_path):
+    """The crack of pressurised-crack.geo under a compression of 1 MPa (top edge) with a
+    proppant layer of thickness t along it and no fluid: the faces rest on the layer, the
+    opening is t on the whole crack but the last element at each tip (the tips do not open),
+    so the crack volume is t (2 a - h_1 - h_2), h_i the tip elements (0.004): within 0.5 % of
+    2 a t."""
+    t = 1e-4
+    text = (
+        (DEMOS / "pressurised-crack.toml")
+        .read_text()
+        .replace("fluid_pressure = 1e6", f"proppant_thickness = {t}")
+        .replace(
+            "[interface]", '[[boundary]]\ngroup = "top"\ntraction = [0.0, -1e6]\n\n[interface]'
+        )
+    )
+    (tmp_path / "pressurised-crack.geo").write_text((DEMOS / "pressurised-crack.geo").read_text())
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    scene, numerics, petsc = load_problem(path)
+    res = scene.run(numerics, petsc_options=petsc, verbose=False)
+    assert res.interface.extra["crack_volume"] == pytest.approx(2.0 * t, rel=5e-3)
+    assert res.interface.proppant_force > 0.0
+
+
+def test_interface_problem_joint_closure(tmp_path):
+    """A Barton-Bandis joint across a column (two blocks of height 1 and width 1 with lateral
+    rollers) under a top compression s: the joint closes uniformly by the closed form
+    v = s Vm / (Kni Vm + s) (references.joint_column), so the crack volume is -v times the
+    width; the closure is uniform and the P1 fields represent it exactly: to the solver's
+    tolerance (1e-6 relative, Newton on the hyperbolic law)."""
+    from contactfx.references import joint_column
+
+    geo = """
+Point(1) = {0, 0, 0, 0.1}; Point(2) = {1, 0, 0, 0.1}; Point(3) = {1, 1, 0, 0.1};
+Point(4) = {0, 1, 0, 0.1}; Point(5) = {1, 2, 0, 0.1}; Point(6) = {0, 2, 0, 0.1};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
+Line(5) = {3, 5}; Line(6) = {5, 6}; Line(7) = {6, 4};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Curve Loop(2) = {-3, 5, 6, 7}; Plane Surface(2) = {2};
+Physical Surface("column") = {1, 2};
+Physical Curve("bottom") = {1}; Physical Curve("top") = {6};
+Physical Curve("sides") = {2, 4, 5, 7}; Physical Curve("joint") = {3};
+"""
+    (tmp_path / "column.geo").write_text(geo)
+    s, Kni, Vm, w0, E, nu = 2e6, 5e9, 1e-3, 2e-3, 10e9, 0.25
+    text = f"""
+[mesh]
+file = "column.geo"
+[[bodies]]
+group = "column"
+E = {E}
+nu = {nu}
+[[boundary]]
+group = "bottom"
+fix = ["y"]
+[[boundary]]
+group = "sides"
+fix = ["x"]
+[[boundary]]
+group = "top"
+pressure = {s}
+[interface]
+group = "joint"
+joint = {{ Kni = {Kni}, Vm = {Vm}, w0 = {w0} }}
+"""
+    path = tmp_path / "column.toml"
+    path.write_text(text)
+    scene, numerics, petsc = load_problem(path)
+    res = scene.run(numerics, petsc_options=petsc, verbose=False)
+    assert scene.tips() == []  # the joint crosses the column: both ends on the boundary
+    v = joint_column(s, 0.0, E, nu, 1.0, w0, Kni, Vm)["closure"]
+    assert res.interface.extra["crack_volume"] == pytest.approx(-v, rel=1e-6)
