@@ -36,6 +36,7 @@ __all__ = [
     "numpy_math",
     "ufl_math",
     "FacetTree",
+    "point_values",
 ]
 
 _NEW = tuple(int(p) for p in dolfinx.__version__.split(".")[:2]) >= (0, 8)
@@ -257,3 +258,41 @@ class FacetTree:
             pairs = self._geo.compute_collisions(other.tree, self.tree)
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
         return other._original[pairs[:, 0]], self._original[pairs[:, 1]]
+
+
+def point_values(f: dolfinx.fem.Function, points: np.ndarray) -> np.ndarray:
+    """Values (n, value size) of ``f`` at the points (n, gdim) on every rank: each point is
+    evaluated by the lowest rank that owns a cell containing it; NaN for a point outside the
+    mesh. Collective."""
+    import dolfinx.geometry as geo
+    from mpi4py import MPI
+
+    mesh = f.function_space.mesh
+    comm, tdim = mesh.comm, mesh.topology.dim
+    n = len(points)
+    pts = np.zeros((n, 3))
+    pts[:, : points.shape[1]] = points
+    owned = mesh.topology.index_map(tdim).size_local
+    cells = np.arange(owned, dtype=np.int32)
+    if _NEW:
+        tree = geo.bb_tree(mesh, tdim, cells)
+        candidates = geo.compute_collisions_points(tree, pts)
+    else:
+        tree = geo.BoundingBoxTree(mesh, tdim, cells)
+        candidates = geo.compute_collisions(tree, pts)
+    colliding = geo.compute_colliding_cells(mesh, candidates, pts)
+    found = np.array([len(colliding.links(i)) > 0 for i in range(n)], dtype=bool)
+    ranks = np.where(found, comm.rank, comm.size).astype(np.int64)
+    first = np.empty_like(ranks)
+    comm.Allreduce(ranks, first, op=MPI.MIN)
+    size = int(np.prod(f.ufl_shape)) if f.ufl_shape else 1
+    local = np.zeros((n, size))
+    mine = np.flatnonzero(first == comm.rank)
+    if len(mine):
+        local[mine] = f.eval(
+            pts[mine], np.array([colliding.links(i)[0] for i in mine], dtype=np.int32)
+        ).reshape(len(mine), size)
+    values = np.zeros_like(local)
+    comm.Allreduce(local, values, op=MPI.SUM)
+    values[first == comm.size] = np.nan
+    return values

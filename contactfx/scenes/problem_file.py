@@ -90,7 +90,7 @@ KEYS = {
     "obstacle": ("shape", "contact", "radius", "distance", "position", "motion", "amplitude"),
     "contact": ("slave", "master"),
     "interface": ("group", "fluid_pressure", "proppant_thickness", "joint"),
-    "output": ("reactions",),
+    "output": ("reactions", "probes"),
 }
 SHAPES = ("plane", "circle", "cylinder", "sphere", "distance")
 
@@ -235,6 +235,7 @@ class ProblemFile:
     contact: tuple[str, str] | None
     interface: dict | None
     reactions: list[str]
+    probes: list[list[float]]
     title: str
 
 
@@ -361,6 +362,14 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     reactions = output.get("reactions", [])
     if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
         r.fail("output.reactions", f"expected a list of group names, got {reactions!r}")
+    probes = output.get("probes", [])
+    if not isinstance(probes, list) or not all(
+        isinstance(q, list)
+        and len(q) in (2, 3)
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in q)
+        for q in probes
+    ):
+        r.fail("output.probes", f"expected a list of points [x, y(, z)], got {probes!r}")
     title = data.get("title", path.stem)
     if not isinstance(title, str):
         r.fail("title", f"expected a string, got {title!r}")
@@ -373,7 +382,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
              for k, v in petsc.items()}  # fmt: skip
     problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
-                          list(reactions), title)  # fmt: skip
+                          list(reactions), probes, title)  # fmt: skip
     return problem, numerics, petsc
 
 
@@ -515,12 +524,23 @@ class _FileMesh:
                 self._fail(f"boundary.{i}", f"component z in a {self.gdim}D problem")
             if b.traction is not None and len(b.traction) != self.gdim:
                 self._fail(f"boundary.{i}.traction", f"expected {self.gdim} numbers")
+        touching = set(pb.contact or ())
+        if pb.obstacle is not None:
+            touching.add(pb.obstacle["contact"])
+        for i, b in enumerate(pb.boundary):
+            if b.group in touching:
+                self._fail(f"boundary.{i}.group", f"'{b.group}' is a contact surface: the "
+                           "contact law there assumes no other condition or load (Nitsche "
+                           "would be inconsistent); give it its own physical group")  # fmt: skip
         if pb.contact is None and not any(b.fix or b.displacement for b in pb.boundary):
             self._fail("boundary", "the body has no support (fix or displacement on a group): "
                        "frictionless contact alone leaves it free to slide, the solve would be "
                        "singular")  # fmt: skip
         for i, g in enumerate(pb.reactions):
             self.tag(f"output.reactions.{i}", g, fdim)
+        for i, q in enumerate(pb.probes):
+            if len(q) != self.gdim:
+                self._fail(f"output.probes.{i}", f"expected {self.gdim} coordinates, got {q}")
 
     # -- supports and loads -----------------------------------------------------------------
     def dirichlet(self, V, facet_tags) -> list:
@@ -590,6 +610,7 @@ class _FileMesh:
         supported dofs only, so R is the bulk residual K u - b summed over the group's owned
         dofs."""
         row = {"load": load, "contact_force": quantities.force}
+        self._probe(problem, row)
         if not self.spec.reactions:
             self.reaction_rows.append(row)
             return
@@ -609,6 +630,27 @@ class _FileMesh:
                 row[f"{g}_{AXES[c]}"] = problem.mesh.comm.allreduce(total, op=MPI.SUM)
         r.destroy()
         self.reaction_rows.append(row)
+
+    def _probe(self, problem, row: dict) -> None:
+        """The displacement at the probe points (NaN outside the mesh), interpolated into a
+        discontinuous space of the displacement's degree, so that near an interface it is
+        the total displacement u + H a of the side whose cell holds the point."""
+        if not self.spec.probes:
+            return
+        if not hasattr(self, "_probe_fn"):
+            space = _compat.function_space(problem.mesh, "DG", problem.num.degree, (self.gdim,))
+            self._probe_fn = dolfinx.fem.Function(space)
+            disp = getattr(problem, "w", None)
+            if disp is None:
+                disp = problem.U
+            self._probe_expr = _compat.expression(
+                ufl.as_vector([disp[i] for i in range(self.gdim)]), space
+            )
+        self._probe_fn.interpolate(self._probe_expr)
+        values = _compat.point_values(self._probe_fn, np.asarray(self.spec.probes, float))
+        for i, v in enumerate(values):
+            for c in range(self.gdim):
+                row[f"probe{i}_u{AXES[c]}"] = float(v[c])
 
 
 class FileObstacleScene(_FileMesh, ObstacleScene):

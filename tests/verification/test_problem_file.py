@@ -117,6 +117,8 @@ def test_bad_problem_files(tmp_path, edit, message):
     (lambda t: t.replace('group = "pad"', 'group = "top"'),
      "bodies.0.group: group 'top' has dimension 1, expected 2"),
     (lambda t: t.replace('contact = "top"', 'contact = "hull"'), "obstacle.contact: no physical"),
+    (lambda t: t.replace('contact = "top"', 'contact = "bottom"'),
+     "boundary.0.group: 'bottom' is a contact surface"),
 ])  # fmt: skip
 def test_problem_file_groups_checked_against_the_mesh(tmp_path, edit, message):
     scene, _, _ = load_problem(_write(tmp_path, edit(GOOD)))
@@ -265,7 +267,7 @@ def test_interface_problem_joint_closure(tmp_path):
     rollers) under a top compression s: the joint closes uniformly by the closed form
     v = s Vm / (Kni Vm + s) (references.joint_column), so the crack volume is -v times the
     width; the closure is uniform and the P1 fields represent it exactly: to the solver's
-    tolerance (1e-6 relative, Newton on the hyperbolic law)."""
+    tolerance (1e-6 relative, Newton on the hyperbolic law). Probes in both blocks."""
     from contactfx.references import joint_column
 
     geo = """
@@ -300,11 +302,21 @@ pressure = {s}
 [interface]
 group = "joint"
 joint = {{ Kni = {Kni}, Vm = {Vm}, w0 = {w0} }}
+[output]
+probes = [[0.3, 0.5], [0.6, 1.5], [5.0, 5.0]]
 """
     path = tmp_path / "column.toml"
     path.write_text(text)
     scene, numerics, petsc = load_problem(path)
     res = scene.run(numerics, petsc_options=petsc, verbose=False)
     assert scene.tips() == []  # the joint crosses the column: both ends on the boundary
-    v = joint_column(s, 0.0, E, nu, 1.0, w0, Kni, Vm)["closure"]
+    ref = joint_column(s, 0.0, E, nu, 1.0, w0, Kni, Vm)
+    v = ref["closure"]
     assert res.interface.extra["crack_volume"] == pytest.approx(-v, rel=1e-6)
+    # probes: uniaxial strain in each block, u_y = -s y / M, the upper block moved down by
+    # the closure as well (the total displacement u + H a of the probed cell's side)
+    row = scene.reaction_rows[-1]
+    assert row["probe0_uy"] == pytest.approx(-s * 0.5 / ref["M"], rel=1e-6)
+    assert row["probe1_uy"] == pytest.approx(-s * 1.5 / ref["M"] - v, rel=1e-6)
+    assert abs(row["probe0_ux"]) + abs(row["probe1_ux"]) <= 1e-9 * v
+    assert np.isnan(row["probe2_uy"])  # outside the mesh
