@@ -604,19 +604,18 @@ class _FileMesh:
 
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float, quantities) -> None:
-        """The step's contact force and the reaction force of each group of
-        ``output.reactions``: the force the supports exert
-        on the body there, per component. At a solution K u = b + R with R nonzero on the
-        supported dofs only, so R is the bulk residual K u - b summed over the group's owned
-        dofs."""
+        """The step's contact force, the probes, and the reaction force of each group of
+        ``output.reactions``: the force the supports exert on the body there, per component.
+        At a solution K u - b + F_c(u) = R, nonzero on the supported dofs only
+        (ContactSNES.reactions); R is summed over the group's owned dofs. (The condensed
+        mortar rewrites the rows of the slave nodes: a support sharing nodes with a mortar
+        slave surface would not be reported right.)"""
         row = {"load": load, "contact_force": quantities.force}
         self._probe(problem, row)
         if not self.spec.reactions:
             self.reaction_rows.append(row)
             return
-        r = solver.K.createVecLeft()
-        solver.K.mult(_compat.petsc_vec(problem.state), r)
-        r.axpy(-1.0, solver.b)
+        r = solver.reactions()
         values = r.getArray()
         n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
         for g in self.spec.reactions:

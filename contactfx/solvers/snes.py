@@ -257,6 +257,12 @@ class ContactSNES:
             F.set(np.nan)
             return
         self._sync(x)
+        self._unconstrained_residual(x, F, search=True)
+        dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
+        self.timer.assembly += time.perf_counter() - t0
+
+    def _unconstrained_residual(self, x: PETSc.Vec, F: PETSc.Vec, search: bool) -> None:
+        """F = K x - b + F_c(x), every row (the Dirichlet rows not replaced)."""
         self.K.mult(x, F)
         F.axpy(-1.0, self.b)
         if self._F_c is not None:
@@ -264,12 +270,20 @@ class ContactSNES:
             F.axpy(1.0, self.fc)
         if self.coupling is not None:
             t1 = time.perf_counter()
-            if self.coupling.search_each_newton:
+            if search and self.coupling.search_each_newton:
                 self._search()
             self.coupling.residual(x, F)
             self.timer.contact += time.perf_counter() - t1
-        dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
-        self.timer.assembly += time.perf_counter() - t0
+
+    def reactions(self) -> PETSc.Vec:
+        """The forces the supports exert at the current (converged) u: at a solution
+        K u - b + F_c(u) vanishes on the free rows, and on a supported row it is the reaction.
+        Collective; the caller destroys the vector."""
+        x = _compat.petsc_vec(self.u)
+        self._sync(x)
+        R = self.K.createVecLeft()
+        self._unconstrained_residual(x, R, search=False)
+        return R
 
     def _search(self) -> None:
         """The coupling's search at the current u. The Jacobian's sparsity may change with it:

@@ -161,7 +161,9 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
 def test_loads_and_amplitude_reach_the_support(tmp_path, load, per_length):
     """No contact (the obstacle stays 1 above the pad): the bottom carries the load on the top
     (length 2) scaled by the amplitude table at each step, exactly (to solver tolerance)."""
+    # (the obstacle's surface is the sides: the top carries the load)
     text = GOOD.replace("position = [0.0, 1.0]", "position = [0.0, 2.0]").replace(
+        'contact = "top"', 'contact = "sides"').replace(
         '[obstacle]',
         f'[[boundary]]\ngroup = "top"\n{load}\namplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 0.5]]'
         '\n\n[obstacle]')  # fmt: skip
