@@ -52,7 +52,7 @@ def test_contact_pair_problem_reactions_balance():
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
 @pytest.mark.parametrize("name", ["holed-pad.toml", "block-on-plinth.toml",
-                                  "pressurised-crack.toml"])  # fmt: skip
+                                  "pressurised-crack.toml", "bored-block.toml"])  # fmt: skip
 def test_problem_file_ranks_agree(name):
     _, parallel = _solve(name)
     _, serial = _solve(name, comm=MPI.COMM_SELF)
@@ -322,3 +322,16 @@ probes = [[0.3, 0.5], [0.6, 1.5], [5.0, 5.0]]
     assert row["probe1_uy"] == pytest.approx(-s * 1.5 / ref["M"] - v, rel=1e-6)
     assert abs(row["probe0_ux"]) + abs(row["probe1_ux"]) <= 1e-9 * v
     assert np.isnan(row["probe2_uy"])  # outside the mesh
+
+
+def test_petsc_table_reaches_the_solver():
+    """[petsc] options apply: GMRES + Jacobi instead of LU takes many Krylov iterations per
+    Newton step and, solved to 1e-12, gives the LU run's force (Newton stops at snes_rtol
+    1e-10: 1e-8)."""
+    _, lu = _solve("holed-pad.toml", sets=["numerics.steps=1"])
+    _, it = _solve("holed-pad.toml", sets=["numerics.steps=1", "petsc.ksp_type=gmres",
+                                           "petsc.pc_type=jacobi", "petsc.ksp_rtol=1e-12",
+                                           "petsc.ksp_max_it=20000"])  # fmt: skip
+    assert lu.ksp_iterations == lu.newton_iterations
+    assert it.ksp_iterations > 10 * it.newton_iterations
+    assert it.force == pytest.approx(lu.force, rel=1e-8)
