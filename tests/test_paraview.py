@@ -12,14 +12,18 @@ Vector (face jump = the aperture field, to 1e-6) against Sneddon's closed form (
 surface dataset carrying the same contact fields.
 
 Needs ``pvpython`` (Debian: ``apt-get install paraview python3-paraview``) and, without a
-display, ``xvfb-run`` (``xvfb xauth``): ParaView 5.11 of Debian 12 renders through X even with
-``--force-offscreen-rendering``. Launches subprocesses: ``serial_only``.
+display, ``Xvfb`` (``xvfb``): ParaView 5.11 of Debian 12 renders through X even with
+``--force-offscreen-rendering``. One Xvfb server serves the module, on a display number no
+other server holds (starting one per probe with ``xvfb-run -a`` raced: a probe sometimes got
+"bad X server connection"). Launches subprocesses: ``serial_only``.
 """
 
 import json
 import os
 import shutil
 import subprocess
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +31,7 @@ import pytest
 from conftest import clean_env, run_cli
 
 PVPYTHON = shutil.which("pvpython")
-XVFB = shutil.which("xvfb-run")
+XVFB = shutil.which("Xvfb")
 pytestmark = [
     pytest.mark.serial_only,
     pytest.mark.skipif(
@@ -35,7 +39,7 @@ pytestmark = [
     ),
     pytest.mark.skipif(
         not os.environ.get("DISPLAY") and XVFB is None,
-        reason="no display and no xvfb-run (Debian: xvfb xauth) to render",
+        reason="no display and no Xvfb (Debian: xvfb) to render",
     ),
 ]
 
@@ -104,29 +108,56 @@ CASES = {
 }  # fmt: skip
 
 
-def _probe(out, scene, field, scale):
+@pytest.fixture(scope="module")
+def display():
+    """The DISPLAY to render on: the user's, or a private Xvfb server for the module."""
+    if os.environ.get("DISPLAY"):
+        yield os.environ["DISPLAY"]
+        return
+    server, number = None, None
+    for n in range(90, 200):  # a free display: no lock file, and the server stays up
+        if Path(f"/tmp/.X{n}-lock").exists() or Path(f"/tmp/.X11-unix/X{n}").exists():
+            continue
+        argv = [XVFB, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"]
+        server = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        for _ in range(200):  # up once its socket exists (or it exited: display taken)
+            if Path(f"/tmp/.X11-unix/X{n}").exists() or server.poll() is not None:
+                break
+            time.sleep(0.05)
+        time.sleep(0.5)
+        if server.poll() is None:
+            number = n
+            break
+    assert number is not None, "no Xvfb server could start"
+    try:
+        yield f":{number}"
+    finally:
+        server.terminate()
+        server.wait(timeout=30)
+
+
+def _probe(out, scene, field, scale, display):
     png = out / f"{scene}-paraview.png"
     script = out / "probe.py"
     script.write_text(PROBE)
     cmd = [PVPYTHON, "--force-offscreen-rendering", str(script), str(out / f"{scene}.pvd"),
            str(out / f"{scene}_surface.pvd"), str(png), "POINTS", str(scale), field]  # fmt: skip
-    if not os.environ.get("DISPLAY"):
-        cmd = [XVFB, "-a", "-s", "-screen 0 1024x768x24", *cmd]
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=clean_env())
+    env = {**clean_env(), "DISPLAY": display}
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
     lines = [ln for ln in res.stdout.splitlines() if ln.startswith("PROBE ")]
     assert res.returncode == 0 and lines, res.stdout + res.stderr
     return json.loads(lines[-1][len("PROBE ") :]), png
 
 
 @pytest.mark.parametrize("kind", list(CASES))
-def test_paraview_opens_one_dataset_with_every_field(kind, tmp_path):
+def test_paraview_opens_one_dataset_with_every_field(kind, tmp_path, display):
     args, point, cell, field, scale = CASES[kind]
     scene = args[0]
     res = run_cli("run", *args, "--quiet", "--out", str(tmp_path), ranks=2)
     assert res.returncode == 0, res.stderr
     run = json.loads((tmp_path / "run.json").read_text())
     assert run["paraview"] == str(tmp_path / f"{scene}.pvd")
-    probe, png = _probe(tmp_path, scene, field, scale)
+    probe, png = _probe(tmp_path, scene, field, scale, display)
 
     # one unstructured grid per step (not a multiblock of per-field grids), every field on it
     assert probe["class"] == "vtkUnstructuredGrid"
