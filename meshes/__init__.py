@@ -38,6 +38,7 @@ from contactfx.meshes._build import (
 )
 from contactfx.meshes.box import BoxCells, BoxFacets, box
 from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
+from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
 from contactfx.meshes.two_body import (
@@ -67,6 +68,8 @@ __all__ = [
     "Builder",
     "CrackPlateCells",
     "CrackPlateFacets",
+    "IntervalCells",
+    "IntervalFacets",
     "CylindersCells",
     "CylindersFacets",
     "Group",
@@ -91,6 +94,7 @@ __all__ = [
     "build_file",
     "file_groups",
     "crack_plate",
+    "interval",
     "cylinders",
     "joint_column",
     "punch_foundation",

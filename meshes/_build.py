@@ -132,8 +132,8 @@ def _gmsh_session(name: str) -> Iterator[type[gmsh.model]]:
 
 
 def _check_gdim(gdim: int) -> None:
-    if gdim not in (2, 3):
-        raise ValueError(f"gdim must be 2 or 3, got {gdim}")
+    if gdim not in (1, 2, 3):
+        raise ValueError(f"gdim must be 1, 2 or 3, got {gdim}")
 
 
 def _check_generated(model: type[gmsh.model], gdim: int) -> None:

@@ -1,5 +1,5 @@
 """Command line: ``contactfx list | run SCENE [options] [-- PETSc options] | bench | stress |
-plot RUN``.
+solve PROBLEM.toml | check PROBLEM.toml | init SCENE --out DIR | plot RUN``.
 
 PETSc options after ``--`` reach PETSc: they initialise petsc4py before dolfinx is imported and
 are copied under the solver's options prefix, so ``-- -snes_monitor -ksp_type gmres`` works.
@@ -20,7 +20,7 @@ USAGE = (
     "bench [--scene CASES] [--method M,...] [--levels N] [--degree 1,2] [--out DIR] | "
     "stress [--quick] [--axis AXES] [--out DIR] | "
     "solve PROBLEM.toml [--set KEY=VALUE] [--out DIR] [-- PETSc options] | "
-    "check PROBLEM.toml | "
+    "check PROBLEM.toml | init SCENE [options] --out DIR | "
     "plot RUN [--field NAME] [--step N] [--scale S] [--out PNG]}"
 )
 
@@ -47,6 +47,10 @@ def _dispatch(command: str, rest: list[str], petsc_options: dict, comm) -> int:
         from contactfx.cli.solve import cmd_check, cmd_solve
 
         return (cmd_solve if command == "solve" else cmd_check)(rest, petsc_options, comm)
+    if command == "init":
+        from contactfx.cli.init import cmd_init
+
+        return cmd_init(rest, comm)
     if command == "plot":
         from contactfx.cli.plot import cmd_plot
 

@@ -17,9 +17,9 @@ from contactfx.solvers.snes import ConvergenceError
 __all__ = ["cmd_list", "cmd_run", "table", "write_failed", "print_outputs"]
 
 
-def _scene_parser(scene_cls) -> Parser:
+def _scene_parser(scene_cls, command: str = "run") -> Parser:
     parser = Parser(
-        prog=f"contactfx run {scene_cls.name}",
+        prog=f"contactfx {command} {scene_cls.name}",
         description=scene_cls.summary,
         epilog="PETSc options go after '--', e.g. -- -snes_monitor -ksp_type gmres",
     )

@@ -5,6 +5,7 @@ x = L + g0 (u(L) <= g0). With Nitsche's method its discrete solution is known ex
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import dolfinx
@@ -14,7 +15,9 @@ import ufl
 from contactfx import _compat
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.mechanics.elasticity import Elastic
+from contactfx.meshes import interval
 from contactfx.params import param
+from contactfx.scenes import export
 from contactfx.scenes._common import fix
 from contactfx.scenes.base import ObstacleScene, SceneParams
 
@@ -54,6 +57,18 @@ class Bar1D(ObstacleScene):
         order = np.argsort(indices)
         tags = dolfinx.mesh.meshtags(mesh, 0, indices[order], values[order].astype(np.int32))
         return mesh, tags
+
+    def mesh_builder(self):
+        return functools.partial(interval, length=self.p.length, cells=self.p.cells), 1
+
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        return {
+            "bodies": [export.body("bar", self.material(), body_force=[p.body_force])],
+            "boundary": [export.fixed("left", (0,))],
+            "obstacle": {"shape": "plane", "contact": "right", "h": self.h_contact(),
+                         **export.motion(self.obstacle_offset, 1)},
+        }  # fmt: skip
 
     def obstacle(self) -> Obstacle:
         return HalfSpace(0.0)

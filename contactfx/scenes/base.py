@@ -18,6 +18,7 @@ from mpi4py import MPI
 from contactfx.contact.obstacles import Obstacle
 from contactfx.driver.obstacle import ObstacleProblem
 from contactfx.mechanics.elasticity import Elastic
+from contactfx.meshes import build
 from contactfx.numerics import Numerics
 from contactfx.params import Params, param
 from contactfx.results import RunSummary
@@ -70,9 +71,24 @@ class Scene:
         parameters (gamma_N = gamma0 E / h, kappa, r)."""
         return self.material().E
 
+    def mesh_builder(self):
+        """(builder, gdim): the scene's gmsh geometry (:mod:`contactfx.meshes`) with its
+        parameters bound; :meth:`build_mesh` meshes it, ``contactfx init`` writes it to a
+        ``.msh`` file."""
+        raise NotImplementedError(f"scene '{self.name}' has no gmsh builder")
+
     def build_mesh(self, comm):
-        """Return (mesh, facet_tags)."""
-        raise NotImplementedError
+        """Return (mesh, facet_tags) (and keep the cell tags as ``cell_tags``)."""
+        builder, gdim = self.mesh_builder()
+        data = build(comm, builder, gdim, self.name)
+        self.cell_tags = data.cell_tags
+        return data.mesh, data.facet_tags
+
+    def problem_data(self, numerics: Numerics) -> dict:
+        """The scene as the tables of a problem file (all but ``[mesh]``, groups by the
+        physical names of :meth:`mesh_builder`) under ``numerics``: what ``contactfx init``
+        writes (:mod:`contactfx.scenes.export`); solving that file gives this scene's run."""
+        raise NotImplementedError(f"scene '{self.name}' cannot be written as a problem file")
 
     def load(self, v, ds, t):
         """External load (linear form in v); t is the load-factor Constant. None for none."""

@@ -9,6 +9,7 @@ The edge radius regularises the corner; the contact extends beyond a by O(edge r
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +18,8 @@ from contactfx.contact.obstacles import FlatPunch, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
 from contactfx.references import rigid_punch_2d
-from contactfx.scenes._common import fix, gmsh_mesh
+from contactfx.scenes import export
+from contactfx.scenes._common import fix
 from contactfx.scenes.base import ObstacleScene, elastic
 from contactfx.scenes.hertz import QuarterBlock
 
@@ -50,14 +52,14 @@ class FlatPunch2D(ObstacleScene):
     Params = FlatPunch2DParams
     contact_tag = RectangleFacets.TOP
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         w = 1.2 * p.punch_half_width
-        return gmsh_mesh(
-            comm, rectangle, 2, self.name,
+        return functools.partial(
+            rectangle,
             x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
             refine_x0=-w, refine_x1=w, h_contact=p.h_contact, h_far=p.h_far,
-        )  # fmt: skip
+        ), 2  # fmt: skip
 
     def obstacle(self) -> Obstacle:
         return FlatPunch(self.p.punch_half_width, self.p.edge_radius)
@@ -67,6 +69,16 @@ class FlatPunch2D(ObstacleScene):
 
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, RectangleFacets.BOTTOM)
+
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [export.fixed("bottom", (0, 1))],
+            "obstacle": {"shape": "punch", "contact": "top", "radius": p.punch_half_width,
+                         "edge_radius": p.edge_radius, "h": p.h_contact,
+                         **export.motion(self.obstacle_offset, 2)},
+        }  # fmt: skip
 
     def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
         """max |pi sqrt(a^2 - x^2) p_h / P - 1| over surface nodes with |x| <= 0.8 a."""
@@ -92,6 +104,10 @@ class FlatPunch3D(QuarterBlock):
 
     def refine_radius(self) -> float:
         return 1.2 * self.p.punch_radius
+
+    def obstacle_data(self) -> dict:
+        return {"shape": "punch", "radius": self.p.punch_radius,
+                "edge_radius": self.p.edge_radius}  # fmt: skip
 
     def obstacle(self) -> Obstacle:
         return FlatPunch(self.p.punch_radius, self.p.edge_radius)

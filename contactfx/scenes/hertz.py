@@ -17,6 +17,7 @@ contrast) and the scene reports no reference.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import dolfinx
@@ -28,7 +29,8 @@ from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.params import param
 from contactfx.references import hertz_2d, hertz_3d
-from contactfx.scenes._common import fix, fix_component, gmsh_mesh
+from contactfx.scenes import export
+from contactfx.scenes._common import fix, fix_component
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["Hertz2D", "Hertz3D", "QuarterBlock", "cattaneo_mindlin"]
@@ -113,15 +115,15 @@ class Hertz2D(ObstacleScene):
         """Young's modulus of the top layer (E without a layer)."""
         return self.p.layer_E if self.layered and self.p.layer_E > 0.0 else self.p.E
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
-        return gmsh_mesh(
-            comm, rectangle, 2, self.name,
+        return functools.partial(
+            rectangle,
             x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
             refine_x0=-p.refine_half_width, refine_x1=p.refine_half_width,
             h_contact=p.h_contact, h_far=p.h_far,
             interfaces=(-p.layer_thickness,) if self.layered else (),
-        )  # fmt: skip
+        ), 2  # fmt: skip
 
     def modulus(self, mesh):
         """Piecewise constant (DG0) modulus: layer_E in the layer, E below. The interface is a
@@ -146,6 +148,21 @@ class Hertz2D(ObstacleScene):
 
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, RectangleFacets.BOTTOM)
+
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        if self.layered:
+            raise ValueError("contactfx init hertz2d: a layered block (--layer-thickness) has "
+                             "one cell group in its mesh: it cannot be written as a problem "
+                             "file yet")  # fmt: skip
+        kinks = (0.0, 0.5, 1.0) if p.shift > 0.0 else (0.0, 1.0)
+        shape = "circle" if p.profile == "circle" else "parabola"
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [export.fixed("bottom", (0, 1))],
+            "obstacle": {"shape": shape, "contact": "top", "radius": p.radius,
+                         "h": p.h_contact, **export.motion(self.obstacle_offset, 2, kinks)},
+        }  # fmt: skip
 
     def _hertz(self, force: float) -> dict[str, float]:
         """The half-space closed form, or {} for a layer of another modulus (none applies)."""
@@ -199,18 +216,36 @@ class QuarterBlock(ObstacleScene):
     def refine_radius(self) -> float:
         raise NotImplementedError
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
-        return gmsh_mesh(
-            comm, box, 3, self.name,
+        return functools.partial(
+            box,
             x0=-p.size if self.half else 0.0, x1=p.size, y0=0.0, y1=p.size,
             z0=-p.height, z1=0.0,
             refine_center=(0.0, 0.0), refine_radius=self.refine_radius(),
             h_contact=p.h_contact, h_far=p.h_far,
-        )  # fmt: skip
+        ), 3  # fmt: skip
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
         return _indent_then_shift(t, self.p.depth, self.shift, gdim)
+
+    def obstacle_data(self) -> dict:
+        """The ``[obstacle]`` shape keys of the indenter."""
+        raise NotImplementedError
+
+    def problem_data(self, numerics) -> dict:
+        boundary = [export.fixed("zmin", (0, 1, 2)), export.fixed("ymin", (1,))]
+        if not self.half:
+            boundary.append(export.fixed("xmin", (0,)))
+        kinks = (0.0, 0.5, 1.0) if self.half else (0.0, 1.0)
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": boundary,
+            "obstacle": {**self.obstacle_data(), "contact": "zmax", "h": self.p.h_contact,
+                         **export.motion(self.obstacle_offset, 3, kinks)},
+            "output": {"symmetry": self.symmetry,
+                       "tangential_symmetry": list(self.tangential_symmetry)},
+        }  # fmt: skip
 
     def dirichlet(self, V, facet_tags):
         bcs = [*fix(V, facet_tags, BoxFacets.ZMIN), fix_component(V, facet_tags, BoxFacets.YMIN, 1)]
@@ -229,6 +264,10 @@ class Hertz3D(QuarterBlock):
 
     def refine_radius(self) -> float:
         return self.p.refine_radius
+
+    def obstacle_data(self) -> dict:
+        shape = "sphere" if self.p.profile == "circle" else "paraboloid"
+        return {"shape": shape, "radius": self.p.radius}
 
     def obstacle(self) -> Obstacle:
         return _indenter(self.p.profile, self.p.radius)

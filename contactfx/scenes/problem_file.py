@@ -68,7 +68,14 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.contact.interface import BartonBandis
-from contactfx.contact.obstacles import Ball, HalfSpace, Obstacle
+from contactfx.contact.obstacles import (
+    Ball,
+    FlatPunch,
+    HalfSpace,
+    Obstacle,
+    Paraboloid,
+    Sinusoid,
+)
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import build_file
 from contactfx.numerics import Numerics
@@ -82,17 +89,34 @@ __all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
 
 AXES = ("x", "y", "z")
 SECTIONS = ("title", "mesh", "bodies", "boundary", "obstacle", "contact", "interface",
-            "numerics", "petsc", "output")  # fmt: skip
+            "initial", "numerics", "petsc", "output")  # fmt: skip
 KEYS = {
     "mesh": ("file", "size"),
-    "bodies": ("group", "E", "nu"),
+    "bodies": ("group", "E", "nu", "body_force", "amplitude"),
     "boundary": ("group", "fix", "displacement", "traction", "pressure", "amplitude"),
-    "obstacle": ("shape", "contact", "radius", "distance", "position", "motion", "amplitude"),
+    "obstacle": (
+        "shape",
+        "contact",
+        "radius",
+        "distance",
+        "position",
+        "motion",
+        "amplitude",
+        "path",
+        "height",
+        "wavelength",
+        "edge_radius",
+        "h",
+    ),
     "contact": ("slave", "master"),
     "interface": ("group", "fluid_pressure", "proppant_thickness", "joint"),
-    "output": ("reactions", "probes"),
+    "initial": ("displacement",),
+    "output": ("reactions", "probes", "symmetry", "tangential_symmetry", "contact_size"),
 }
-SHAPES = ("plane", "circle", "cylinder", "sphere", "distance")
+SHAPES = ("plane", "circle", "cylinder", "sphere", "parabola", "paraboloid", "sinusoid",
+          "punch", "distance")  # fmt: skip
+#: the contact size reported from the measure m of the contact set (times the symmetry)
+CONTACT_SIZES = ("half-measure", "measure", "disc-radius")
 
 
 @dataclass(frozen=True)
@@ -205,6 +229,20 @@ class _Reader:
             self.fail(f"{key}.amplitude", f"load factors must increase, got {ts}")
         return [(float(a), float(b)) for a, b in value]
 
+    def offsets(self, data: dict, key: str) -> list[list[float]]:
+        value = data["path"]
+        ok = isinstance(value, list) and len(value) >= 1 and all(
+            isinstance(r, list) and len(r) >= 2
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
+            for r in value)  # fmt: skip
+        if not ok or len({len(r) for r in value}) != 1:
+            self.fail(f"{key}.path", "expected a table of [load factor, offset components] "
+                      f"rows, got {value!r}")  # fmt: skip
+        ts = [r[0] for r in value]
+        if any(b <= a for a, b in zip(ts, ts[1:], strict=False)):
+            self.fail(f"{key}.path", f"load factors must increase, got {ts}")
+        return [[float(v) for v in r] for r in value]
+
 
 def _amplitude(table: list[tuple[float, float]], t: float) -> float:
     ts, vs = zip(*table, strict=True)
@@ -237,6 +275,11 @@ class ProblemFile:
     reactions: list[str]
     probes: list[list[float]]
     title: str
+    body_forces: list = dataclasses.field(default_factory=list)
+    initial: list | None = None
+    symmetry: float = 1.0
+    tangential_symmetry: list[float] | None = None
+    contact_size: str | None = None
 
 
 def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
@@ -260,7 +303,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     bodies_data = data.get("bodies")
     if not isinstance(bodies_data, list) or not bodies_data:
         r.fail("bodies", "expected at least one [[bodies]] table (group, E, nu)")
-    bodies = []
+    bodies, body_forces = [], []
     for i, b in enumerate(bodies_data):
         key = f"bodies.{i}"
         b = r.table(b, key, KEYS["bodies"])
@@ -270,6 +313,14 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         if not -1.0 < nu < 0.5:
             r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
         bodies.append((group, Elastic(E, nu)))
+        if "body_force" in b:
+            f = b["body_force"]
+            if not isinstance(f, list) or not f or not all(
+                    isinstance(v, int | float) and not isinstance(v, bool) for v in f):  # fmt: skip
+                r.fail(f"{key}.body_force", f"expected a list of numbers, got {f!r}")
+            body_forces.append((group, np.asarray(f, dtype=np.float64), r.amplitude(b, key)))
+        elif "amplitude" in b:
+            r.fail(f"{key}.amplitude", "an amplitude scales a body_force: give one")
 
     boundary = []
     for i, b in enumerate(data.get("boundary", [])):
@@ -339,8 +390,22 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
         obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
         obstacle["contact"] = r.string(obstacle, "obstacle", "contact")
-        if obstacle["shape"] in ("circle", "cylinder", "sphere"):
+        if obstacle["shape"] in ("circle", "cylinder", "sphere", "parabola", "paraboloid",
+                                 "punch"):  # fmt: skip
             obstacle["radius"] = r.number(obstacle, "obstacle", "radius", positive=True)
+        if obstacle["shape"] == "punch":
+            obstacle["edge_radius"] = r.number(obstacle, "obstacle", "edge_radius",
+                                               positive=True)  # fmt: skip
+        if obstacle["shape"] == "sinusoid":
+            for k in ("height", "wavelength"):
+                obstacle[k] = r.number(obstacle, "obstacle", k, positive=True)
+        if "h" in obstacle:
+            obstacle["h"] = r.number(obstacle, "obstacle", "h", positive=True)
+        if "path" in obstacle:
+            for k in ("motion", "amplitude"):
+                if k in obstacle:
+                    r.fail(f"obstacle.{k}", "give either path or motion (with its amplitude)")
+            obstacle["path"] = r.offsets(obstacle, "obstacle")
         if obstacle["shape"] == "distance":
             text = r.string(obstacle, "obstacle", "distance")
             try:
@@ -370,6 +435,25 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         for q in probes
     ):
         r.fail("output.probes", f"expected a list of points [x, y(, z)], got {probes!r}")
+    initial = r.table(data.get("initial", {}), "initial", KEYS["initial"])
+    displacement = initial.get("displacement")
+    if displacement is not None:
+        if not isinstance(displacement, list) or not all(
+                isinstance(e, str | int | float) for e in displacement):  # fmt: skip
+            r.fail("initial.displacement", "expected a list of expressions in x, y, z (one per "
+                   f"component), got {displacement!r}")  # fmt: skip
+        try:
+            displacement = [parse_expression(str(e)) for e in displacement]
+        except ValueError as err:
+            r.fail("initial.displacement", str(err))
+    symmetry = r.number(output, "output", "symmetry", 1.0, positive=True)
+    tsym = output.get("tangential_symmetry")
+    if tsym is not None and (not isinstance(tsym, list) or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in tsym)):  # fmt: skip
+        r.fail("output.tangential_symmetry", f"expected a list of numbers, got {tsym!r}")
+    contact_size = None
+    if "contact_size" in output:
+        contact_size = r.string(output, "output", "contact_size", CONTACT_SIZES)
     title = data.get("title", path.stem)
     if not isinstance(title, str):
         r.fail("title", f"expected a string, got {title!r}")
@@ -382,7 +466,9 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
              for k, v in petsc.items()}  # fmt: skip
     problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
-                          list(reactions), probes, title)  # fmt: skip
+                          list(reactions), probes, title, body_forces, displacement, symmetry,
+                          None if tsym is None else [float(v) for v in tsym],
+                          contact_size)  # fmt: skip
     return problem, numerics, petsc
 
 
@@ -485,6 +571,9 @@ class _FileMesh:
         self.summary = f"problem file {problem.path.name}"
         self.reaction_rows: list[dict] = []
         self._constants: list[tuple[dolfinx.fem.Constant, list, np.ndarray]] = []
+        self.symmetry = problem.symmetry
+        if problem.tangential_symmetry is not None:
+            self.tangential_symmetry = tuple(problem.tangential_symmetry)
 
     def _fail(self, key: str, message: str):
         raise ProblemError(f"{self.spec.path}: {key}: {message}")
@@ -556,6 +645,14 @@ class _FileMesh:
 
     def load(self, v, ds, t):
         L = None
+        dx = ufl.Measure("dx", domain=self._mesh, subdomain_data=self.cell_tags)
+        for i, (group, force, table) in enumerate(self.spec.body_forces):
+            if len(force) != self.gdim:
+                self._fail(f"bodies.{i}.body_force", f"expected {self.gdim} numbers")
+            amp = dolfinx.fem.Constant(self._mesh, 0.0)
+            self._constants.append((amp, table, np.array(1.0)))
+            form = amp * ufl.dot(ufl.as_vector(force.tolist()), v) * dx(self.groups[group].tag)
+            L = form if L is None else L + form
         for b in self.spec.boundary:
             if b.traction is None and b.pressure is None:
                 continue
@@ -578,8 +675,28 @@ class _FileMesh:
         return self._h
 
     def contact_size(self, measure: float) -> float:
-        """The contact half-width (2D) or the radius of the disc of the same area (3D)."""
-        return 0.5 * measure if self.gdim == 2 else float(np.sqrt(measure / np.pi))
+        """From the measure of the contact set (times the symmetry): by default the contact
+        half-width (2D) or the radius of the disc of the same area (3D); ``output.contact_size``
+        chooses half-measure, measure or disc-radius."""
+        rule = self.spec.contact_size or ("disc-radius" if self.gdim == 3 else "half-measure")
+        if rule == "measure":
+            return measure
+        return 0.5 * measure if rule == "half-measure" else float(np.sqrt(measure / np.pi))
+
+    def initial_guess(self, u, t: float) -> None:
+        """The file's ``initial.displacement`` (expressions in x, y, z), else zero."""
+        exprs = self.spec.initial
+        if exprs is None:
+            return
+        if len(exprs) != self.gdim:
+            self._fail("initial.displacement", f"expected {self.gdim} expressions, got "
+                       f"{len(exprs)}")  # fmt: skip
+        x = ufl.SpatialCoordinate(self._mesh)
+        y = ufl.as_vector([x[i] for i in range(self.gdim)])
+        values = [e(y) for e in exprs]
+        values = [v if isinstance(v, ufl.core.expr.Expr) else ufl.as_ufl(v) + 0.0 * x[0]
+                  for v in values]  # fmt: skip
+        u.interpolate(_compat.expression(ufl.as_vector(values), u.function_space))
 
     def _facet_size(self, mesh, facet_tags, tags: list[int]) -> float:
         """The longest edge of the facets of the groups ``tags`` (all ranks)."""
@@ -665,19 +782,44 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         self._facet_tags = facet_tags
         ob = self.spec.obstacle
         self.contact_tag = self.tag("obstacle.contact", ob["contact"], self.gdim - 1)
-        if ob["shape"] in ("circle", "cylinder") and self.gdim != 2:
-            self._fail("obstacle.shape", f"{ob['shape']} is a 2D obstacle (in 3D: sphere)")
-        if ob["shape"] == "sphere" and self.gdim != 3:
-            self._fail("obstacle.shape", "sphere is a 3D obstacle (in 2D: circle)")
+        for shape, dim, other in (("circle", 2, "sphere"), ("cylinder", 2, "sphere"),
+                                  ("parabola", 2, "paraboloid"), ("sphere", 3, "circle"),
+                                  ("paraboloid", 3, "parabola")):  # fmt: skip
+            if ob["shape"] == shape and self.gdim != dim:
+                self._fail("obstacle.shape", f"{shape} is a {dim}D obstacle (in "
+                           f"{5 - dim}D: {other})")  # fmt: skip
+        if ob["shape"] in ("sinusoid", "punch") and self.gdim == 1:
+            self._fail("obstacle.shape", f"{ob['shape']} needs a 2D or 3D problem")
         r = _Reader(self.spec.path)
         zero = [0.0] * self.gdim
         self.position = r.vector(ob, "obstacle", "position", self.gdim, zero)
         self.motion = r.vector(ob, "obstacle", "motion", self.gdim, zero)
-        self._h = self._facet_size(mesh, facet_tags, [self.contact_tag])
+        if "path" in ob and len(ob["path"][0]) != self.gdim + 1:
+            self._fail("obstacle.path", f"expected rows [load factor, {self.gdim} offset "
+                       "components]")  # fmt: skip
+        self._h = ob.get("h") or self._facet_size(mesh, facet_tags, [self.contact_tag])
+        if not self._h > 0.0:
+            self._fail("obstacle.h", "the contact facets have no size (a 1D problem): give "
+                       "the element size h")  # fmt: skip
         if len(self.spec.bodies) > 1 and len({m.nu for _, m in self.spec.bodies}) > 1:
             self._fail("bodies", "bodies of different nu against an obstacle are not supported "
                        "(one nu, E per body)")  # fmt: skip
+        self._contact_E = self._touching_modulus(mesh, facet_tags, self.contact_tag)
         return mesh, facet_tags
+
+    def _touching_modulus(self, mesh, facet_tags, tag: int) -> float:
+        """The largest Young's modulus of the bodies whose cells touch the facet group."""
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        f2c = mesh.topology.connectivity(tdim - 1, tdim)
+        cells = np.unique([c for f in facet_tags.indices[facet_tags.values == tag]
+                           for c in f2c.links(f)])  # fmt: skip
+        cell_body = dict(zip(self.cell_tags.indices, self.cell_tags.values, strict=True))
+        moduli = {tag: m.E for tag, (_, m) in zip(self.body_tags, self.spec.bodies,
+                                                  strict=True)}  # fmt: skip
+        local = max((moduli.get(cell_body.get(int(c)), 0.0) for c in cells), default=0.0)
+        E = mesh.comm.allreduce(local, op=MPI.MAX)
+        return E if E > 0.0 else max(moduli.values())
 
     def material(self) -> Elastic:
         return self.spec.bodies[0][1]
@@ -694,18 +836,31 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         return E
 
     def contact_modulus(self) -> float:
-        return max(m.E for _, m in self.spec.bodies)
+        """The modulus of the body at the contact surface (the largest, if several touch)."""
+        return self._contact_E
 
     def obstacle(self) -> Obstacle:
         ob = self.spec.obstacle
-        if ob["shape"] == "plane":
+        shape = ob["shape"]
+        if shape == "plane":
             return HalfSpace(0.0)
-        if ob["shape"] == "distance":
+        if shape == "distance":
             return DistanceObstacle(ob["distance"])
+        if shape in ("parabola", "paraboloid"):
+            return Paraboloid(ob["radius"])
+        if shape == "sinusoid":
+            return Sinusoid(ob["height"], ob["wavelength"])
+        if shape == "punch":
+            return FlatPunch(ob["radius"], ob["edge_radius"])
         return Ball(ob["radius"])
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
-        return self.position + self.motion * _amplitude(self.spec.obstacle["amplitude"], t)
+        ob = self.spec.obstacle
+        if "path" in ob:
+            rows = np.asarray(ob["path"])
+            moved = np.array([np.interp(t, rows[:, 0], rows[:, 1 + i]) for i in range(gdim)])
+            return self.position + moved
+        return self.position + self.motion * _amplitude(ob["amplitude"], t)
 
 
 class FileTwoBodyScene(_FileMesh, TwoBodyScene):

@@ -16,6 +16,7 @@ the stick zone shrinks towards the middle as the shift grows.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,8 @@ import ufl
 from contactfx.contact.obstacles import HalfSpace, Obstacle
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
-from contactfx.scenes._common import fix_component, gmsh_mesh
+from contactfx.scenes import export
+from contactfx.scenes._common import fix_component
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["SlidingBlock", "SlidingBlockParams"]
@@ -53,14 +55,14 @@ class SlidingBlock(ObstacleScene):
     }  # fmt: skip
     contact_tag = RectangleFacets.TOP
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         half = 0.5 * p.width
-        return gmsh_mesh(
-            comm, rectangle, 2, self.name,
+        return functools.partial(
+            rectangle,
             x0=-half, x1=half, y0=-p.height, y1=0.0, refine_x0=-half, refine_x1=half,
             h_contact=p.h, h_far=p.h,
-        )  # fmt: skip
+        ), 2  # fmt: skip
 
     def h_contact(self) -> float:
         return self.p.h
@@ -84,6 +86,20 @@ class SlidingBlock(ObstacleScene):
         strain = min(2.0 * t, 1.0) * self.p.pressure / self.material().M
         overlap = 1e-3 * self.p.h
         u.interpolate(lambda x: np.vstack([np.zeros(x.shape[1]), overlap - strain * x[1]]))
+
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        t = 1.0 / numerics.steps
+        strain = min(2.0 * t, 1.0) * p.pressure / self.material().M
+        overlap = 1e-3 * p.h
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [{"group": "bottom", "fix": ["x"], "traction": [0.0, p.pressure],
+                          "amplitude": [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]}],
+            "obstacle": {"shape": "plane", "contact": "top", "h": p.h,
+                         **export.motion(self.obstacle_offset, 2, (0.0, 0.5, 1.0))},
+            "initial": {"displacement": ["0.0", f"{overlap!r} - {strain!r} * y"]},
+        }  # fmt: skip
 
     def reference(self, force: float) -> dict[str, float]:
         return {"force": self.p.pressure * self.p.width}

@@ -18,6 +18,7 @@ H is of relative size (1 + kH) e^{-kH} (5e-5 at H = 2 lambda): far below the err
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +27,8 @@ import ufl
 from contactfx.contact.obstacles import Obstacle, Sinusoid
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
-from contactfx.scenes._common import fix_component, gmsh_mesh
+from contactfx.scenes import export
+from contactfx.scenes._common import fix_component
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["Westergaard"]
@@ -58,14 +60,14 @@ class Westergaard(ObstacleScene):
     def p_mean(self) -> float:
         return self.p.mean_pressure_ratio * self.p_star
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         half = 0.5 * p.wavelength
-        return gmsh_mesh(
-            comm, rectangle, 2, self.name,
+        return functools.partial(
+            rectangle,
             x0=0.0, x1=half, y0=-p.depth_ratio * p.wavelength, y1=0.0,
             refine_x0=0.0, refine_x1=half, h_contact=p.h_contact, h_far=p.h_far,
-        )  # fmt: skip
+        ), 2  # fmt: skip
 
     def obstacle(self) -> Obstacle:
         return Sinusoid(self.p.amplitude, self.p.wavelength)
@@ -89,6 +91,22 @@ class Westergaard(ObstacleScene):
 
     def contact_size(self, measure: float) -> float:
         return measure
+
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        r = min(p.mean_pressure_ratio / numerics.steps, 1.0)
+        lift = 2.0 * p.amplitude * r
+        strain = self.p_mean / numerics.steps / self.material().M
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [export.fixed("left", (0,)), export.fixed("right", (0,)),
+                         {"group": "bottom", "traction": [0.0, self.p_mean]}],
+            "obstacle": {"shape": "sinusoid", "contact": "top", "height": p.amplitude,
+                         "wavelength": p.wavelength, "h": p.h_contact},
+            # Newton's start: a rigid lift into the obstacle plus the strip's compression
+            "initial": {"displacement": ["0.0", f"{lift!r} - {strain!r} * y"]},
+            "output": {"contact_size": "measure"},
+        }  # fmt: skip
 
     def reference(self, force: float) -> dict[str, float]:
         r = self.p.mean_pressure_ratio

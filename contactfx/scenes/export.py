@@ -1,0 +1,97 @@
+"""``contactfx init``: a built-in scene written as a problem file with its mesh beside it.
+
+The scene gives its gmsh geometry (:meth:`contactfx.scenes.base.Scene.mesh_builder`), written
+to ``<scene>.msh`` with its physical names, and its physics as the tables of a problem file
+(:meth:`contactfx.scenes.base.Scene.problem_data`): bodies, supports and loads with their load
+amplitudes, the obstacle, contact pair or interface, the initial state, the outputs. The
+numerics are the run's. Solving the file (:mod:`contactfx.scenes.problem_file`) is the scene's
+discrete problem: the same mesh, forms and load program, so the same numbers up to round-off
+(docs/verification.md section 11).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from mpi4py import MPI
+
+from contactfx.io.toml import dumps
+from contactfx.meshes import write_msh
+from contactfx.numerics import Numerics
+
+__all__ = ["write_problem", "numerics_table"]
+
+ORDER = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
+         "initial", "numerics", "petsc", "output")  # fmt: skip
+
+
+def numerics_table(numerics: Numerics) -> dict:
+    """The numerics that differ from the defaults, with the method and the steps always."""
+    default = Numerics()
+    out = {}
+    for f in dataclasses.fields(Numerics):
+        value = getattr(numerics, f.name)
+        if f.name in ("method", "steps") or value != getattr(default, f.name):
+            out[f.name] = value
+    return out
+
+
+def write_problem(scene, numerics: Numerics, out: Path, command: str,
+                  comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[Path, Path]:  # fmt: skip
+    """Write ``out/<scene>.msh`` and ``out/<scene>.toml``; returns their paths. Collective:
+    rank 0 writes, an error there is raised on every rank."""
+    tables = scene.problem_data(numerics)  # refuses what a problem file cannot say, first
+    builder, gdim = scene.mesh_builder()
+    out = Path(out)
+    msh, toml = out / f"{scene.name}.msh", out / f"{scene.name}.toml"
+    failure = None
+    if comm.rank == 0:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+            write_msh(builder, gdim, msh, scene.name)
+            doc = {"title": scene.name, "mesh": {"file": msh.name}, **tables,
+                   "numerics": numerics_table(numerics)}  # fmt: skip
+            doc = {k: doc[k] for k in ORDER if k in doc}
+            head = (
+                f"# {scene.summary}\n# the built-in scene '{scene.name}' as a problem file, "
+                f"written by: {command}\n# solve it with: contactfx solve {toml.name}\n\n"
+            )
+            toml.write_text(head + dumps(doc))
+        except Exception as exc:
+            failure = exc
+    failure = comm.bcast(failure, root=0)
+    if failure is not None:
+        raise failure
+    return msh, toml
+
+
+# -- helpers of the scenes' problem_data ---------------------------------------------------
+
+AXES = ("x", "y", "z")
+
+
+def body(group: str, material, **extra) -> dict:
+    """A ``[[bodies]]`` table."""
+    return {"group": group, "E": float(material.E), "nu": float(material.nu), **extra}
+
+
+def fixed(group: str, components) -> dict:
+    """A ``[[boundary]]`` table fixing the components (indices) on the group."""
+    return {"group": group, "fix": [AXES[c] for c in components]}
+
+
+def motion(offset, gdim: int, kinks=(0.0, 1.0)) -> dict:
+    """The obstacle's motion keys from its rigid offset ``offset(t, gdim)``, piecewise linear
+    in the load factor with the kinks ``kinks``: ``position`` and ``motion`` when it is linear,
+    else a ``path`` table."""
+    rows = [[float(t), *(float(v) for v in offset(t, gdim))] for t in kinks]
+    if len(rows) == 2 and rows[0][0] == 0.0 and rows[1][0] == 1.0:
+        start, end = rows[0][1:], rows[1][1:]
+        out = {}
+        if any(start):
+            out["position"] = start
+        if any(e - s for s, e in zip(start, end, strict=True)):
+            out["motion"] = [e - s for s, e in zip(start, end, strict=True)]
+        return out
+    return {"path": rows}

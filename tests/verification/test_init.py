@@ -1,0 +1,111 @@
+"""``contactfx init``: every built-in scene written as a problem file with its mesh beside it
+and solved by ``contactfx solve`` gives the scene's own run.json numbers (docs/verification.md
+section 11).
+
+Both runs solve the same discrete problem (the same gmsh mesh, read back from the .msh file;
+the same forms, loads and Newton start), so they differ by round-off only: every computed
+number of run.json (dofs, iterations, forces, sizes, pressures, friction and interface
+quantities, per step) agrees to 1e-10 relative. The closed-form references and scores are the
+scene's own (a problem file has none) and are not compared."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mpi4py import MPI
+
+from contactfx.numerics import Numerics
+from contactfx.scenes import SCENES, get_scene
+from contactfx.scenes.export import write_problem
+from contactfx.scenes.problem_file import load_problem
+
+#: (scene, parameters, numerics): coarse meshes, every scene kind and obstacle shape
+OBSTACLE_CASES = [
+    ("hertz2d", {"h_contact": 0.01}, {}),
+    ("hertz2d", {"h_contact": 0.01, "profile": "circle", "gap0": 5e-4}, {"steps": 2}),
+    ("hertz2d", {"h_contact": 0.01, "shift": 5e-4},
+     {"friction": "coulomb", "mu": 0.3, "steps": 4}),
+    ("hertz3d", {"h_contact": 0.06, "h_far": 0.4}, {}),
+    ("punch2d", {"h_contact": 0.01}, {}),
+    ("punch3d", {"h_contact": 0.02, "h_far": 0.4}, {"method": "penalty"}),
+    ("westergaard", {"h_contact": 1.0 / 32}, {}),
+    ("sliding-block", {"h": 0.1}, {"steps": 4}),
+    ("bar1d", {}, {}),
+]  # fmt: skip
+INTERFACE_CASES: list = []
+TWO_BODY_CASES: list = []
+CASES = OBSTACLE_CASES + INTERFACE_CASES + TWO_BODY_CASES
+
+#: what a problem-file run cannot report like the scene: its name and parameters, the
+#: closed-form references and scores, timings, file names
+SKIP = {"status", "scene", "parameters", "versions", "petsc_prefix", "timings", "reference",
+        "scores", "errors", "paraview", "paraview_surface", "plot"}  # fmt: skip
+
+
+def _flat(data, prefix=""):
+    if isinstance(data, dict):
+        out = {}
+        for k, v in data.items():
+            if not prefix and k in SKIP:
+                continue
+            out.update(_flat(v, f"{prefix}{k}."))
+        return out
+    if isinstance(data, list):
+        out = {}
+        for i, v in enumerate(data):
+            out.update(_flat(v, f"{prefix}{i}."))
+        return out
+    return {prefix[:-1]: data}
+
+
+def _shared_dir(tmp_path: Path, comm) -> Path:
+    return Path(comm.bcast(str(tmp_path), root=0))
+
+
+@pytest.mark.parametrize("name, params, numerics", CASES,
+                         ids=[f"{c[0]}-{i}" for i, c in enumerate(CASES)])  # fmt: skip
+def test_init_round_trip(tmp_path, name, params, numerics):
+    comm = MPI.COMM_WORLD
+    cls = get_scene(name)
+    scene = cls(cls.Params(**params))
+    num = cls.default_numerics(**numerics)
+    builtin = scene.run(num, comm=comm, verbose=False).to_json()
+
+    out = _shared_dir(tmp_path, comm)
+    _, toml = write_problem(scene, num, out, f"contactfx init {name}", comm)
+    file_scene, file_num, petsc = load_problem(toml)
+    assert file_num == num
+    solved = file_scene.run(file_num, comm=comm, petsc_options=petsc, verbose=False).to_json()
+
+    a, b = _flat(builtin), _flat(solved)
+    assert a, "nothing to compare"
+    missing = sorted(set(a) - set(b))
+    assert not missing, f"the problem file's run.json lacks {missing}"
+    scale = max(abs(builtin["force"]), abs(builtin.get("peak_pressure", 0.0)), 1e-300)
+    h = builtin["h_contact"]
+    for key, va in a.items():
+        vb = b[key]
+        if isinstance(va, float) or isinstance(vb, float):
+            # round-off: 1e-10 relative, with a floor of 1e-12 of the quantity's natural scale
+            # (h for lengths, the force / peak pressure otherwise) for values near zero
+            length = any(w in key for w in ("size", "width", "penetration", "gap", "aperture",
+                                            "slip", "opening", "h_contact"))  # fmt: skip
+            floor = 1e-12 * (h if length else scale)
+            assert abs(va - vb) <= 1e-10 * max(abs(va), abs(vb)) + floor, (key, va, vb)
+        else:
+            assert va == vb, (key, va, vb)
+
+
+def test_every_scene_has_a_round_trip_case():
+    covered = {c[0] for c in CASES}
+    assert sorted(set(SCENES) - covered) == []
+
+
+def test_init_refuses_what_a_problem_file_cannot_say(tmp_path):
+    cls = get_scene("hertz2d")
+    scene = cls(cls.Params(layer_thickness=0.05, layer_E=2000.0))
+    with pytest.raises(ValueError, match="layered block"):
+        write_problem(scene, Numerics(), _shared_dir(tmp_path, MPI.COMM_WORLD), "init",
+                      MPI.COMM_WORLD)  # fmt: skip
+    assert not any(Path(tmp_path).iterdir())
