@@ -91,6 +91,13 @@ BAD = [
     (["run", "joint-column", "--Vm", "2e-3"], "--Vm (0.002) must be <= --aperture"),
     # the fluid pushes harder than the load: no equilibrium, the solve diverges
     (["run", "joint-column", "--fluid-pressure", "40e6"], "nonlinear solve diverged"),
+    (["init", "nosuch", "--out", "x"], "unknown scene 'nosuch'"),
+    (["init", "hertz2d"], "give the output folder with --out DIR"),
+    (["init", "hertz2d", "--nu", "0.5", "--out", "x"], "Poisson's ratio nu must lie in"),
+    (
+        ["init", "hertz2d", "--layer-thickness", "0.05", "--out", "x"],
+        "a layered block (--layer-thickness) has one cell group",
+    ),
 ]
 
 
@@ -139,6 +146,30 @@ def test_run_two_ranks_writes_results(tmp_path):
     assert "von_mises" in grid["cell_data"]
     p = grid["point_data"]["contact_pressure"]
     assert p.max() == pytest.approx(data["peak_pressure"], rel=1e-9)
+
+
+def test_init_then_solve_two_ranks_reproduces_the_run(tmp_path):
+    """The user's path: `contactfx init` writes the scene as a problem file, `contactfx solve`
+    on it (2 ranks, as `contactfx run`) gives the run's numbers (the same discrete problem:
+    round-off apart, tests/verification/test_init.py)."""
+    run = run_cli("run", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "run"),
+                  "--quiet", ranks=2)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    init = run_cli("init", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "p"),
+                   ranks=2)  # fmt: skip
+    assert init.returncode == 0, init.stderr
+    toml = tmp_path / "p" / "hertz2d.toml"
+    assert f"wrote {toml}" in init.stdout and (tmp_path / "p" / "hertz2d.msh").is_file()
+    solve = run_cli("solve", str(toml), "--out", str(tmp_path / "solved"), ranks=2)
+    assert solve.returncode == 0, solve.stderr
+    a = json.loads((tmp_path / "run" / "run.json").read_text())
+    b = json.loads((tmp_path / "solved" / "run.json").read_text())
+    assert b["status"] == "completed" and b["ranks"] == 2 and b["dofs"] == a["dofs"]
+    assert b["newton_iterations"] == a["newton_iterations"]
+    for key in ("force", "contact_half_width", "peak_pressure"):
+        assert b[key] == pytest.approx(a[key], rel=1e-10), key
+    assert [s["force"] for s in b["steps"]] == pytest.approx([s["force"] for s in a["steps"]],
+                                                              rel=1e-10)  # fmt: skip
 
 
 def test_module_entry_point_westergaard():

@@ -80,7 +80,7 @@ from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import build_file
 from contactfx.numerics import Numerics
 from contactfx.params import Params, param
-from contactfx.scenes._common import fix_component, prescribe_component
+from contactfx.scenes._common import fix, fix_component, prescribe_component
 from contactfx.scenes.base import ObstacleScene
 from contactfx.scenes.interface_base import InterfaceScene
 from contactfx.scenes.two_body_base import TwoBodyScene
@@ -634,8 +634,14 @@ class _FileMesh:
     # -- supports and loads -----------------------------------------------------------------
     def dirichlet(self, V, facet_tags) -> list:
         bcs = []
-        for b in self.spec.boundary:
+        for i, b in enumerate(self.spec.boundary):
             tag = self.groups[b.group].tag
+            if V.num_sub_spaces == 0:  # one component (1D on dolfinx 0.9): no sub-spaces
+                if b.displacement:
+                    self._fail(f"boundary.{i}.displacement", "prescribed displacements are "
+                               "not offered in 1D (fix is)")  # fmt: skip
+                bcs += fix(V, facet_tags, tag) if b.fix else []
+                continue
             bcs += [fix_component(V, facet_tags, tag, c) for c in b.fix]
             for c, value in b.displacement.items():
                 const = dolfinx.fem.Constant(V.mesh, 0.0)
