@@ -39,6 +39,8 @@ class RectangleCells(IntEnum):
     """Cell tags of :func:`rectangle`."""
 
     DOMAIN = 1
+    #: the cells above the highest interface (a layered block's top layer)
+    LAYER = 2
 
 
 class RectangleFacets(IntEnum):
@@ -75,7 +77,8 @@ def rectangle(
         h_far: Element size far from the contact zone, >= h_contact (length).
         grading: Size increase per unit distance from the contact zone (dimensionless).
         interfaces: Heights y0 < y < y1 of horizontal lines across the rectangle that the mesh
-            must resolve (material interfaces of a layered block; length).
+            must resolve (material interfaces of a layered block; length). The cells above the
+            highest one are the cell group ``layer``, the others ``domain``.
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -114,6 +117,16 @@ def rectangle(
             RectangleFacets.LEFT: (0, x0),
         },
     )
+    if lines:
+        top = max(interfaces)
+        tol = 1e-6 * (y1 - y0)
+        cells = [tag for _, tag in model.getEntities(2)]
+        upper = [c for c in cells if model.getBoundingBox(2, c)[1] >= top - tol]
+        model.removePhysicalGroups([(2, RectangleCells.DOMAIN.value)])
+        for group, members in ((RectangleCells.DOMAIN, [c for c in cells if c not in upper]),
+                               (RectangleCells.LAYER, upper)):  # fmt: skip
+            model.addPhysicalGroup(2, members, group.value)
+            model.setPhysicalName(2, group.value, group.name.lower())
 
     # Distance to the segment [a, b] x {y1}: (|x - a| + |x - b| - (b - a)) / 2 is the distance
     # of x to [a, b] along the x axis.

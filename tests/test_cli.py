@@ -94,10 +94,6 @@ BAD = [
     (["init", "nosuch", "--out", "x"], "unknown scene 'nosuch'"),
     (["init", "hertz2d"], "give the output folder with --out DIR"),
     (["init", "hertz2d", "--nu", "0.5", "--out", "x"], "Poisson's ratio nu must lie in"),
-    (
-        ["init", "hertz2d", "--layer-thickness", "0.05", "--out", "x"],
-        "a layered block (--layer-thickness) has one cell group",
-    ),
 ]
 
 

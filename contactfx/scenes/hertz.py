@@ -26,6 +26,7 @@ import ufl
 
 from contactfx import _compat
 from contactfx.contact.obstacles import Ball, Obstacle, Paraboloid
+from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import BoxFacets, RectangleFacets, box, rectangle
 from contactfx.params import param
 from contactfx.references import hertz_2d, hertz_3d
@@ -151,14 +152,13 @@ class Hertz2D(ObstacleScene):
 
     def problem_data(self, numerics) -> dict:
         p = self.p
-        if self.layered:
-            raise ValueError("contactfx init hertz2d: a layered block (--layer-thickness) has "
-                             "one cell group in its mesh: it cannot be written as a problem "
-                             "file yet")  # fmt: skip
+        bodies = [export.body("domain", self.material())]
+        if self.layered:  # the top layer: its own cell group, the same nu
+            bodies.append(export.body("layer", Elastic(self.layer_E, p.nu)))
         kinks = (0.0, 0.5, 1.0) if p.shift > 0.0 else (0.0, 1.0)
         shape = "circle" if p.profile == "circle" else "parabola"
         return {
-            "bodies": [export.body("domain", self.material())],
+            "bodies": bodies,
             "boundary": [export.fixed("bottom", (0, 1))],
             "obstacle": {"shape": shape, "contact": "top", "radius": p.radius,
                          "h": p.h_contact, **export.motion(self.obstacle_offset, 2, kinks)},

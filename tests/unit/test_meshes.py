@@ -371,6 +371,11 @@ def test_rectangle_interfaces() -> None:
     # Straight-sided triangles tile the layers and the interfaces exactly: only round-off.
     assert _measure(data) == pytest.approx(width * height, rel=1e-12)
     assert _measure(data, RectangleFacets.LEFT) == pytest.approx(height, rel=1e-12)
+    # the top layer (above the highest interface) is its own cell group
+    layer = width * (p["y1"] - max(p["interfaces"]))
+    assert _measure(data, RectangleCells.LAYER, "dx") == pytest.approx(layer, rel=1e-12)
+    assert _measure(data, RectangleCells.DOMAIN, "dx") == pytest.approx(width * height - layer,
+                                                                        rel=1e-12)  # fmt: skip
     mesh = data.mesh
     for y in p["interfaces"]:
         on_line = dolfinx.mesh.locate_entities(mesh, 1, lambda x, y=y: np.isclose(x[1], y))
