@@ -192,11 +192,15 @@ def build(comm: MPI.Comm, builder: Builder, gdim: int, name: str) -> MeshData:
     return MeshData(mesh, cell_tags, facet_tags)
 
 
-def write_msh(builder: Builder, gdim: int, path: str | os.PathLike[str], name: str) -> MshInfo:
+def write_msh(builder: Builder, gdim: int, path: str | os.PathLike[str], name: str,
+              binary: bool = False) -> MshInfo:  # fmt: skip
     """Run ``builder`` with gmsh alone and write the mesh to ``path`` (gmsh format 4.1).
 
     Only the elements of physical groups are written, with their physical tags (gmsh's default
     ``Mesh.SaveAll`` 0). Returns the path and the numbers of nodes and of cells written.
+    ``binary`` writes the binary variant: its node coordinates are the doubles themselves,
+    while the ASCII file rounds them to 16 significant digits (off by up to an ulp, and a
+    contact search can turn an ulp into a different discrete problem).
     """
     _check_gdim(gdim)
     path = Path(path)
@@ -208,6 +212,7 @@ def write_msh(builder: Builder, gdim: int, path: str | os.PathLike[str], name: s
         builder(model)
         _check_generated(model, gdim)
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.option.setNumber("Mesh.Binary", int(binary))
         gmsh.write(str(path))
         node_tags, _, _ = model.mesh.getNodes()
         _, element_tags, _ = model.mesh.getElements(gdim)

@@ -49,7 +49,7 @@ def write_problem(scene, numerics: Numerics, out: Path, command: str,
     if comm.rank == 0:
         try:
             out.mkdir(parents=True, exist_ok=True)
-            write_msh(builder, gdim, msh, scene.name)
+            write_msh(builder, gdim, msh, scene.name, binary=True)  # exact coordinates
             doc = {"title": scene.name, "mesh": {"file": msh.name}, **tables,
                    "numerics": numerics_table(numerics)}  # fmt: skip
             doc = {k: doc[k] for k in ORDER if k in doc}

@@ -87,7 +87,7 @@ from contactfx.params import Params, param
 from contactfx.scenes._common import fix, fix_component, prescribe_component
 from contactfx.scenes.base import ObstacleScene
 from contactfx.scenes.interface_base import InterfaceScene
-from contactfx.scenes.two_body_base import TwoBodyScene
+from contactfx.scenes.two_body_base import CONTACT_EDGES, TwoBodyScene, contact_edge
 
 __all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
 
@@ -112,7 +112,7 @@ KEYS = {
         "edge_radius",
         "h",
     ),
-    "contact": ("slave", "master"),
+    "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring"),
     "interface": ("group", "fluid_pressure", "proppant_thickness", "joint"),
     "initial": ("displacement",),
     "output": ("reactions", "probes", "symmetry", "tangential_symmetry", "contact_size"),
@@ -284,6 +284,8 @@ class ProblemFile:
     symmetry: float = 1.0
     tangential_symmetry: list[float] | None = None
     contact_size: str | None = None
+    #: the contact pair's options: h, force_on, edge, edge_ring (those given)
+    pair: dict = dataclasses.field(default_factory=dict)
 
 
 def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
@@ -427,6 +429,20 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             r.fail("contact.0", "the slave and master surfaces of a pair must differ")
         if len(bodies) != 2:
             r.fail("bodies", f"a contact pair needs two bodies, got {len(bodies)}")
+        pair = {}
+        if "h" in c:
+            pair["h"] = r.number(c, "contact.0", "h", positive=True)
+        if "force_on" in c:
+            pair["force_on"] = r.string(c, "contact.0", "force_on", [g for g, _ in bodies])
+        if "edge" in c:
+            pair["edge"] = r.string(c, "contact.0", "edge", CONTACT_EDGES)
+        if "edge_ring" in c:
+            if pair.get("edge") != "radial":
+                r.fail("contact.0.edge_ring", "the ring width of edge = 'radial' only")
+            pair["edge_ring"] = r.number(c, "contact.0", "edge_ring", positive=True)
+        elif pair.get("edge") == "radial":
+            r.fail("contact.0.edge_ring", "missing (the ring width of edge = 'radial', "
+                   "about the slave element size)")  # fmt: skip
     output = r.table(data.get("output", {}), "output", KEYS["output"])
     reactions = output.get("reactions", [])
     if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
@@ -472,7 +488,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
                           list(reactions), probes, title, body_forces, displacement, symmetry,
                           None if tsym is None else [float(v) for v in tsym],
-                          contact_size)  # fmt: skip
+                          contact_size, pair if contact is not None else {})  # fmt: skip
     return problem, numerics, petsc
 
 
@@ -890,8 +906,24 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
         self._master = self.tag("contact.0.master", master, fdim)
         self.cells = {g: t for (g, _), t in zip(self.spec.bodies, self.body_tags,
                                                 strict=True)}  # fmt: skip
-        self._h = self._facet_size(mesh, facet_tags, [self._slave, self._master])
+        contact = [self._slave, self._master]
+        self._h = self.spec.pair.get("h") or self._facet_size(mesh, facet_tags, contact)
+        self._slave_body = self._body_of(mesh, facet_tags, self._slave, "contact.0.slave")
         return mesh, facet_tags
+
+    def _body_of(self, mesh, facet_tags, tag: int, key: str) -> str:
+        """The body (group name) whose cells the facet group ``tag`` bounds (all ranks)."""
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        f2c = mesh.topology.connectivity(tdim - 1, tdim)
+        cell_body = dict(zip(self.cell_tags.indices, self.cell_tags.values, strict=True))
+        facets = facet_tags.indices[facet_tags.values == tag]
+        local = {int(cell_body.get(int(c), -1)) for f in facets for c in f2c.links(f)}
+        found = set().union(*mesh.comm.allgather(local)) & set(self.body_tags)
+        if len(found) != 1:
+            names = sorted(g for g, t in self.cells.items() if t in found)
+            self._fail(key, f"the surface must bound one body, it bounds {names or 'none'}")
+        return next(g for g, t in self.cells.items() if t in found)
 
     # (before the mesh is read the tags are unknown; the file's names were checked distinct)
     @property
@@ -904,13 +936,28 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
 
     @property
     def slave_is_upper(self) -> bool:
-        return True
+        """Whether the pair's force vector (the friction's tangential force, pair_forces.csv)
+        is reported on the slave body: ``contact.force_on`` names that body (default the
+        slave's)."""
+        on = self.spec.pair.get("force_on")
+        return on is None or on == getattr(self, "_slave_body", on)
 
     def materials(self) -> dict[str, Elastic]:
         return dict(self.spec.bodies)
 
     def material(self) -> Elastic:
+        """The slave body's material: it scales the methods' parameters (gamma_N = gamma0 E /
+        h, the penalty), as the surface whose traction the method discretises (the stiffest
+        body's before the mesh is read)."""
+        slave = getattr(self, "_slave_body", None)
+        if slave is not None:
+            return self.materials()[slave]
         return max((m for _, m in self.spec.bodies), key=lambda m: m.E)
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+        """The contact size by the rule ``contact.edge`` (:func:`contact_edge`), else None
+        (the measure rule of ``output.contact_size``)."""
+        return contact_edge(self.spec.pair.get("edge"), x, p, self.spec.pair.get("edge_ring"))
 
 
 class FileInterfaceScene(_FileMesh, InterfaceScene):

@@ -57,10 +57,11 @@ from contactfx.meshes import (
 )
 from contactfx.params import param
 from contactfx.references import hertz_2d, hertz_3d
+from contactfx.scenes import export
 from contactfx.scenes._common import fix_component
-from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
+from contactfx.scenes.two_body_base import TwoBodyScene, radial_edge, two_elastic
 
-__all__ = ["PatchTest", "HertzCylinders", "HertzSpheres"]
+__all__ = ["PatchTest", "HertzCylinders", "HertzSpheres", "radial_edge"]
 
 
 def _component_value(V, facet_tags, tag: int, component: int, value):
@@ -88,6 +89,7 @@ class PatchTest(TwoBodyScene):
     summary = ("two stacked blocks (--dim 3: boxes) with non-matching meshes under uniform "
                "pressure; exact: uniform stress and contact pressure")  # fmt: skip
     Params = PatchTestParams
+    size_rule = "measure"  # the contact length (2D) or area (3D)
     cells = {"lower": StackedBlocksCells.LOWER, "upper": StackedBlocksCells.UPPER}
     surfaces = {"lower": StackedBlocksFacets.LOWER_TOP, "upper": StackedBlocksFacets.UPPER_BOTTOM}
 
@@ -98,12 +100,12 @@ class PatchTest(TwoBodyScene):
             self.surfaces = {"lower": StackedBoxesFacets.LOWER_TOP,
                              "upper": StackedBoxesFacets.UPPER_BOTTOM}  # fmt: skip
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         blocks = stacked_boxes if p.dim == 3 else stacked_blocks
         builder = functools.partial(blocks, width=p.width, h_lower=p.height, h_upper=p.height,
                                     h1=p.h, ratio=p.ratio, offset=p.offset)  # fmt: skip
-        return self.mesh_of(comm, builder, p.dim)
+        return builder, p.dim
 
     def h_contact(self) -> float:
         return self.p.h
@@ -121,14 +123,23 @@ class PatchTest(TwoBodyScene):
                 fix_component(V, facet_tags, f.LOWER_LEFT, 0),
                 fix_component(V, facet_tags, f.UPPER_LEFT, 0)]  # fmt: skip
 
+    def boundary_data(self) -> list[dict]:
+        """The rollers of :meth:`dirichlet` and the pressure q on the top (a traction -q along
+        the last axis, ramped with the load factor as :meth:`load`)."""
+        if self.p.dim == 3:
+            rollers = [("lower_bottom", 2), ("lower_x0", 0), ("upper_x0", 0), ("lower_y0", 1),
+                       ("upper_y0", 1)]  # fmt: skip
+        else:
+            rollers = [("lower_bottom", 1), ("lower_left", 0), ("upper_left", 0)]
+        traction = [0.0] * self.p.dim
+        traction[-1] = -self.p.pressure
+        return [*(export.fixed(g, (c,)) for g, c in rollers),
+                {"group": "upper_top", "traction": traction}]  # fmt: skip
+
     def load(self, v, ds, t):
         if self.p.dim == 3:
             return -self.p.pressure * t * v[2] * ds(StackedBoxesFacets.UPPER_TOP)
         return -self.p.pressure * t * v[1] * ds(StackedBlocksFacets.UPPER_TOP)
-
-    def contact_size(self, measure: float) -> float:
-        """The contact length (2D) or area (3D)."""
-        return measure
 
     def reference(self, force: float) -> dict[str, float]:
         """The exact contact force q * width^(dim - 1) and the uniform pressure q (as p0)."""
@@ -182,15 +193,20 @@ class HertzCylinders(_TwoHertz):
     cells = {"lower": CylindersCells.LOWER, "upper": CylindersCells.UPPER}
     surfaces = {"lower": CylindersFacets.LOWER_CONTACT, "upper": CylindersFacets.UPPER_CONTACT}
     symmetry = 2.0
+    # the contact half-width from the two outermost closed nodes (near the edge of a smooth
+    # contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a - x)); a lumped
+    # measure of the closed nodes would err by up to h / 2
+    edge_rule = "x-max"
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
                                     h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
                                     ratio=p.ratio, offset=p.offset)  # fmt: skip
-        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        return builder, 2
+
+    def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
-        return mesh, facet_tags
 
     def dirichlet(self, V, facet_tags) -> list:
         f = CylindersFacets
@@ -199,22 +215,13 @@ class HertzCylinders(_TwoHertz):
                 fix_component(V, facet_tags, f.UPPER_SYMMETRY, 0),
                 _component_value(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
 
+    def boundary_data(self) -> list[dict]:
+        return [export.fixed("lower_bottom", (1,)), export.fixed("lower_symmetry", (0,)),
+                export.fixed("upper_symmetry", (0,)),
+                {"group": "upper_top", "displacement": {"y": -self.p.depth}}]  # fmt: skip
+
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.depth
-
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
-        """The contact half-width from the slave nodes x (all ranks) with pressure p > 0: the
-        zero of the straight line through (x, p^2) at the two outermost closed nodes (near the
-        edge of a smooth contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a
-        - x)); a lumped measure of the closed nodes would err by up to h / 2."""
-        closed = p > 0.0
-        if np.count_nonzero(closed) < 2:
-            return None
-        order = np.argsort(x[closed, 0])
-        (x1, x2), (p1, p2) = x[closed, 0][order][-2:], p[closed][order][-2:]
-        if not p1 > p2:
-            return float(x2)
-        return float(x2 + p2**2 * (x2 - x1) / (p1**2 - p2**2))
 
     def pressure_profile(self, s, force):
         """Hertz p0 sqrt(1 - s^2 / a^2) (0 beyond a) at the computed force."""
@@ -223,30 +230,6 @@ class HertzCylinders(_TwoHertz):
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_2d(force, self.R(), self.E_star())
-
-
-def radial_edge(r: np.ndarray, p: np.ndarray, width: float) -> float | None:
-    """The radius of a round contact area from its closed nodes at the radii r with the
-    pressures p > 0: the closed nodes are binned in rings of ``width`` (the slave element
-    size), each ring gives its mean radius and mean p^2, and the straight line of p^2 through
-    the two outermost rings is extrapolated to zero (near the edge of a smooth contact p^2 falls
-    linearly with the distance to the edge; for Hertz p^2 = p0^2 (1 - r^2 / a^2) exactly
-    linear in r^2, and the line in r errs by O((width / a)^2)). Averaging over a ring of nodes
-    smooths the scatter of single nodes of an unstructured surface mesh. None with fewer than
-    two rings."""
-    if len(r) == 0:
-        return None
-    ring = np.floor(r / width).astype(np.int64)
-    rings, inv = np.unique(ring, return_inverse=True)
-    if len(rings) < 2:
-        return None
-    count = np.bincount(inv)
-    r_mean = np.bincount(inv, weights=r) / count
-    p2_mean = np.bincount(inv, weights=p**2) / count
-    (r1, r2), (q1, q2) = r_mean[-2:], p2_mean[-2:]
-    if not q1 > q2:
-        return float(r2)
-    return float(r2 + q2 * (r2 - r1) / (q1 - q2))
 
 
 @dataclass(frozen=True)
@@ -277,16 +260,22 @@ class HertzSpheres(_TwoHertz):
     cells = {"lower": SpheresCells.LOWER, "upper": SpheresCells.UPPER}
     surfaces = {"lower": SpheresFacets.LOWER_CONTACT, "upper": SpheresFacets.UPPER_CONTACT}
     symmetry = 4.0
+    # the radius of a disc of the closed nodes' area (the fallback of the edge rule)
+    size_rule = "disc-radius"
+    # the contact radius from the closed slave nodes: :func:`radial_edge` of their radial
+    # distances sqrt(x^2 + y^2), rings of the slave element size
+    edge_rule = "radial"
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         builder = functools.partial(spheres, radius_lower=p.R_lower, radius_upper=p.R_upper,
                                     h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
                                     ratio=p.ratio, offset=p.offset,
                                     grading=p.grading)  # fmt: skip
-        mesh, facet_tags = self.mesh_of(comm, builder, 3)
+        return builder, 3
+
+    def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
-        return mesh, facet_tags
 
     def dirichlet(self, V, facet_tags) -> list:
         f = SpheresFacets
@@ -297,6 +286,12 @@ class HertzSpheres(_TwoHertz):
                 fix_component(V, facet_tags, f.UPPER_Y0, 1),
                 _component_value(V, facet_tags, f.UPPER_TOP, 2, self.push)]  # fmt: skip
 
+    def boundary_data(self) -> list[dict]:
+        return [export.fixed("lower_bottom", (2,)), export.fixed("lower_x0", (0,)),
+                export.fixed("upper_x0", (0,)), export.fixed("lower_y0", (1,)),
+                export.fixed("upper_y0", (1,)),
+                {"group": "upper_top", "displacement": {"z": -self.p.depth}}]  # fmt: skip
+
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.depth
 
@@ -305,16 +300,8 @@ class HertzSpheres(_TwoHertz):
         p = self.p
         return p.h_contact * (p.ratio if p.slave == "upper" else 1.0)
 
-    def contact_size(self, measure: float) -> float:
-        """The radius of a disc of the closed nodes' area (fallback of :meth:`contact_edge`)."""
-        return float(np.sqrt(measure / np.pi))
-
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
-        """The contact radius from the closed slave nodes: :func:`radial_edge` of their radial
-        distances sqrt(x^2 + y^2), rings of the slave element size."""
-        closed = p > 0.0
-        r = np.hypot(x[closed, 0], x[closed, 1])
-        return radial_edge(r, p[closed], self.h_slave())
+    def edge_ring(self) -> float:
+        return self.h_slave()
 
     def reference(self, force: float) -> dict[str, float]:
         return hertz_3d(force, self.R(), self.E_star())

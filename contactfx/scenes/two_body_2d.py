@@ -70,6 +70,7 @@ from contactfx.meshes import (
 )
 from contactfx.params import param
 from contactfx.references import rigid_punch_2d
+from contactfx.scenes import export
 from contactfx.scenes._common import fix, fix_component, prescribe_component
 from contactfx.scenes.flat_punch import normalised_pressure_error
 from contactfx.scenes.hertz import cattaneo_mindlin
@@ -77,6 +78,16 @@ from contactfx.scenes.two_body import HertzCylinders
 from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
 
 __all__ = ["PunchFoundation", "SlidingContact", "CattaneoCylinders"]
+
+
+def press_then_drag(group: str, drag: float, push: float, fraction: float) -> list[dict]:
+    """The ``[[boundary]]`` tables of a face moved by ``push`` along y during the first
+    ``fraction`` of the load program, then along x by ``drag`` at that vertical displacement:
+    one table per component, each with its piecewise-linear amplitude."""
+    return [{"group": group, "displacement": {"x": float(drag)},
+             "amplitude": [[0.0, 0.0], [float(fraction), 0.0], [1.0, 1.0]]},
+            {"group": group, "displacement": {"y": float(push)},
+             "amplitude": [[0.0, 0.0], [float(fraction), 1.0], [1.0, 1.0]]}]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -112,16 +123,17 @@ class PunchFoundation(TwoBodyScene):
                 "upper": PunchFoundationFacets.PUNCH_CONTACT}  # fmt: skip
     symmetry = 2.0
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         builder = functools.partial(
             punch_foundation, width=p.width, depth=p.depth, b=p.b, rho=p.rho,
             h_punch=p.punch_height, h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
             ratio=p.ratio, offset=p.offset,
         )  # fmt: skip
-        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        return builder, 2
+
+    def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
-        return mesh, facet_tags
 
     def dirichlet(self, V, facet_tags) -> list:
         f = PunchFoundationFacets
@@ -129,6 +141,11 @@ class PunchFoundation(TwoBodyScene):
                 fix_component(V, facet_tags, f.BLOCK_SYMMETRY, 0),
                 fix_component(V, facet_tags, f.PUNCH_SYMMETRY, 0),
                 prescribe_component(V, facet_tags, f.PUNCH_TOP, 1, self.push)]  # fmt: skip
+
+    def boundary_data(self) -> list[dict]:
+        return [export.fixed("block_bottom", (0, 1)), export.fixed("block_symmetry", (0,)),
+                export.fixed("punch_symmetry", (0,)),
+                {"group": "punch_top", "displacement": {"y": -self.p.indentation}}]  # fmt: skip
 
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.indentation
@@ -196,23 +213,29 @@ class SlidingContact(TwoBodyScene):
                 "upper": RoundedOnBlockFacets.ROUNDED_CONTACT}  # fmt: skip
     numerics_defaults = {"steps": 50}
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
         builder = functools.partial(
             rounded_on_block, radius=p.radius, height=p.height, left=p.left, right=p.right,
             depth=p.depth, track=p.slide, h_contact=p.h_contact, h_far=p.h_far,
             refine=p.refine, ratio=p.ratio, offset=p.offset,
         )  # fmt: skip
-        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        return builder, 2
+
+    def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
         self.drag = dolfinx.fem.Constant(mesh, 0.0)
-        return mesh, facet_tags
 
     def dirichlet(self, V, facet_tags) -> list:
         f = RoundedOnBlockFacets
         return [*fix(V, facet_tags, f.BLOCK_BOTTOM),
                 prescribe_component(V, facet_tags, f.ROUNDED_TOP, 0, self.drag),
                 prescribe_component(V, facet_tags, f.ROUNDED_TOP, 1, self.push)]  # fmt: skip
+
+    def boundary_data(self) -> list[dict]:
+        p = self.p
+        return [export.fixed("block_bottom", (0, 1)),
+                *press_then_drag("rounded_top", p.slide, -p.press, p.press_fraction)]  # fmt: skip
 
     def top_displacement(self, t: float) -> tuple[float, float]:
         """(tangential, vertical) displacement of the top at load factor t: pressing on
@@ -277,15 +300,20 @@ class CattaneoCylinders(HertzCylinders):
     symmetry = 1.0
     numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 8}
 
-    def build_mesh(self, comm):
+    # half the distance between the two edges of the contact band (each from the two
+    # outermost closed nodes on its side, as :class:`HertzCylinders`)
+    edge_rule = "x-band"
+
+    def mesh_builder(self):
         p = self.p
         builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
                                     h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
                                     ratio=p.ratio, offset=p.offset, full=True)  # fmt: skip
-        mesh, facet_tags = self.mesh_of(comm, builder, 2)
+        return builder, 2
+
+    def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
         self.drag = dolfinx.fem.Constant(mesh, 0.0)
-        return mesh, facet_tags
 
     def dirichlet(self, V, facet_tags) -> list:
         f = CylindersFacets
@@ -293,17 +321,15 @@ class CattaneoCylinders(HertzCylinders):
                 prescribe_component(V, facet_tags, f.UPPER_TOP, 0, self.drag),
                 prescribe_component(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
 
+    def boundary_data(self) -> list[dict]:
+        p = self.p
+        return [export.fixed("lower_bottom", (0, 1)),
+                *press_then_drag("upper_top", p.shift, -p.depth, p.press_fraction)]  # fmt: skip
+
     def set_load(self, t: float) -> None:
         f = self.p.press_fraction
         self.push.value = -min(t / f, 1.0) * self.p.depth
         self.drag.value = max(t - f, 0.0) / (1.0 - f) * self.p.shift
-
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
-        """Half the distance between the two edges of the contact band (each from the two
-        outermost closed nodes on its side, :meth:`HertzCylinders.contact_edge`)."""
-        right = super().contact_edge(x, p)
-        left = super().contact_edge(-x, p)
-        return None if right is None or left is None else 0.5 * (right + left)
 
     def force_scores(self, loads, forces):
         """Q, P at the last step and Q / (mu P) is in the friction references."""

@@ -16,9 +16,73 @@ from contactfx.driver.two_body import TwoBodyProblem
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import build
 from contactfx.params import Params, param
+from contactfx.scenes import export
 from contactfx.scenes.base import Scene
 
-__all__ = ["two_elastic", "TwoBodyScene"]
+__all__ = ["two_elastic", "TwoBodyScene", "line_edge", "radial_edge", "contact_edge",
+           "CONTACT_EDGES"]  # fmt: skip
+
+#: the rules of :func:`contact_edge`
+CONTACT_EDGES = ("x-max", "x-band", "radial")
+
+
+def line_edge(s: np.ndarray, p: np.ndarray) -> float | None:
+    """The edge of a smooth contact on the side of growing s from the closed nodes at s with
+    the pressures p > 0: the zero of the straight line through (s, p^2) at the two outermost
+    closed nodes (near the edge of a smooth contact p^2 falls linearly with the distance to
+    the edge, p ~ sqrt(a - s)); a lumped measure of the closed nodes would err by up to h / 2.
+    None with fewer than two closed nodes."""
+    if len(s) < 2:
+        return None
+    order = np.argsort(s)
+    (x1, x2), (p1, p2) = s[order][-2:], p[order][-2:]
+    if not p1 > p2:
+        return float(x2)
+    return float(x2 + p2**2 * (x2 - x1) / (p1**2 - p2**2))
+
+
+def radial_edge(r: np.ndarray, p: np.ndarray, width: float) -> float | None:
+    """The radius of a round contact area from its closed nodes at the radii r with the
+    pressures p > 0: the closed nodes are binned in rings of ``width`` (the slave element
+    size), each ring gives its mean radius and mean p^2, and the straight line of p^2 through
+    the two outermost rings is extrapolated to zero (near the edge of a smooth contact p^2 falls
+    linearly with the distance to the edge; for Hertz p^2 = p0^2 (1 - r^2 / a^2) exactly
+    linear in r^2, and the line in r errs by O((width / a)^2)). Averaging over a ring of nodes
+    smooths the scatter of single nodes of an unstructured surface mesh. None with fewer than
+    two rings."""
+    if len(r) == 0:
+        return None
+    ring = np.floor(r / width).astype(np.int64)
+    rings, inv = np.unique(ring, return_inverse=True)
+    if len(rings) < 2:
+        return None
+    count = np.bincount(inv)
+    r_mean = np.bincount(inv, weights=r) / count
+    p2_mean = np.bincount(inv, weights=p**2) / count
+    (r1, r2), (q1, q2) = r_mean[-2:], p2_mean[-2:]
+    if not q1 > q2:
+        return float(r2)
+    return float(r2 + q2 * (r2 - r1) / (q1 - q2))
+
+
+def contact_edge(rule: str | None, x: np.ndarray, p: np.ndarray,
+                 ring: float | None = None) -> float | None:  # fmt: skip
+    """The contact half-width / radius from the slave nodes x (all ranks) with the pressures
+    p by the rule: ``x-max`` the edge on the side of growing x (:func:`line_edge`; a symmetric
+    contact modelled on x >= 0), ``x-band`` half the distance between the edges on both sides
+    in x (a contact band that may move), ``radial`` the radius from rings of width ``ring``
+    about the axis x = y = 0 (:func:`radial_edge`); None (no rule, or too few closed nodes)
+    for the measure of the closed nodes."""
+    closed = p > 0.0
+    xc, pc = x[closed], p[closed]
+    if rule == "x-max":
+        return line_edge(xc[:, 0], pc)
+    if rule == "x-band":
+        right, left = line_edge(xc[:, 0], pc), line_edge(-xc[:, 0], pc)
+        return None if right is None or left is None else 0.5 * (right + left)
+    if rule == "radial":
+        return radial_edge(np.hypot(xc[:, 0], xc[:, 1]), pc, ring)
+    return None
 
 
 def two_elastic(E0: float, nu0: float) -> type:
@@ -52,6 +116,11 @@ class TwoBodyScene(Scene):
     surfaces: ClassVar[dict[str, int]]
     #: multiplicity of the modelled part for forces and contact measures
     symmetry: ClassVar[float] = 1.0
+    #: the contact size from the measure m of the closed set (full model): ``half-measure``
+    #: m / 2 (a half-width), ``measure`` m, ``disc-radius`` sqrt(m / pi)
+    size_rule: ClassVar[str] = "half-measure"
+    #: the rule of :func:`contact_edge` (None: the contact size from the measure)
+    edge_rule: ClassVar[str | None] = None
 
     @property
     def slave_tag(self) -> int:
@@ -98,13 +167,60 @@ class TwoBodyScene(Scene):
         raise NotImplementedError
 
     def contact_size(self, measure: float) -> float:
-        """Contact half-width / radius from the measure of the contact set (full model)."""
+        """Contact half-width / radius from the measure of the contact set (full model), by
+        :attr:`size_rule`."""
+        if self.size_rule == "measure":
+            return measure
+        if self.size_rule == "disc-radius":
+            return float(np.sqrt(measure / np.pi))
         return 0.5 * measure
 
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
-        """The contact half-width / radius from the closed slave nodes of every rank
-        (coordinates x, pressures p), or None for the measure of the closed nodes."""
+    def edge_ring(self) -> float | None:
+        """The ring width of the ``radial`` edge rule (the slave element size)."""
         return None
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+        """The contact half-width / radius from the slave nodes of every rank (coordinates x,
+        pressures p) by :attr:`edge_rule`, or None for the measure of the closed nodes."""
+        return contact_edge(self.edge_rule, x, p, self.edge_ring())
+
+    # -- the scene as a problem file ----------------------------------------------------------
+    def mesh_builder(self):
+        raise NotImplementedError(f"scene '{self.name}' has no gmsh builder")
+
+    def build_mesh(self, comm):
+        """The mesh of :meth:`mesh_builder`, then :meth:`make_constants` on it."""
+        mesh, facet_tags = super().build_mesh(comm)
+        self.make_constants(mesh)
+        return mesh, facet_tags
+
+    def make_constants(self, mesh) -> None:
+        """Create the load program's constants (prescribed displacements) on ``mesh``."""
+
+    def boundary_data(self) -> list[dict]:
+        """The supports and loads as the ``[[boundary]]`` tables of a problem file."""
+        raise NotImplementedError(f"scene '{self.name}' cannot be written as a problem file")
+
+    def problem_data(self, numerics) -> dict:
+        """Bodies (the cell groups with their materials), the scene's supports and loads, the
+        contact pair (slave and master surfaces, h, the body the pair force is reported on,
+        the contact edge rule) and the symmetry and contact size outputs."""
+        other = "lower" if self.p.slave == "upper" else "upper"
+        mats = self.materials()
+        pair = {"slave": self.surfaces[self.p.slave].name.lower(),
+                "master": self.surfaces[other].name.lower(), "h": float(self.h_contact()),
+                "force_on": self.cells["upper"].name.lower()}  # fmt: skip
+        if self.edge_rule is not None:
+            pair["edge"] = self.edge_rule
+            if self.edge_ring() is not None:
+                pair["edge_ring"] = float(self.edge_ring())
+        return {
+            "bodies": [export.body(self.cells[b].name.lower(), mats[b])
+                       for b in ("lower", "upper")],
+            "boundary": self.boundary_data(),
+            "contact": [pair],
+            "output": {"symmetry": float(self.symmetry), "contact_size": self.size_rule},
+        }  # fmt: skip
 
     def reference(self, force: float) -> dict[str, float]:
         return {}

@@ -127,6 +127,75 @@ def test_problem_file_groups_checked_against_the_mesh(tmp_path, edit, message):
     assert message in str(err.value)
 
 
+PAIR = (DEMOS / "block-on-plinth.toml").read_text()
+
+
+def _write_pair(tmp_path: Path, text: str) -> Path:
+    geo = (DEMOS / "block-on-plinth.geo").read_text() + '\nPhysical Curve("both") = {12, 2};\n'
+    (tmp_path / "block-on-plinth.geo").write_text(geo)
+    path = tmp_path / "pair.toml"
+    path.write_text(text)
+    return path
+
+
+def _pair_key(line: str):
+    return lambda t: t.replace('master = "plinth_top"', f'master = "plinth_top"\n{line}')
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("edit, message", [
+    (_pair_key("h = -0.1"), "contact.0.h: must be > 0"),
+    (_pair_key('h = "fine"'), "contact.0.h: expected a number"),
+    (_pair_key('force_on = "pad"'), "contact.0.force_on: must be one of plinth, block, got 'pad'"),
+    (_pair_key('edge = "ellipse"'), "contact.0.edge: must be one of x-max, x-band, radial"),
+    (_pair_key('edge = "radial"'), "contact.0.edge_ring: missing"),
+    (_pair_key('edge = "radial"\nedge_ring = 0.0'), "contact.0.edge_ring: must be > 0"),
+    (_pair_key("edge_ring = 0.01"), "contact.0.edge_ring: the ring width of edge = 'radial'"),
+    (_pair_key("colour = 1"), "contact.0.colour: unknown key"),
+    (lambda t: t.replace('slave = "block_bottom"', 'slave = "both"'),
+     "contact.0.slave: the surface must bound one body, it bounds ['block', 'plinth']"),
+])  # fmt: skip
+def test_bad_contact_pair_keys(tmp_path, edit, message):
+    path = _write_pair(tmp_path, edit(PAIR))
+    with pytest.raises(ValueError) as err:
+        scene, _, _ = load_problem(path)
+        scene.build_mesh(MPI.COMM_SELF)
+    assert message in str(err.value)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.serial_only
+def test_contact_pair_keys(tmp_path):
+    """h, force_on and the slave body's material reach the scene; the edge rules find the
+    edge of a Hertz-like pressure p = sqrt(1 - (x / a)^2) (p^2 linear in x near the edge)."""
+    from contactfx.scenes.two_body_base import contact_edge
+
+    path = _write_pair(tmp_path, _pair_key('h = 0.05\nforce_on = "plinth"')(PAIR))
+    scene, _, _ = load_problem(path)
+    scene.build_mesh(MPI.COMM_SELF)
+    assert scene.h_contact() == 0.05
+    assert scene.material().E == 10000.0  # the slave (block) body's, the stiffer here
+    assert not scene.slave_is_upper  # the force reported on the master (plinth) body
+    swap = ["contact.0.slave=plinth_top", "contact.0.master=block_bottom"]
+    scene, _, _ = load_problem(path, swap)
+    scene.build_mesh(MPI.COMM_SELF)
+    assert scene.material().E == 1000.0 and scene.slave_is_upper
+    assert scene.h_contact() == 0.05
+
+    a = 0.3
+    x = np.linspace(-a, a, 61)[1:-1]
+    p = np.sqrt(1.0 - (x / a) ** 2)
+    pts = np.column_stack([x + 0.01, np.zeros_like(x)])
+    # p^2 is linear in x near the edge only to O(h / a): the line through the two last nodes
+    assert contact_edge("x-max", pts, p) == pytest.approx(a + 0.01, rel=1e-2)
+    assert contact_edge("x-band", pts, p) == pytest.approx(a, rel=1e-2)
+    assert contact_edge(None, pts, p) is None
+    r = np.linspace(0.0, a, 300, endpoint=False)
+    ring = np.column_stack([r * np.cos(r * 50), r * np.sin(r * 50)])
+    assert contact_edge("radial", ring, np.sqrt(1.0 - (r / a) ** 2), 0.01) == pytest.approx(
+        a, rel=2e-2)  # fmt: skip
+
+
 def test_bad_set():
     with pytest.raises(ValueError, match="--set expects key=value"):
         load_problem(DEMOS / "holed-pad.toml", ["numerics.steps"])
