@@ -143,8 +143,16 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print(f"  boundary   {b.group}: {'; '.join(what)}{amp}")
     if pb.obstacle is not None:
         ob = pb.obstacle
-        print(f"  obstacle   {ob['shape']} touching {ob['contact']}, from "
-              f"{scene.position.tolist()} moving by {scene.motion.tolist()}")  # fmt: skip
+        size = ", ".join(f"{k} {ob[k]:g}" for k in ("radius", "edge_radius", "height",
+                                                      "wavelength", "h") if k in ob)  # fmt: skip
+        moves = (f"along the path {ob['path']}" if "path" in ob
+                 else f"moving by {scene.motion.tolist()}")  # fmt: skip
+        print(f"  obstacle   {ob['shape']}{' (' + size + ')' if size else ''} touching "
+              f"{ob['contact']}, from {scene.position.tolist()} {moves}")  # fmt: skip
+    for group, force, _ in pb.body_forces:
+        print(f"  body force {group}: {force.tolist()}")
+    if pb.initial is not None:
+        print("  initial    displacement given (Newton's start)")
     if pb.contact is not None:
         print(f"  contact    slave {pb.contact[0]}, master {pb.contact[1]}")
     print(f"  numerics   method {numerics.method}, friction {numerics.friction}, "
