@@ -6,7 +6,7 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
-from contactfx.cli.run import _fields, _scene_parser
+from contactfx.cli.run import fields_of, scene_parser
 from contactfx.numerics import Numerics
 from contactfx.scenes import get_scene
 
@@ -24,12 +24,12 @@ def cmd_init(argv: list[str], comm) -> int:
     scene_cls = get_scene(argv[0])
     if comm.rank != 0 and ("-h" in argv or "--help" in argv):
         return 0
-    parser = _scene_parser(scene_cls, command="init")
+    parser = scene_parser(scene_cls, command="init")
     ns = vars(parser.parse_args(argv[1:]))
     if ns["out"] is None:
         raise ValueError("contactfx init: give the output folder with --out DIR")
-    scene = scene_cls(scene_cls.Params(**_fields(scene_cls.Params, ns)))
-    numerics = Numerics(**_fields(Numerics, ns))
+    scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
+    numerics = Numerics(**fields_of(Numerics, ns))
     command = "contactfx init " + shlex.join(argv)
     from contactfx.scenes.export import write_problem
 

@@ -14,10 +14,18 @@ from contactfx.results import RunSummary
 from contactfx.scenes import SCENES, get_scene
 from contactfx.solvers.snes import ConvergenceError
 
-__all__ = ["cmd_list", "cmd_run", "table", "write_failed", "print_outputs"]
+__all__ = [
+    "cmd_list",
+    "cmd_run",
+    "table",
+    "write_failed",
+    "print_outputs",
+    "scene_parser",
+    "fields_of",
+]
 
 
-def _scene_parser(scene_cls, command: str = "run") -> Parser:
+def scene_parser(scene_cls, command: str = "run") -> Parser:
     parser = Parser(
         prog=f"contactfx {command} {scene_cls.name}",
         description=scene_cls.summary,
@@ -30,7 +38,7 @@ def _scene_parser(scene_cls, command: str = "run") -> Parser:
     return parser
 
 
-def _fields(cls, values: dict) -> dict:
+def fields_of(cls, values: dict) -> dict:
     return {f.name: values[f.name] for f in dataclasses.fields(cls)}
 
 
@@ -127,9 +135,9 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
     scene_cls = get_scene(argv[0])
     if comm.rank != 0 and ("-h" in argv or "--help" in argv):
         return 0
-    ns = vars(_scene_parser(scene_cls).parse_args(argv[1:]))
-    scene = scene_cls(scene_cls.Params(**_fields(scene_cls.Params, ns)))
-    numerics = Numerics(**_fields(Numerics, ns))
+    ns = vars(scene_parser(scene_cls).parse_args(argv[1:]))
+    scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
+    numerics = Numerics(**fields_of(Numerics, ns))
     if comm.rank == 0 and not ns["quiet"]:
         print(f"contactfx: {scene.name}, method {numerics.method}, {comm.size} rank(s)", flush=True)
     try:
