@@ -12,6 +12,7 @@ discrete problem: the same mesh, forms and load program, so the same numbers up 
 from __future__ import annotations
 
 import dataclasses
+import types
 from pathlib import Path
 
 from mpi4py import MPI
@@ -20,7 +21,7 @@ from contactfx.io.toml import dumps
 from contactfx.meshes import write_msh
 from contactfx.numerics import Numerics
 
-__all__ = ["write_problem", "numerics_table"]
+__all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
 
 ORDER = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
          "initial", "numerics", "petsc", "output")  # fmt: skip
@@ -95,3 +96,96 @@ def motion(offset, gdim: int, kinks=(0.0, 1.0)) -> dict:
             out["motion"] = [e - s for s, e in zip(start, end, strict=True)]
         return out
     return {"path": rows}
+
+
+def pins(pinned) -> list[dict]:
+    """``[[pins]]`` tables from the scene's (point, component) pairs, one table per point."""
+    out: list[dict] = []
+    for point, comp in pinned:
+        point = [float(v) for v in point]
+        for entry in out:
+            if entry["point"] == point:
+                entry["fix"].append(AXES[comp])
+                break
+        else:
+            out.append({"point": point, "fix": [AXES[comp]]})
+    return out
+
+
+class Symbol:
+    """An expression in x, y, z written as problem-file text
+    (:func:`contactfx.scenes.problem_file.parse_expression`) by running a closed form's own
+    arithmetic on it (the ``m`` namespace of :mod:`contactfx.references` is :data:`SYMBOLIC`):
+    the file then evaluates the same formula. Products with an exact zero and sums with it are
+    dropped."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    @staticmethod
+    def wrap(v) -> Symbol | float:
+        return v if isinstance(v, Symbol) else float(v)
+
+    @staticmethod
+    def text_of(v) -> str:
+        return v.text if isinstance(v, Symbol) else f"({float(v)!r})"
+
+    def _binary(self, other, op: str, reverse: bool = False):
+        a, b = (other, self) if reverse else (self, other)
+        a, b = Symbol.wrap(a), Symbol.wrap(b)
+        if op == "*" and (a == 0.0 or b == 0.0):
+            return 0.0
+        if op == "+" and (a == 0.0 or b == 0.0):
+            return b if a == 0.0 else a
+        if op == "-" and b == 0.0:
+            return a
+        return Symbol(f"({Symbol.text_of(a)} {op} {Symbol.text_of(b)})")
+
+    def __add__(self, o):
+        return self._binary(o, "+")
+
+    def __radd__(self, o):
+        return self._binary(o, "+", True)
+
+    def __sub__(self, o):
+        return self._binary(o, "-")
+
+    def __rsub__(self, o):
+        return self._binary(o, "-", True)
+
+    def __mul__(self, o):
+        return self._binary(o, "*")
+
+    def __rmul__(self, o):
+        return self._binary(o, "*", True)
+
+    def __truediv__(self, o):
+        return self._binary(o, "/")
+
+    def __rtruediv__(self, o):
+        return self._binary(o, "/", True)
+
+    def __pow__(self, o):
+        return self._binary(o, "**")
+
+    def __neg__(self):
+        return Symbol(f"(-{self.text})")
+
+    def __eq__(self, other) -> bool:  # a symbol is never an exact zero
+        return False
+
+    __hash__ = object.__hash__
+
+
+def _call(name: str):
+    return lambda *args: Symbol(f"{name}({', '.join(Symbol.text_of(a) for a in args)})")
+
+
+#: the math namespace of the closed forms (:mod:`contactfx.references`) on :class:`Symbol`
+SYMBOLIC = types.SimpleNamespace(sqrt=_call("sqrt"), atan2=_call("atan2"), cos=_call("cos"),
+                                 sin=_call("sin"), maximum=_call("max"))  # fmt: skip
+
+
+def text(v) -> str | float:
+    """A :class:`Symbol` as its text, a number as a float (a problem-file entry)."""
+    return v.text if isinstance(v, Symbol) else float(v)
