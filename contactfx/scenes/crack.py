@@ -173,7 +173,7 @@ class _CrackPlate(InterfaceScene):
         p, q = self.face_loads()
         if self.p.boundary == "infinite" and (p != 0.0 or q != 0.0):
             d, n = self._axes()
-            x = (export.Symbol("x"), export.Symbol("y"))
+            x = (export.Symbol("x"), export.Symbol("y"))  # the variables of the file
             xl = d[0] * x[0] + d[1] * x[1]
             yl = n[0] * x[0] + n[1] * x[1]
             sxx, syy, sxy = cf.crack_perturbation_stress(

@@ -619,17 +619,31 @@ _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
 def parse_expression(text: str):
     """A function y -> UFL of the expression ``text`` in x, y, z (the coordinates of the point
     in the obstacle's frame), numbers, + - * / **, pi and the functions sqrt, sin, cos, tan,
-    exp, ln, abs, atan2, min, max. Anything else is refused (nothing is evaluated as Python)."""
+    exp, ln, abs, atan2, min, max. Definitions ``name = expression`` may come first, separated
+    by ';' or new lines, the last statement being the value: a long closed form names its
+    repeated parts once (``r = sqrt(x**2 + y**2); 1 / r``). Anything else is refused (nothing
+    is evaluated as Python)."""
+    shown = re.sub(r"\s+", " ", text.strip())
+    shown = shown if len(shown) <= 80 else shown[:77] + "..."
     try:
-        tree = ast.parse(text, mode="eval")
+        module = ast.parse("\n".join(line.strip() for line in text.strip().splitlines()))
     except SyntaxError:
-        raise ValueError(f"not an expression: '{text}'") from None
+        raise ValueError(f"not an expression: '{shown}'") from None
+    *defs, last = module.body or [None]
+    if not isinstance(last, ast.Expr) or not all(
+            isinstance(d, ast.Assign) and len(d.targets) == 1
+            and isinstance(d.targets[0], ast.Name) for d in defs):  # fmt: skip
+        raise ValueError(f"not an expression: '{shown}' (definitions name = expression, then "
+                         "the value)")  # fmt: skip
+    for d in defs:
+        if d.targets[0].id in ("x", "y", "z", "pi", *_FUNCTIONS):
+            raise ValueError(f"'{d.targets[0].id}' cannot be redefined in '{shown}'")
 
-    def build(node, y):
-        if isinstance(node, ast.Expression):
-            return build(node.body, y)
+    def build(node, y, env):
         if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
             return float(node.value)
+        if isinstance(node, ast.Name) and node.id in env:
+            return env[node.id]
         if isinstance(node, ast.Name) and node.id in ("x", "y", "z"):
             i = "xyz".index(node.id)
             if i >= ufl.shape(y)[0]:
@@ -638,19 +652,25 @@ def parse_expression(text: str):
         if isinstance(node, ast.Name) and node.id == "pi":
             return float(np.pi)
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            return _BINARY[type(node.op)](build(node.left, y), build(node.right, y))
+            return _BINARY[type(node.op)](build(node.left, y, env), build(node.right, y, env))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-            v = build(node.operand, y)
+            v = build(node.operand, y, env)
             return -v if isinstance(node.op, ast.USub) else v
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
                 and node.func.id in _FUNCTIONS and not node.keywords):  # fmt: skip
-            return _FUNCTIONS[node.func.id](*(build(a, y) for a in node.args))
-        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{text}' (numbers, x, y, z, "
-                         "pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+            return _FUNCTIONS[node.func.id](*(build(a, y, env) for a in node.args))
+        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{shown}' (numbers, x, y, "
+                         "z, pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+
+    def evaluate(y):
+        env = {}
+        for d in defs:
+            env[d.targets[0].id] = build(d.value, y, env)
+        return build(last.value, y, env)
 
     # check the names and operators once, in 3D
-    build(tree, ufl.as_vector([1.0, 1.0, 1.0]))
-    return lambda y: build(tree, y)
+    evaluate(ufl.as_vector([1.0, 1.0, 1.0]))
+    return evaluate
 
 
 class DistanceObstacle(Obstacle):
