@@ -40,6 +40,12 @@ group or a contact pair between two bodies; then the numerics, PETSc options and
     [output]
     reactions = ["bottom"]             # reaction per group and step: history.csv
 
+A fitted interface inside one body takes ``[interface]`` (group, fluid_pressure,
+proppant_thickness with an optional proppant_zone, joint, h, origin, direction) instead of the
+obstacle; a plate held by tractions only takes ``[[pins]]`` (point: a mesh vertex, fix), and a
+boundary may carry the traction sigma n of a ``stress`` tensor (numbers or expressions in x, y,
+z) integrated with its ``quadrature_degree``.
+
 Groups are the gmsh physical names. Everything is validated before anything is computed: an
 unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error
 lists those it has) or of the wrong dimension is one error naming the file and the key.
