@@ -169,7 +169,7 @@ class _CrackPlate(InterfaceScene):
         """:meth:`_boundary_stress` as problem-file entries: numbers, or for the infinite
         plate's field the same closed form written as expressions in x, y
         (:class:`contactfx.scenes.export.Symbol`)."""
-        sigma = [[float(v) for v in row] for row in self.remote_stress()]
+        sigma = [[float(v) + 0.0 for v in row] for row in self.remote_stress()]  # no -0.0
         p, q = self.face_loads()
         if self.p.boundary == "infinite" and (p != 0.0 or q != 0.0):
             d, n = self._axes()
