@@ -26,6 +26,7 @@ about 20 % low on the default mesh).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +37,7 @@ from contactfx._compat import numpy_math, ufl_math
 from contactfx.driver.interface_post import STATUS, Profile
 from contactfx.meshes import CrackPlateFacets, crack_plate
 from contactfx.params import param
-from contactfx.scenes._common import gmsh_mesh
+from contactfx.scenes import export
 from contactfx.scenes.base import elastic
 from contactfx.scenes.interface_base import InterfaceScene
 
@@ -116,13 +117,13 @@ class _CrackPlate(InterfaceScene):
         n = np.array([-np.sin(beta), np.cos(beta)])
         return d, n
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
-        return gmsh_mesh(
-            comm, crack_plate, 2, self.name, half_width=0.5 * p.plate_width,
+        return functools.partial(
+            crack_plate, half_width=0.5 * p.plate_width,
             crack_half_length=p.crack_half_length, angle=self.angle(), h_crack=p.h_crack,
             h_far=p.h_far, grading=p.grading, split_at=self.split_points(), h_tip=p.h_tip,
-        )  # fmt: skip
+        ), 2  # fmt: skip
 
     def length_scale(self) -> float:
         return self.p.plate_width
@@ -163,6 +164,50 @@ class _CrackPlate(InterfaceScene):
             local = ufl.as_matrix([[sxx, sxy], [sxy, syy]])
             sigma = sigma + R * local * R.T
         return sigma
+
+    def _boundary_stress_text(self) -> list[list]:
+        """:meth:`_boundary_stress` as problem-file entries: numbers, or for the infinite
+        plate's field the same closed form written as expressions in x, y
+        (:class:`contactfx.scenes.export.Symbol`)."""
+        sigma = [[float(v) + 0.0 for v in row] for row in self.remote_stress()]  # no -0.0
+        p, q = self.face_loads()
+        if self.p.boundary == "infinite" and (p != 0.0 or q != 0.0):
+            d, n = self._axes()
+            x = (export.Symbol("x"), export.Symbol("y"))  # the variables of the file
+            xl = d[0] * x[0] + d[1] * x[1]
+            yl = n[0] * x[0] + n[1] * x[1]
+            sxx, syy, sxy = cf.crack_perturbation_stress(
+                xl, yl, self.p.crack_half_length, p, q, export.SYMBOLIC
+            )
+            R = [[d[0], n[0]], [d[1], n[1]]]
+            local = [[sxx, sxy], [sxy, syy]]
+            for i in range(2):
+                for j in range(2):
+                    for k in range(2):
+                        for m in range(2):
+                            sigma[i][j] = sigma[i][j] + R[i][k] * local[k][m] * R[j][m]
+        return [[export.text(v) for v in row] for row in sigma]
+
+    def interface_data(self) -> dict:
+        """The ``[interface]`` keys beyond the group, h and frame."""
+        fluid = self.fluid_pressure()
+        return {} if fluid is None else {"fluid_pressure": float(fluid)}
+
+    def problem_data(self, numerics) -> dict:
+        """The plate with its boundary stress on the four edges (traction sigma n, the same
+        degree-8 rule), the pinned corners, and the crack with the scene's frame and h."""
+        stress = self._boundary_stress_text()
+        boundary = []
+        if any(v != 0.0 for row in stress for v in row):
+            boundary = [{"group": tag.name.lower(), "stress": stress, "quadrature_degree": 8}
+                        for tag in _OUTER]  # fmt: skip
+        origin, direction = self.frame()
+        interface = {"group": "crack", "h": self.h_contact(),
+                     "origin": [float(v) for v in origin],
+                     "direction": [float(v) for v in direction],
+                     **self.interface_data()}  # fmt: skip
+        return {"bodies": [export.body("domain", self.material())], "boundary": boundary,
+                "pins": export.pins(self.pinned()), "interface": interface}  # fmt: skip
 
     def load(self, v, ds, t):
         mesh = ds.ufl_domain()
@@ -362,6 +407,11 @@ class ProppedFracture(_CrackPlate):
     def floor(self, s):
         b = self.p.proppant_half_length * (1.0 - 1e-9)  # the layer's end nodes are unpropped
         return ufl.conditional(ufl.lt(abs(s), b), self.p.proppant_thickness, 0.0)
+
+    def interface_data(self):
+        b = self.p.proppant_half_length
+        return {**super().interface_data(), "proppant_thickness": self.p.proppant_thickness,
+                "proppant_zone": [-b, b]}  # fmt: skip
 
     def exact_opening(self, s):
         return self._ellipse(s, self.p.net_pressure) if self.open_branch() else None

@@ -12,6 +12,7 @@ discrete problem: the same mesh, forms and load program, so the same numbers up 
 from __future__ import annotations
 
 import dataclasses
+import types
 from pathlib import Path
 
 from mpi4py import MPI
@@ -20,7 +21,7 @@ from contactfx.io.toml import dumps
 from contactfx.meshes import write_msh
 from contactfx.numerics import Numerics
 
-__all__ = ["write_problem", "numerics_table"]
+__all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
 
 ORDER = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
          "initial", "numerics", "petsc", "output")  # fmt: skip
@@ -95,3 +96,126 @@ def motion(offset, gdim: int, kinks=(0.0, 1.0)) -> dict:
             out["motion"] = [e - s for s, e in zip(start, end, strict=True)]
         return out
     return {"path": rows}
+
+
+def pins(pinned) -> list[dict]:
+    """``[[pins]]`` tables from the scene's (point, component) pairs, one table per point."""
+    out: list[dict] = []
+    for point, comp in pinned:
+        point = [float(v) for v in point]
+        for entry in out:
+            if entry["point"] == point:
+                entry["fix"].append(AXES[comp])
+                break
+        else:
+            out.append({"point": point, "fix": [AXES[comp]]})
+    return out
+
+
+class Symbol:
+    """An expression in x, y, z built by running a closed form's own arithmetic on it (the
+    ``m`` namespace of :mod:`contactfx.references` is :data:`SYMBOLIC`) and written as
+    problem-file text (:func:`contactfx.scenes.problem_file.parse_expression`) by
+    :func:`text`: the file then evaluates the same formula, with the same operations in the
+    same order. Products with an exact zero and sums with it are dropped."""
+
+    def __init__(self, op: str, args: tuple = ()) -> None:
+        self.op, self.args = op, args  # a variable name (no args), an operator or a function
+
+    @staticmethod
+    def _binary(a, b, op: str):
+        a, b = (v if isinstance(v, Symbol) else float(v) for v in (a, b))
+        if op == "*" and (a == 0.0 or b == 0.0):
+            return 0.0
+        if op == "+" and (a == 0.0 or b == 0.0):
+            return b if a == 0.0 else a
+        if op == "-" and b == 0.0:
+            return a
+        return Symbol(op, (a, b))
+
+    def __add__(self, o):
+        return Symbol._binary(self, o, "+")
+
+    def __radd__(self, o):
+        return Symbol._binary(o, self, "+")
+
+    def __sub__(self, o):
+        return Symbol._binary(self, o, "-")
+
+    def __rsub__(self, o):
+        return Symbol._binary(o, self, "-")
+
+    def __mul__(self, o):
+        return Symbol._binary(self, o, "*")
+
+    def __rmul__(self, o):
+        return Symbol._binary(o, self, "*")
+
+    def __truediv__(self, o):
+        return Symbol._binary(self, o, "/")
+
+    def __rtruediv__(self, o):
+        return Symbol._binary(o, self, "/")
+
+    def __pow__(self, o):
+        return Symbol._binary(self, o, "**")
+
+    def __neg__(self):
+        return Symbol("neg", (self,))
+
+    def __eq__(self, other) -> bool:  # a symbol is never an exact zero
+        return False
+
+    __hash__ = object.__hash__
+
+
+def _call(name: str):
+    return lambda *args: Symbol(name, args)
+
+
+#: the math namespace of the closed forms (:mod:`contactfx.references`) on :class:`Symbol`
+SYMBOLIC = types.SimpleNamespace(sqrt=_call("sqrt"), atan2=_call("atan2"), cos=_call("cos"),
+                                 sin=_call("sin"), maximum=_call("max"))  # fmt: skip
+_OPERATORS = ("+", "-", "*", "/", "**")
+
+
+def text(v) -> str | float:
+    """A number as a float; a :class:`Symbol` as an expression whose parts used more than once
+    are named first (``t0 = ...; t1 = ...; value``), as the closed form computes them."""
+    if not isinstance(v, Symbol):
+        return float(v)
+    uses: dict[int, int] = {}
+    order: list[Symbol] = []
+
+    def visit(s) -> None:
+        if not isinstance(s, Symbol) or not s.args:
+            return
+        uses[id(s)] = uses.get(id(s), 0) + 1
+        if uses[id(s)] == 1:
+            for a in s.args:
+                visit(a)
+            order.append(s)  # after its parts
+
+    visit(v)
+    names: dict[int, str] = {}
+
+    def write(s) -> str:
+        if not isinstance(s, Symbol):
+            return f"({float(s)!r})"
+        if not s.args:
+            return s.op
+        if id(s) in names:
+            return names[id(s)]
+        parts = [write(a) for a in s.args]
+        if s.op in _OPERATORS:
+            return f"({parts[0]} {s.op} {parts[1]})"
+        if s.op == "neg":
+            return f"(-{parts[0]})"
+        return f"{s.op}({', '.join(parts)})"
+
+    lines = []
+    for s in order:
+        if uses[id(s)] > 1 and s is not v:
+            lines.append(f"t{len(names)} = {write(s)}")
+            names[id(s)] = f"t{len(names)}"
+    return "; ".join([*lines, write(v)])

@@ -11,6 +11,7 @@ reproduces it to the solver tolerance (docs/verification.md section 7).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,7 @@ from contactfx import references as cf
 from contactfx.contact.interface import BartonBandis
 from contactfx.meshes import JointColumnFacets, joint_column
 from contactfx.params import param
-from contactfx.scenes._common import gmsh_mesh
+from contactfx.scenes import export
 from contactfx.scenes.base import elastic
 from contactfx.scenes.interface_base import InterfaceScene
 
@@ -50,10 +51,28 @@ class JointColumn(InterfaceScene):
     Params = JointColumnParams
     interface_tag = JointColumnFacets.JOINT
 
-    def build_mesh(self, comm):
+    def mesh_builder(self):
         p = self.p
-        return gmsh_mesh(comm, joint_column, 2, self.name, width=p.width,
-                         block_height=p.block_height, h=p.h)  # fmt: skip
+        return functools.partial(joint_column, width=p.width, block_height=p.block_height,
+                                 h=p.h), 2  # fmt: skip
+
+    def problem_data(self, numerics) -> dict:
+        """Rollers, the compression on the top as a traction, the joint with the scene's
+        frame, h, fluid pressure and Barton-Bandis law; the top's mean settlement."""
+        p = self.p
+        origin, direction = self.frame()
+        F = JointColumnFacets
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [*(export.fixed(tag.name.lower(), (c,)) for tag, c in self.supports()),
+                         {"group": "top", "traction": [0.0, -p.closure_stress]}],
+            "interface": {"group": F.JOINT.name.lower(), "h": p.h,
+                          "origin": [float(v) for v in origin],
+                          "direction": [float(v) for v in direction],
+                          "fluid_pressure": p.fluid_pressure,
+                          "joint": {"Kni": p.Kni, "Vm": p.Vm, "w0": p.aperture}},
+            "output": {"mean_displacement": {"top_displacement": ["top", "y"]}},
+        }  # fmt: skip
 
     def length_scale(self) -> float:
         return self.p.block_height

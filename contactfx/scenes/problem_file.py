@@ -44,6 +44,12 @@ and outputs (reactions, probes, the model's symmetry multiplicity)::
     [output]
     reactions = ["bottom"]             # reaction per group and step: history.csv
 
+A fitted interface inside one body takes ``[interface]`` (group, fluid_pressure,
+proppant_thickness with an optional proppant_zone, joint, h, origin, direction) instead of the
+obstacle; a plate held by tractions only takes ``[[pins]]`` (point: a mesh vertex, fix), and a
+boundary may carry the traction sigma n of a ``stress`` tensor (numbers or expressions in x, y,
+z) integrated with its ``quadrature_degree``.
+
 Groups are the gmsh physical names. Everything is validated before anything is computed: an
 unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error
 lists those it has) or of the wrong dimension is one error naming the file and the key.
@@ -92,12 +98,22 @@ from contactfx.scenes.two_body_base import CONTACT_EDGES, TwoBodyScene, contact_
 __all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
 
 AXES = ("x", "y", "z")
-SECTIONS = ("title", "mesh", "bodies", "boundary", "obstacle", "contact", "interface",
+SECTIONS = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
             "initial", "numerics", "petsc", "output")  # fmt: skip
 KEYS = {
     "mesh": ("file", "size"),
     "bodies": ("group", "E", "nu", "body_force", "amplitude"),
-    "boundary": ("group", "fix", "displacement", "traction", "pressure", "amplitude"),
+    "boundary": (
+        "group",
+        "fix",
+        "displacement",
+        "traction",
+        "pressure",
+        "stress",
+        "amplitude",
+        "quadrature_degree",
+    ),
+    "pins": ("point", "fix"),
     "obstacle": (
         "shape",
         "contact",
@@ -113,9 +129,25 @@ KEYS = {
         "h",
     ),
     "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring"),
-    "interface": ("group", "fluid_pressure", "proppant_thickness", "joint"),
+    "interface": (
+        "group",
+        "fluid_pressure",
+        "proppant_thickness",
+        "proppant_zone",
+        "joint",
+        "h",
+        "origin",
+        "direction",
+    ),
     "initial": ("displacement",),
-    "output": ("reactions", "probes", "symmetry", "tangential_symmetry", "contact_size"),
+    "output": (
+        "reactions",
+        "probes",
+        "symmetry",
+        "tangential_symmetry",
+        "contact_size",
+        "mean_displacement",
+    ),
 }
 SHAPES = ("plane", "circle", "cylinder", "sphere", "parabola", "paraboloid", "sinusoid",
           "punch", "distance")  # fmt: skip
@@ -253,6 +285,34 @@ def _amplitude(table: list[tuple[float, float]], t: float) -> float:
     return float(np.interp(t, ts, vs))
 
 
+def _stress(r: _Reader, value, key: str) -> list[list]:
+    """A boundary's stress tensor: d rows of d entries, each a number or an expression in x,
+    y, z (:func:`parse_expression`; e.g. a closed-form field around a crack)."""
+    ok = isinstance(value, list) and len(value) in (1, 2, 3) and all(
+        isinstance(row, list) and len(row) == len(value)
+        and all(isinstance(v, int | float | str) and not isinstance(v, bool) for v in row)
+        for row in value)  # fmt: skip
+    if not ok:
+        r.fail(key, "expected a square table of numbers or expressions in x, y, z (the stress "
+               f"tensor's rows), got {value!r}")  # fmt: skip
+    out = []
+    for row in value:
+        entries = []
+        for v in row:
+            if isinstance(v, str):
+                try:
+                    v = parse_expression(v)
+                except ValueError as err:
+                    r.fail(key, str(err))
+            elif not np.isfinite(v):
+                r.fail(key, f"must be finite, got {v}")
+            else:
+                v = float(v)
+            entries.append(v)
+        out.append(entries)
+    return out
+
+
 @dataclass
 class Boundary:
     group: str
@@ -261,6 +321,9 @@ class Boundary:
     traction: np.ndarray | None = None
     pressure: float | None = None
     amplitude: list = dataclasses.field(default_factory=list)
+    #: a stress tensor (rows of numbers or expressions in x, y, z) whose traction sigma n
+    stress: list | None = None
+    quadrature_degree: int | None = None
 
 
 @dataclass
@@ -286,6 +349,8 @@ class ProblemFile:
     contact_size: str | None = None
     #: the contact pair's options: h, force_on, edge, edge_ring (those given)
     pair: dict = dataclasses.field(default_factory=dict)
+    pins: list = dataclasses.field(default_factory=list)
+    mean_displacement: dict = dataclasses.field(default_factory=dict)
 
 
 def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
@@ -333,9 +398,9 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         key = f"boundary.{i}"
         b = r.table(b, key, KEYS["boundary"])
         entry = Boundary(r.string(b, key, "group"), amplitude=r.amplitude(b, key))
-        kinds = [k for k in ("fix", "displacement", "traction", "pressure") if k in b]
+        kinds = [k for k in ("fix", "displacement", "traction", "pressure", "stress") if k in b]
         if not kinds:
-            r.fail(key, "give one of fix, displacement, traction, pressure")
+            r.fail(key, "give one of fix, displacement, traction, pressure, stress")
         if "fix" in b:
             fixv = b["fix"]
             if not isinstance(fixv, list) or not fixv or any(c not in AXES for c in fixv):
@@ -358,7 +423,30 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             entry.traction = np.asarray(t, dtype=np.float64)
         if "pressure" in b:
             entry.pressure = r.number(b, key, "pressure")
+        if "stress" in b:
+            entry.stress = _stress(r, b["stress"], f"{key}.stress")
+        if "quadrature_degree" in b:
+            q = b["quadrature_degree"]
+            if isinstance(q, bool) or not isinstance(q, int) or not 1 <= q <= 30:
+                r.fail(f"{key}.quadrature_degree", f"expected an integer in 1..30, got {q!r}")
+            entry.quadrature_degree = q
         boundary.append(entry)
+
+    pins = []
+    pins_data = data.get("pins", [])
+    if not isinstance(pins_data, list):
+        r.fail("pins", "expected [[pins]] tables (point, fix)")
+    for i, q in enumerate(pins_data):
+        key = f"pins.{i}"
+        q = r.table(q, key, KEYS["pins"])
+        point = q.get("point")
+        if not isinstance(point, list) or len(point) not in (1, 2, 3) or not all(
+                isinstance(v, int | float) and not isinstance(v, bool) for v in point):  # fmt: skip
+            r.fail(f"{key}.point", f"expected the coordinates of a mesh vertex, got {point!r}")
+        fixv = q.get("fix")
+        if not isinstance(fixv, list) or not fixv or any(c not in AXES for c in fixv):
+            r.fail(f"{key}.fix", f"expected a list of components among x, y, z, got {fixv!r}")
+        pins.append((np.asarray(point, dtype=np.float64), sorted({AXES.index(c) for c in fixv})))
 
     obstacle = data.get("obstacle")
     contact_list = data.get("contact")
@@ -378,6 +466,27 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             interface["proppant_thickness"] = r.number(
                 interface, "interface", "proppant_thickness", positive=True
             )
+        if "proppant_zone" in interface:
+            zone = interface["proppant_zone"]
+            if "proppant_thickness" not in interface:
+                r.fail("interface.proppant_zone", "a zone of the proppant layer: give its "
+                       "proppant_thickness")  # fmt: skip
+            if not (isinstance(zone, list) and len(zone) == 2 and all(
+                    isinstance(v, int | float) and not isinstance(v, bool) for v in zone)
+                    and np.all(np.isfinite(zone)) and zone[0] < zone[1]):  # fmt: skip
+                r.fail("interface.proppant_zone", "expected [s0, s1] with s0 < s1 (the layer's "
+                       f"ends along the interface coordinate s), got {zone!r}")  # fmt: skip
+            interface["proppant_zone"] = (float(zone[0]), float(zone[1]))
+        if "h" in interface:
+            interface["h"] = r.number(interface, "interface", "h", positive=True)
+        for k in ("origin", "direction"):
+            if k in interface:
+                interface[k] = r.vector(interface, "interface", k, 2)
+        if "direction" in interface:
+            norm = float(np.linalg.norm(interface["direction"]))
+            if not np.isfinite(norm) or norm == 0.0:
+                r.fail("interface.direction", "expected a nonzero vector along the interface")
+            interface["direction"] = interface["direction"] / norm
         if "joint" in interface:
             j = r.table(interface["joint"], "interface.joint", ("Kni", "Vm", "w0"))
             values = {k: r.number(j, "interface.joint", k, positive=True)
@@ -392,6 +501,9 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             if b.displacement:
                 r.fail(f"boundary.{i}.displacement", "prescribed displacements are not offered "
                        "with an [interface] yet (fix, traction, pressure are)")  # fmt: skip
+    if pins and interface is None:
+        r.fail("pins", "pinned points are offered with an [interface] (use fix on a group "
+               "otherwise)")  # fmt: skip
     if obstacle is not None:
         obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
         obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
@@ -471,6 +583,14 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     if tsym is not None and (not isinstance(tsym, list) or not all(
             isinstance(v, int | float) and not isinstance(v, bool) for v in tsym)):  # fmt: skip
         r.fail("output.tangential_symmetry", f"expected a list of numbers, got {tsym!r}")
+    mean_displacement = output.get("mean_displacement", {})
+    if not isinstance(mean_displacement, dict) or not all(
+            isinstance(v, list) and len(v) == 2 and isinstance(v[0], str) and v[1] in AXES
+            for v in mean_displacement.values()):  # fmt: skip
+        r.fail("output.mean_displacement", "expected a table name = [group, component], e.g. "
+               f"{{ top_displacement = [\"top\", \"y\"] }}, got {mean_displacement!r}")  # fmt: skip
+    if mean_displacement and interface is None:
+        r.fail("output.mean_displacement", "reported with an [interface] only")
     contact_size = None
     if "contact_size" in output:
         contact_size = r.string(output, "output", "contact_size", CONTACT_SIZES)
@@ -488,7 +608,8 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
                           list(reactions), probes, title, body_forces, displacement, symmetry,
                           None if tsym is None else [float(v) for v in tsym],
-                          contact_size, pair if contact is not None else {})  # fmt: skip
+                          contact_size, pair if contact is not None else {}, pins,
+                          dict(mean_displacement))  # fmt: skip
     return problem, numerics, petsc
 
 
@@ -525,17 +646,31 @@ _BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
 def parse_expression(text: str):
     """A function y -> UFL of the expression ``text`` in x, y, z (the coordinates of the point
     in the obstacle's frame), numbers, + - * / **, pi and the functions sqrt, sin, cos, tan,
-    exp, ln, abs, atan2, min, max. Anything else is refused (nothing is evaluated as Python)."""
+    exp, ln, abs, atan2, min, max. Definitions ``name = expression`` may come first, separated
+    by ';' or new lines, the last statement being the value: a long closed form names its
+    repeated parts once (``r = sqrt(x**2 + y**2); 1 / r``). Anything else is refused (nothing
+    is evaluated as Python)."""
+    shown = re.sub(r"\s+", " ", text.strip())
+    shown = shown if len(shown) <= 80 else shown[:77] + "..."
     try:
-        tree = ast.parse(text, mode="eval")
+        module = ast.parse("\n".join(line.strip() for line in text.strip().splitlines()))
     except SyntaxError:
-        raise ValueError(f"not an expression: '{text}'") from None
+        raise ValueError(f"not an expression: '{shown}'") from None
+    *defs, last = module.body or [None]
+    if not isinstance(last, ast.Expr) or not all(
+            isinstance(d, ast.Assign) and len(d.targets) == 1
+            and isinstance(d.targets[0], ast.Name) for d in defs):  # fmt: skip
+        raise ValueError(f"not an expression: '{shown}' (definitions name = expression, then "
+                         "the value)")  # fmt: skip
+    for d in defs:
+        if d.targets[0].id in ("x", "y", "z", "pi", *_FUNCTIONS):
+            raise ValueError(f"'{d.targets[0].id}' cannot be redefined in '{shown}'")
 
-    def build(node, y):
-        if isinstance(node, ast.Expression):
-            return build(node.body, y)
+    def build(node, y, env):
         if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
             return float(node.value)
+        if isinstance(node, ast.Name) and node.id in env:
+            return env[node.id]
         if isinstance(node, ast.Name) and node.id in ("x", "y", "z"):
             i = "xyz".index(node.id)
             if i >= ufl.shape(y)[0]:
@@ -544,19 +679,25 @@ def parse_expression(text: str):
         if isinstance(node, ast.Name) and node.id == "pi":
             return float(np.pi)
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-            return _BINARY[type(node.op)](build(node.left, y), build(node.right, y))
+            return _BINARY[type(node.op)](build(node.left, y, env), build(node.right, y, env))
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-            v = build(node.operand, y)
+            v = build(node.operand, y, env)
             return -v if isinstance(node.op, ast.USub) else v
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
                 and node.func.id in _FUNCTIONS and not node.keywords):  # fmt: skip
-            return _FUNCTIONS[node.func.id](*(build(a, y) for a in node.args))
-        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{text}' (numbers, x, y, z, "
-                         "pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+            return _FUNCTIONS[node.func.id](*(build(a, y, env) for a in node.args))
+        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{shown}' (numbers, x, y, "
+                         "z, pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+
+    def evaluate(y):
+        env = {}
+        for d in defs:
+            env[d.targets[0].id] = build(d.value, y, env)
+        return build(last.value, y, env)
 
     # check the names and operators once, in 3D
-    build(tree, ufl.as_vector([1.0, 1.0, 1.0]))
-    return lambda y: build(tree, y)
+    evaluate(ufl.as_vector([1.0, 1.0, 1.0]))
+    return evaluate
 
 
 class DistanceObstacle(Obstacle):
@@ -633,6 +774,15 @@ class _FileMesh:
                 self._fail(f"boundary.{i}", f"component z in a {self.gdim}D problem")
             if b.traction is not None and len(b.traction) != self.gdim:
                 self._fail(f"boundary.{i}.traction", f"expected {self.gdim} numbers")
+            if b.stress is not None and len(b.stress) != self.gdim:
+                self._fail(f"boundary.{i}.stress", f"expected {self.gdim} rows of {self.gdim}")
+        for i, (point, comps) in enumerate(pb.pins):
+            if len(point) != self.gdim:
+                self._fail(f"pins.{i}.point", f"expected {self.gdim} coordinates")
+            if any(c >= self.gdim for c in comps):
+                self._fail(f"pins.{i}.fix", f"component z in a {self.gdim}D problem")
+        for name, (group, _) in pb.mean_displacement.items():
+            self.tag(f"output.mean_displacement.{name}", group, fdim)
         touching = set(pb.contact or ())
         if pb.obstacle is not None:
             touching.add(pb.obstacle["contact"])
@@ -641,7 +791,8 @@ class _FileMesh:
                 self._fail(f"boundary.{i}.group", f"'{b.group}' is a contact surface: the "
                            "contact law there assumes no other condition or load (Nitsche "
                            "would be inconsistent); give it its own physical group")  # fmt: skip
-        if pb.contact is None and not any(b.fix or b.displacement for b in pb.boundary):
+        if pb.contact is None and not pb.pins and not any(b.fix or b.displacement
+                                                          for b in pb.boundary):  # fmt: skip
             self._fail("boundary", "the body has no support (fix or displacement on a group): "
                        "frictionless contact alone leaves it free to slide, the solve would be "
                        "singular")  # fmt: skip
@@ -680,7 +831,7 @@ class _FileMesh:
             form = amp * ufl.dot(ufl.as_vector(force.tolist()), v) * dx(self.groups[group].tag)
             L = form if L is None else L + form
         for b in self.spec.boundary:
-            if b.traction is None and b.pressure is None:
+            if b.traction is None and b.pressure is None and b.stress is None:
                 continue
             amp = dolfinx.fem.Constant(self._mesh, 0.0)
             self._constants.append((amp, b.amplitude, np.array(1.0)))
@@ -689,7 +840,15 @@ class _FileMesh:
                 term = ufl.dot(ufl.as_vector(b.traction.tolist()), v)
             if b.pressure is not None:  # a pressure pushes into the body: -p n
                 term = term - b.pressure * ufl.dot(ufl.FacetNormal(self._mesh), v)
-            form = amp * term * ds(self.groups[b.group].tag)
+            if b.stress is not None:  # the traction sigma n of a stress field
+                x = ufl.SpatialCoordinate(self._mesh)
+                y = ufl.as_vector([x[i] for i in range(self.gdim)])
+                sigma = ufl.as_matrix([[e(y) if callable(e) else e for e in row]
+                                       for row in b.stress])  # fmt: skip
+                term = term + ufl.dot(ufl.dot(sigma, ufl.FacetNormal(self._mesh)), v)
+            rule = None if b.quadrature_degree is None else {
+                "quadrature_degree": b.quadrature_degree}  # fmt: skip
+            form = amp * term * ds(self.groups[b.group].tag, metadata=rule)
             L = form if L is None else L + form
         return L
 
@@ -964,7 +1123,15 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
     """A problem file with a straight fitted interface (a crack, a fracture with fluid
     pressure) on an interior facet group of one body, in 2D. The interface's line, its sides
     and its tips (the group's end points that are not on the body's boundary) are read from
-    the mesh; ``crack_volume`` reports the integral of the opening along it."""
+    the mesh; ``crack_volume`` reports the integral of the opening along it.
+
+    The frame of the interface coordinate s = (x - origin) . direction (the proppant zone, the
+    profiles) and the side sign (the + side is the one the normal (-d_y, d_x) points to) are
+    ``interface.origin`` and ``interface.direction`` when given, else the centre of the group's
+    points and their principal direction (of arbitrary sign). ``interface.h``, when given, is
+    the element size that scales the methods' parameters, else the longest interface edge.
+    ``[[pins]]`` fix components at mesh vertices (removing the rigid motions of a plate held
+    by tractions only)."""
 
     Params = FileParams
 
@@ -985,13 +1152,23 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         self._length = float(np.linalg.norm(hi - lo))
         centre = pts.mean(axis=0)
         _, _, vt = np.linalg.svd(pts - centre)
-        self._origin, self._dir = centre, vt[0]
-        self._normal = np.array([-vt[0][1], vt[0][0]])
-        off = np.abs((pts - centre) @ self._normal).max()
+        spec = self.spec.interface
+        self._origin = spec.get("origin", centre)
+        self._dir = spec.get("direction", vt[0])
+        self._normal = np.array([-self._dir[1], self._dir[0]])
+        off = np.abs((pts - centre) @ np.array([-vt[0][1], vt[0][0]])).max()
         if off > 1e-8 * self._length:
             self._fail("interface.group", f"the group '{self.spec.interface['group']}' is not "
                        f"straight ({off:.3g} off its line): curved interfaces are not offered "
                        "yet")  # fmt: skip
+        given = [k for k in ("origin", "direction") if k in spec]
+        off = np.abs((pts - self._origin) @ self._normal).max()
+        if given and off > 1e-8 * self._length:
+            self._fail(
+                f"interface.{given[-1]}",
+                f"the group '{spec['group']}' is {off:.3g} "
+                "off the line through interface.origin along interface.direction",
+            )
         tol = 1e-9 * self._length
         keys = np.round(pts / tol).astype(np.int64)
         uniq, count = np.unique(keys, axis=0, return_counts=True)
@@ -1002,8 +1179,18 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         outer = self._segments(mesh, None, exterior).reshape(-1, 2)
         self._tips = [e for e in ends
                       if not np.any(np.linalg.norm(outer - e, axis=1) < 1e3 * tol)]  # fmt: skip
-        self._h = self._facet_size(mesh, facet_tags, [self.interface_tag])
+        self._h = spec.get("h") or self._facet_size(mesh, facet_tags, [self.interface_tag])
+        self._check_pins(mesh, tol)
         return mesh, facet_tags
+
+    def _check_pins(self, mesh, tol: float) -> None:
+        """Every pin is a mesh vertex (of some rank)."""
+        x = mesh.geometry.x[:, : self.gdim]
+        for i, (point, _) in enumerate(self.spec.pins):
+            found = bool(len(x)) and float(np.min(np.linalg.norm(x - point, axis=1))) < tol
+            if not mesh.comm.allreduce(found, op=MPI.LOR):
+                self._fail(f"pins.{i}.point", f"{point.tolist()} is not a vertex of the mesh "
+                           f"{self.spec.mesh_file.name}")  # fmt: skip
 
     def _segments(self, mesh, facet_tags, selection) -> np.ndarray:
         """(m, 2, gdim) vertex coordinates of the facets (of the groups ``selection``, or the
@@ -1037,6 +1224,9 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
     def supports(self):
         return [(self.groups[b.group].tag, c) for b in self.spec.boundary for c in b.fix]
 
+    def pinned(self):
+        return [(point, c) for point, comps in self.spec.pins for c in comps]
+
     def side(self, x):
         return self._normal[0] * (x[0] - self._origin[0]) + self._normal[1] * (
             x[1] - self._origin[1]
@@ -1055,9 +1245,17 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         return self.spec.interface.get("fluid_pressure")
 
     def floor(self, s):
-        """A proppant layer of uniform thickness along the whole interface."""
+        """A proppant layer of uniform thickness along the whole interface, or on the zone
+        s0 < s < s1 of ``interface.proppant_zone`` only: its end points are unpropped (the
+        zone shrunk by 1e-9 of its half-length, so that nodes placed at the ends are out)."""
         t = self.spec.interface.get("proppant_thickness")
-        return None if t is None else t + 0.0 * s
+        if t is None:
+            return None
+        zone = self.spec.interface.get("proppant_zone")
+        if zone is None:
+            return t + 0.0 * s
+        centre, half = 0.5 * (zone[0] + zone[1]), 0.5 * (zone[1] - zone[0])
+        return ufl.conditional(ufl.lt(abs(s - centre), half * (1.0 - 1e-9)), t, 0.0)
 
     def joint(self):
         return self.spec.interface.get("joint")
@@ -1068,7 +1266,15 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         is +)."""
         dS = ufl.Measure("dS", domain=mesh, subdomain_data=self._facet_tags)
         n = ufl.FacetNormal(mesh)
-        return {"crack_volume": -ufl.dot(ufl.jump(w), n("+")) * dS(self.interface_tag)}
+        out = {"crack_volume": -ufl.dot(ufl.jump(w), n("+")) * dS(self.interface_tag)}
+        # output.mean_displacement: the mean of a displacement component over a facet group
+        for name, (group, comp) in self.spec.mean_displacement.items():
+            tag = self.groups[group].tag
+            one = dolfinx.fem.Constant(mesh, 1.0)
+            local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * ds(tag)))
+            measure = mesh.comm.allreduce(local, op=MPI.SUM)
+            out[name] = w[AXES.index(comp)] / measure * ds(tag)
+        return out
 
 
 def _compat_exterior(mesh) -> np.ndarray:

@@ -33,7 +33,18 @@ OBSTACLE_CASES = [
     ("sliding-block", {"h": 0.1}, {"steps": 4}),
     ("bar1d", {}, {}),
 ]  # fmt: skip
-INTERFACE_CASES: list = []
+_PLATE = {"plate_width": 8.0, "h_crack": 0.1, "h_tip": 0.05, "h_far": 1.0, "grading": 0.3}
+INTERFACE_CASES = [
+    ("crack-sneddon", _PLATE, {}),
+    ("crack-sneddon", {**_PLATE, "pressure": -1e6, "boundary": "remote"}, {}),
+    ("crack-inclined", {**_PLATE, "beta": 30.0}, {}),
+    ("crack-inclined", {**_PLATE, "boundary": "remote"},
+     {"friction": "tresca", "mu": 0.0, "threshold": 1e6, "steps": 2}),
+    ("propped-fracture", _PLATE, {}),
+    ("propped-fracture", {**_PLATE, "net_pressure": 2e6}, {}),
+    ("joint-column", {"h": 0.25}, {}),
+    ("joint-column", {"h": 0.2, "fluid_pressure": 0.0}, {"method": "penalty", "steps": 2}),
+]  # fmt: skip
 TWO_BODY_CASES = [
     ("patch-test", {"h": 0.25}, {"method": "mortar"}),
     ("patch-test", {"h": 0.5, "dim": 3, "slave": "lower"}, {"method": "mortar"}),

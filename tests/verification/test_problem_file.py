@@ -4,10 +4,12 @@ the file and the key."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+import ufl
 from mpi4py import MPI
 
 from contactfx.scenes.problem_file import load_problem
@@ -302,11 +304,93 @@ def test_distance_expression_obstacle_matches_the_cylinder():
     ("__import__('os').getcwd()", "is not allowed"),
     ("sqrt(x**2 + w**2)", "'w' is not allowed"),
     ("x +", "not an expression"),
+    ("r = sqrt(x**2 + y**2)", "not an expression"),
+    ("x = 1; x", "'x' cannot be redefined"),
+    ("r = 1; q", "'q' is not allowed"),
 ])  # fmt: skip
 def test_distance_expression_refused(text, message):
     with pytest.raises(ValueError, match=message):
         load_problem(DEMOS / "holed-pad.toml", ["obstacle.shape=distance",
                                                 f'obstacle.distance="{text}"'])  # fmt: skip
+
+
+def test_expression_definitions():
+    """Definitions name their repeated parts: the same UFL value as the expression written
+    out."""
+    from contactfx.scenes.problem_file import parse_expression
+
+    y = ufl.as_vector([3.0, 4.0])
+    plain = parse_expression("sqrt(x**2 + y**2) * (1 + sqrt(x**2 + y**2))")(y)
+    named = parse_expression("r = sqrt(x**2 + y**2)\n  q = 1 + r; r * q")(y)
+    assert float(named) == pytest.approx(float(plain)) == 30.0
+
+
+CRACK = (DEMOS / "pressurised-crack.toml").read_text()
+_EDGE = '[[boundary]]\ngroup = "top"\n'
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1.0, 0.0]]\n[interface]"),
+     "boundary.2.stress: expected a square table"),
+    (lambda t: t.replace("[interface]", _EDGE + 'stress = [["sqrt(w)", 0], [0, 0]]\n'
+                         "[interface]"), "boundary.2.stress: 'w' is not allowed"),
+    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]"
+                         "\n[interface]"), "boundary.2.stress: expected 2 rows of 2"),
+    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1, 0], [0, 1]]\n"
+                         "quadrature_degree = 0\n[interface]"),
+     "boundary.2.quadrature_degree: expected an integer"),
+    (lambda t: t + '\n[[pins]]\npoint = [0.123, 0.456]\nfix = ["x"]\n',
+     "pins.0.point: [0.123, 0.456] is not a vertex of the mesh"),
+    (lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0]\nfix = ["w"]\n', "pins.0.fix: expected"),
+    (lambda t: t + '\n[[pins]]\npoint = "corner"\nfix = ["x"]\n', "pins.0.point: expected"),
+    (lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0, 0.0]\nfix = ["x"]\n',
+     "pins.0.point: expected 2 coordinates"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\nh = -1.0"),
+     "interface.h: must be > 0"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 0]"),
+     "interface.direction: expected a nonzero vector"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 1]"),
+     "interface.direction: the group 'crack' is 1 off the line"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = [0, 0.5]"),
+     "interface.origin: the group 'crack' is 0.5 off the line"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = 0"),
+     "interface.origin: expected 2 numbers"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "proppant_zone = [-0.5, 0.5]"),
+     "interface.proppant_zone: a zone of the proppant layer: give its proppant_thickness"),
+    (lambda t: t.replace("fluid_pressure = 1e6", "proppant_thickness = 1e-4\n"
+                         "proppant_zone = [0.5, -0.5]"),
+     "interface.proppant_zone: expected [s0, s1] with s0 < s1"),
+    (lambda t: t + '\n[output]\nmean_displacement = { u = ["top", "w"] }\n',
+     "output.mean_displacement: expected a table name = [group, component]"),
+    (lambda t: t + '\n[output]\nmean_displacement = { u = ["nowhere", "y"] }\n',
+     "output.mean_displacement.u: no physical group 'nowhere'"),
+])  # fmt: skip
+def test_bad_interface_problem_files(tmp_path, edit, message):
+    """The keys of the interface problems (boundary stress, pins, the interface's h, frame
+    and proppant zone, mean displacements): a bad value is one error naming the file and
+    the key."""
+    (tmp_path / "pressurised-crack.geo").write_text((DEMOS / "pressurised-crack.geo").read_text())
+    path = tmp_path / "p.toml"
+    path.write_text(edit(CRACK))
+    with pytest.raises(ValueError) as err:
+        scene, _, _ = load_problem(path)
+        scene.build_mesh(MPI.COMM_SELF)
+    assert str(path) in str(err.value) and message in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t + '\n[[pins]]\npoint = [0.0, 0.0]\nfix = ["x"]\n',
+     "pins: pinned points are offered with an [interface]"),
+    (lambda t: t.replace("[output]", '[output]\nmean_displacement = { u = ["top", "y"] }'),
+     "output.mean_displacement: reported with an [interface]"),
+])  # fmt: skip
+def test_interface_keys_refused_elsewhere(tmp_path, edit, message):
+    path = _write(tmp_path, edit(GOOD))
+    with pytest.raises(ValueError, match=re.escape(message)):
+        load_problem(path)
 
 
 def test_interface_problem_proppant_holds_the_faces(tmp_path):
