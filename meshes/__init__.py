@@ -33,6 +33,8 @@ from contactfx.meshes._build import (
     MshInfo,
     build,
     build_file,
+    build_grouped,
+    builder_groups,
     file_groups,
     write_msh,
 )
@@ -62,7 +64,24 @@ from contactfx.meshes.two_body import (
     stacked_boxes,
 )
 
+#: the geometries by name (as in ``python3 -m contactfx.meshes NAME``, and a problem file's
+#: ``mesh.builder``) with their dimension
+BUILDERS = {
+    "interval": (interval, 1),
+    "rectangle": (rectangle, 2),
+    "box": (box, 3),
+    "crack-plate": (crack_plate, 2),
+    "joint-column": (joint_column, 2),
+    "stacked-blocks": (stacked_blocks, 2),
+    "stacked-boxes": (stacked_boxes, 3),
+    "cylinders": (cylinders, 2),
+    "spheres": (spheres, 3),
+    "punch-foundation": (punch_foundation, 2),
+    "rounded-on-block": (rounded_on_block, 2),
+}
+
 __all__ = [
+    "BUILDERS",
     "BoxCells",
     "BoxFacets",
     "Builder",
@@ -92,6 +111,8 @@ __all__ = [
     "box",
     "build",
     "build_file",
+    "build_grouped",
+    "builder_groups",
     "file_groups",
     "crack_plate",
     "interval",

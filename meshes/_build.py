@@ -58,6 +58,8 @@ __all__ = [
     "add_physical_groups",
     "build",
     "build_file",
+    "build_grouped",
+    "builder_groups",
     "file_groups",
     "check_finite",
     "check_less",
@@ -355,6 +357,32 @@ class Group:
     elements: int
 
 
+def _collect_groups(model: type[gmsh.model], groups: list[Group], where: str) -> None:
+    """Append the model's named physical groups (with their element counts) to ``groups``."""
+    if not model.getPhysicalGroups():
+        raise ValueError(f"{where}: the mesh has no physical group (name the bodies and "
+                         "the boundaries with Physical Curve / Surface / Volume)")  # fmt: skip
+    for dim, tag in model.getPhysicalGroups():
+        name = model.getPhysicalName(dim, tag) or str(tag)
+        count = 0
+        for entity in model.getEntitiesForPhysicalGroup(dim, tag):
+            _, element_tags, _ = model.mesh.getElements(dim, entity)
+            count += sum(len(t) for t in element_tags)
+        groups.append(Group(name, dim, tag, count))
+
+
+def builder_groups(builder: Builder, where: str):
+    """``builder`` wrapped to fill, on the rank that runs it, the list it returns with the
+    model's named physical groups (:class:`Group`)."""
+    groups: list[Group] = []
+
+    def wrapped(model: type[gmsh.model]) -> None:
+        builder(model)
+        _collect_groups(model, groups, where)
+
+    return wrapped, groups
+
+
 def file_groups(path: str | os.PathLike[str], size_factor: float = 1.0):
     """A builder that loads a ``.msh`` file or meshes a ``.geo`` file (gmsh's own parser, the
     element sizes scaled by ``size_factor``), and the list it fills, on the rank that runs it,
@@ -370,19 +398,9 @@ def file_groups(path: str | os.PathLike[str], size_factor: float = 1.0):
             gmsh.option.setNumber("Mesh.MeshSizeFactor", float(size_factor))
         gmsh.merge(str(path))
         dims = [d for d, _ in model.getPhysicalGroups()]
-        if not dims:
-            raise ValueError(f"{path}: the mesh has no physical group (name the bodies and "
-                             "the boundaries with Physical Curve / Surface / Volume)")  # fmt: skip
-        top = max(dims)
-        if path.suffix == ".geo":
-            model.mesh.generate(top)
-        for dim, tag in model.getPhysicalGroups():
-            name = model.getPhysicalName(dim, tag) or str(tag)
-            count = 0
-            for entity in model.getEntitiesForPhysicalGroup(dim, tag):
-                _, element_tags, _ = model.mesh.getElements(dim, entity)
-                count += sum(len(t) for t in element_tags)
-            groups.append(Group(name, dim, tag, count))
+        if dims and path.suffix == ".geo":
+            model.mesh.generate(max(dims))
+        _collect_groups(model, groups, str(path))
 
     return builder, groups
 
@@ -397,9 +415,18 @@ def build_file(comm: MPI.Comm, path: str | os.PathLike[str], size_factor: float,
         raise FileNotFoundError(f"mesh file {str(path)!r} not found")
     if path.suffix not in (".msh", ".geo"):
         raise ValueError(f"mesh file {str(path)!r}: expected a .msh or .geo file")
+    builder, groups = file_groups(path, size_factor)
+    return build_grouped(comm, builder, groups, name)
+
+
+def build_grouped(comm: MPI.Comm, builder: Builder, groups: list[Group],
+                  name: str) -> tuple[MeshData, list[Group]]:  # fmt: skip
+    """:func:`build` for a builder that fills ``groups`` on the gmsh rank
+    (:func:`builder_groups`, :func:`file_groups`): the distributed mesh and, on every rank, the
+    named physical groups; the dimension is the highest of a group. Collective; an error of the
+    builder is raised on every rank."""
     import gmsh
 
-    builder, groups = file_groups(path, size_factor)
     on_gmsh_rank = comm.rank == GMSH_RANK
     session = _gmsh_session(name) if on_gmsh_rank else contextlib.nullcontext(gmsh.model)
     with session as model:

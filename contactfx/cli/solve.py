@@ -121,7 +121,9 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         return 0
     pb = scene.spec
     print(f"{ns.problem}: valid")
-    print(f"  mesh       {pb.mesh_file} (size factor {pb.size}), {scene.gdim}D, "
+    where = (f"{pb.mesh_file} (size factor {pb.size})" if pb.builder is None
+             else f"the {pb.builder[0]} builder")  # fmt: skip
+    print(f"  mesh       {where}, {scene.gdim}D, "
           f"{problem.dofs()} dofs")  # fmt: skip
     print("  groups     " + scene.group_list())
     for group, mat in pb.bodies:

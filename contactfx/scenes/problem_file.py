@@ -1,7 +1,7 @@
 """Problem files: a contact problem described by a TOML file over the user's own gmsh mesh.
 
-The file names a mesh (a ``.msh`` file, or a ``.geo`` file meshed at run time with a size
-factor; 1D, 2D or 3D), the bodies (a cell group each, with E and nu, optionally a body force),
+The file names a mesh (a ``.msh`` file, a ``.geo`` file meshed at run time with a size factor,
+or a geometry of :data:`contactfx.meshes.BUILDERS` with its parameters; 1D, 2D or 3D), the bodies (a cell group each, with E and nu, optionally a body force),
 the boundary conditions on named facet groups (fixed components, prescribed displacement
 components, tractions, normal pressures, each scaled by a piecewise-linear load amplitude), and
 a rigid obstacle touching one facet group (plane, circle / cylinder, sphere, parabola /
@@ -66,6 +66,7 @@ from __future__ import annotations
 import ast
 import copy
 import dataclasses
+import functools
 import re
 import tomllib
 from dataclasses import dataclass
@@ -87,7 +88,7 @@ from contactfx.contact.obstacles import (
     Sinusoid,
 )
 from contactfx.mechanics.elasticity import Elastic
-from contactfx.meshes import build_file
+from contactfx.meshes import BUILDERS, build_file, build_grouped, builder_groups
 from contactfx.numerics import Numerics
 from contactfx.params import Params, param
 from contactfx.scenes._common import fix, fix_component, prescribe_component
@@ -101,7 +102,7 @@ AXES = ("x", "y", "z")
 SECTIONS = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
             "initial", "numerics", "petsc", "output")  # fmt: skip
 KEYS = {
-    "mesh": ("file", "size"),
+    "mesh": ("file", "size", "builder", "parameters"),
     "bodies": ("group", "E", "nu", "body_force", "amplitude"),
     "boundary": (
         "group",
@@ -332,7 +333,7 @@ class ProblemFile:
     mesh when it is built)."""
 
     path: Path
-    mesh_file: Path
+    mesh_file: Path | None
     size: float
     bodies: list[tuple[str, Elastic]]
     boundary: list[Boundary]
@@ -351,6 +352,13 @@ class ProblemFile:
     pair: dict = dataclasses.field(default_factory=dict)
     pins: list = dataclasses.field(default_factory=list)
     mean_displacement: dict = dataclasses.field(default_factory=dict)
+    #: (name, parameters) of a built-in geometry (:data:`contactfx.meshes.BUILDERS`)
+    builder: tuple[str, dict] | None = None
+
+    @property
+    def mesh_label(self) -> str:
+        """The mesh file's name, or the builder's."""
+        return self.mesh_file.name if self.builder is None else f"the {self.builder[0]} builder"
 
 
 def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
@@ -367,9 +375,25 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         if key not in SECTIONS:
             r.fail(key, f"unknown section (allowed: {', '.join(SECTIONS)})")
     mesh = r.table(data.get("mesh", {}), "mesh", KEYS["mesh"])
-    mesh_name = r.string(mesh, "mesh", "file")
-    mesh_file = (path.parent / mesh_name).resolve()
-    size = r.number(mesh, "mesh", "size", 1.0, positive=True)
+    builder = None
+    if "builder" in mesh:
+        for k in ("file", "size"):
+            if k in mesh:
+                r.fail(f"mesh.{k}", "give a mesh file or a builder with its parameters, not both")
+        name = r.string(mesh, "mesh", "builder", tuple(BUILDERS))
+        params = mesh.get("parameters", {})
+        if not isinstance(params, dict):
+            r.fail("mesh.parameters", f"expected a table of the builder's parameters, got "
+                   f"{params!r}")  # fmt: skip
+        params = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+        builder = (name, params)
+        mesh_file, size = None, 1.0
+    else:
+        if "parameters" in mesh:
+            r.fail("mesh.parameters", "parameters belong to a builder: give mesh.builder")
+        mesh_name = r.string(mesh, "mesh", "file")
+        mesh_file = (path.parent / mesh_name).resolve()
+        size = r.number(mesh, "mesh", "size", 1.0, positive=True)
 
     bodies_data = data.get("bodies")
     if not isinstance(bodies_data, list) or not bodies_data:
@@ -609,7 +633,7 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
                           list(reactions), probes, title, body_forces, displacement, symmetry,
                           None if tsym is None else [float(v) for v in tsym],
                           contact_size, pair if contact is not None else {}, pins,
-                          dict(mean_displacement))  # fmt: skip
+                          dict(mean_displacement), builder)  # fmt: skip
     return problem, numerics, petsc
 
 
@@ -740,7 +764,16 @@ class _FileMesh:
         raise ProblemError(f"{self.spec.path}: {key}: {message}")
 
     def read_mesh(self, comm):
-        data, groups = build_file(comm, self.spec.mesh_file, self.spec.size, self.name)
+        if self.spec.builder is None:
+            data, groups = build_file(comm, self.spec.mesh_file, self.spec.size, self.name)
+        else:
+            name, params = self.spec.builder
+            function, _ = BUILDERS[name]
+            builder, groups = builder_groups(functools.partial(function, **params), name)
+            try:
+                data, groups = build_grouped(comm, builder, groups, self.name)
+            except (ValueError, TypeError) as err:  # the builder's own checks, unknown names
+                self._fail("mesh.parameters", f"{name}: {err}")
         self.groups = {g.name: g for g in groups}
         self._mesh = data.mesh
         self.gdim = max(g.dim for g in groups)
@@ -754,7 +787,7 @@ class _FileMesh:
     def tag(self, key: str, name: str, dim: int) -> int:
         g = self.groups.get(name)
         if g is None:
-            self._fail(key, f"no physical group '{name}' in {self.spec.mesh_file.name} (it "
+            self._fail(key, f"no physical group '{name}' in {self.spec.mesh_label} (it "
                        f"has: {self.group_list()})")  # fmt: skip
         if g.dim != dim:
             what = "cells (a body)" if dim == self.gdim else "facets (a boundary)"
@@ -1190,7 +1223,7 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
             found = bool(len(x)) and float(np.min(np.linalg.norm(x - point, axis=1))) < tol
             if not mesh.comm.allreduce(found, op=MPI.LOR):
                 self._fail(f"pins.{i}.point", f"{point.tolist()} is not a vertex of the mesh "
-                           f"{self.spec.mesh_file.name}")  # fmt: skip
+                           f"{self.spec.mesh_label}")  # fmt: skip
 
     def _segments(self, mesh, facet_tags, selection) -> np.ndarray:
         """(m, 2, gdim) vertex coordinates of the facets (of the groups ``selection``, or the

@@ -126,3 +126,52 @@ def test_init_round_trip(tmp_path, name, params, numerics):
 def test_every_scene_has_a_round_trip_case():
     covered = {c[0] for c in CASES}
     assert sorted(set(SCENES) - covered) == []
+
+
+_RECTANGLE = ('builder = "rectangle"\nparameters = { x0 = -1.0, x1 = 1.0, y0 = -1.0, y1 = 0.0, '
+              'refine_x0 = -0.06, refine_x1 = 0.06, h_contact = 0.01, h_far = 0.1 }')  # fmt: skip
+
+
+def _builder_file(tmp_path: Path, mesh: str) -> Path:
+    """hertz2d's problem file with its [mesh] table replaced by ``mesh``."""
+    cls = get_scene("hertz2d")
+    scene = cls(cls.Params(h_contact=0.01))
+    out = _shared_dir(tmp_path, MPI.COMM_WORLD)
+    _, toml = write_problem(scene, cls.default_numerics(), out, "init", MPI.COMM_WORLD)
+    text = toml.read_text().replace('[mesh]\nfile = "hertz2d.msh"', f"[mesh]\n{mesh}")
+    path = out / "builder.toml"
+    MPI.COMM_WORLD.barrier()
+    if MPI.COMM_WORLD.rank == 0:
+        path.write_text(text)
+    MPI.COMM_WORLD.barrier()
+    return path
+
+
+def test_mesh_from_a_builder_gives_the_scene(tmp_path):
+    """``[mesh] builder = "rectangle"`` with hertz2d's parameters meshes the scene's own
+    geometry in memory: the same discrete problem as the scene, to round-off."""
+    cls = get_scene("hertz2d")
+    builtin = cls(cls.Params(h_contact=0.01)).run(cls.default_numerics(), verbose=False)
+    scene, num, petsc = load_problem(_builder_file(tmp_path, _RECTANGLE))
+    res = scene.run(num, petsc_options=petsc, verbose=False)
+    assert res.dofs == builtin.dofs and res.newton_iterations == builtin.newton_iterations
+    # round-off only (the test above): 1e-10
+    assert res.force == pytest.approx(builtin.force, rel=1e-10)
+    assert res.contact_size == pytest.approx(builtin.contact_size, rel=1e-10)
+
+
+@pytest.mark.parametrize("mesh, message", [
+    ('builder = "triangle"', "mesh.builder: must be one of interval, rectangle"),
+    (_RECTANGLE.replace("x1 = 1.0", "x1 = -2.0"), "mesh.parameters: rectangle: x0 must be < x1"),
+    (_RECTANGLE.replace("h_far = 0.1", "h_far = 0.1, colour = 1"),
+     "mesh.parameters: rectangle: rectangle() got an unexpected keyword argument 'colour'"),
+    (_RECTANGLE + '\nfile = "a.msh"', "mesh.file: give a mesh file or a builder"),
+    ('file = "hertz2d.msh"\nparameters = { x0 = 1.0 }', "mesh.parameters: parameters belong"),
+])  # fmt: skip
+def test_bad_builder(tmp_path, mesh, message):
+    path = _builder_file(tmp_path, mesh)
+    with pytest.raises(ValueError) as err:
+        scene, _, _ = load_problem(path)
+        scene.build_mesh(MPI.COMM_WORLD)
+    assert message in str(err.value) and str(path) in str(err.value)
+    assert "\n" not in str(err.value)
