@@ -1,14 +1,15 @@
 """Problem files: a contact problem described by a TOML file over the user's own gmsh mesh.
 
 The file names a mesh (a ``.msh`` file, a ``.geo`` file meshed at run time with a size factor,
-or a geometry of :data:`contactfx.meshes.BUILDERS` with its parameters; 1D, 2D or 3D), the bodies (a cell group each, with E and nu, optionally a body force),
-the boundary conditions on named facet groups (fixed components, prescribed displacement
-components, tractions, normal pressures, each scaled by a piecewise-linear load amplitude), and
-a rigid obstacle touching one facet group (plane, circle / cylinder, sphere, parabola /
-paraboloid, sinusoid, punch with rounded edges, or a signed distance expression; moved by
-``motion`` times an amplitude or along a ``path``), a contact pair between two bodies, or an
-interface; then an optional initial displacement (Newton's start), the numerics, PETSc options
-and outputs (reactions, probes, the model's symmetry multiplicity)::
+or a geometry of :data:`contactfx.meshes.BUILDERS` with its parameters; 1D, 2D or 3D), the
+bodies (a cell group each, with E and nu, optionally a body force), the boundary conditions on
+named facet groups (fixed components, prescribed displacement components, tractions, normal
+pressures, each scaled by a piecewise-linear load amplitude), and a rigid obstacle touching one
+facet group (plane, circle / cylinder, sphere, parabola / paraboloid, sinusoid, punch with
+rounded edges, or a signed distance expression; moved by ``motion`` times an amplitude or along
+a ``path``), a contact pair between two bodies, or an interface; then an optional initial
+displacement (Newton's start), the numerics, PETSc options and outputs (reactions, probes, the
+model's symmetry multiplicity)::
 
     [mesh]
     file = "block.geo"                 # relative to the problem file
