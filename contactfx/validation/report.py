@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["machine", "write_bench", "write_csv", "markdown_table"]
+__all__ = ["machine", "write_bench", "write_csv", "markdown_table", "method_guide"]
 
 
 def machine(ranks: int) -> str:
@@ -65,12 +65,17 @@ def _cell(value) -> str:
     return str(value)
 
 
+def _escape(text: str) -> str:
+    """A table cell's text with its pipes escaped (|x| would split the cell)."""
+    return text.replace("|", "\\|")
+
+
 def markdown_table(rows: list[dict], columns: list[tuple[str, str]]) -> str:
     """Rows as a Markdown table with the (key, heading) columns."""
-    lines = ["| " + " | ".join(h for _, h in columns) + " |",
+    lines = ["| " + " | ".join(_escape(h) for _, h in columns) + " |",
              "|" + "---|" * len(columns)]  # fmt: skip
     for r in rows:
-        lines.append("| " + " | ".join(_cell(r.get(k, "")) for k, _ in columns) + " |")
+        lines.append("| " + " | ".join(_escape(_cell(r.get(k, ""))) for k, _ in columns) + " |")
     return "\n".join(lines)
 
 
@@ -115,6 +120,11 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
         "bench.csv). Rates: least-squares slope of log(error) against log(h) over the levels "
         "(last pair in brackets).",
     ]
+    md += ["", "## Which method for which problem", "",
+           "From the tables below (generated): per case, the most accurate method at the finest "
+           "level every method reached, the fastest one whose error is within twice that, the "
+           "one with the fewest Newton iterations, and the runs that failed.", ""]  # fmt: skip
+    md += method_guide(rows)
     for case_name in dict.fromkeys(r["case"] for r in rows):
         case_rows = [r for r in rows if r["case"] == case_name]
         measures = [m for m in MEASURES if _has(case_rows, m)]
@@ -162,10 +172,22 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
     return written
 
 
+#: one colour per method variant (tab10 and eight more of distinct hue), in order of appearance
+PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+           "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8", "#ffbb78", "#98df8a",
+           "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d")  # fmt: skip
+#: one line style and marker per degree
+DEGREE_STYLE = {1: ("-", "o"), 2: ("--", "s"), 3: (":", "^")}
+
+
 def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
+    """Error against time or h: a colour per method, a line style and marker per degree, the
+    legend beside the axes (off the data)."""
     from contactfx.validation.bench import observed_rates
 
-    fig, ax = plt.subplots(figsize=(6.0, 4.2))
+    colours = {label: PALETTE[i % len(PALETTE)]
+               for i, label in enumerate(dict.fromkeys(label for label, _ in series))}  # fmt: skip
+    fig, ax = plt.subplots(figsize=(8.4, 4.4))
     for (label, degree), srs in series.items():
         pts = [(r["t_run"] if kind == "time" else r["h"], r[column]) for r in srs]
         pts = [(x, e) for x, e in pts if math.isfinite(e) and e > 1e-10]
@@ -175,17 +197,70 @@ def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
         name = f"{label} P{degree}"
         if kind == "h" and len(pts) > 1:
             name += f" (rate {observed_rates(srs, column)[0]:.2f})"
-        ax.loglog(x, e, "o-", label=name, markersize=4)
+        line, marker = DEGREE_STYLE.get(degree, ("-.", "v"))
+        ax.loglog(x, e, linestyle=line, marker=marker, color=colours[label], label=name,
+                  markersize=4)  # fmt: skip
     ax.set_xlabel("wall time, assembly + solve [s]" if kind == "time" else "h (contact zone)")
     ax.set_ylabel("relative error")
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     if kind == "h":
         ax.invert_xaxis()
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def method_guide(rows: list[dict]) -> list[str]:
+    """Markdown: for each case, from the bench rows, the most accurate method at the finest
+    level it reached, the fastest method within twice that error (time of assembly + solve at
+    that method's finest level), the one with the fewest Newton iterations there, and the
+    methods that failed. The yardstick is the case's primary error (``PRIMARY``, most specific
+    first) that is above round-off somewhere, else its first such measure."""
+    from contactfx.results import PRIMARY
+    from contactfx.validation.bench import MEASURES, ROUNDOFF
+
+    lines = ["| case | yardstick | most accurate | fastest within 2x its error | "
+             "fewest Newton | failed |", "|---|---|---|---|---|---|"]  # fmt: skip
+    for case in dict.fromkeys(r["case"] for r in rows):
+        case_rows = [r for r in rows if r["case"] == case]
+        measures = [m for m in MEASURES if _has(case_rows, m)]
+        failed = sorted({f"{r['method']} P{r['degree']}" for r in case_rows
+                         if r["status"] not in ("ok", "n/a")})  # fmt: skip
+        above = [m for m in measures if _has(case_rows, m, ROUNDOFF)]
+        if not above:
+            continue
+        primary = [c for _, c in PRIMARY if c in above]
+        m = primary[0] if primary else above[0]
+        best: dict[tuple[str, int], dict] = {}
+        for (label, degree), srs in _series(case_rows).items():
+            ok = [r for r in srs if math.isfinite(r.get(m, math.nan))]
+            if ok:
+                best[(label, degree)] = max(ok, key=lambda r: r["level"])
+        if not best:
+            continue
+        finest = max(r["level"] for r in best.values())
+        top = {k: r for k, r in best.items() if r["level"] == finest}
+        acc_key, acc = min(top.items(), key=lambda kv: kv[1][m])
+        near = {k: r for k, r in top.items() if r[m] <= 2.0 * max(acc[m], ROUNDOFF_GUIDE)}
+        fast_key, fast = min(near.items(), key=lambda kv: kv[1]["t_run"])
+        few_key, few = min(top.items(), key=lambda kv: (kv[1]["newton"], kv[1]["t_run"]))
+
+        def name(key):
+            return f"{key[0]} P{key[1]}"
+
+        lines.append(
+            f"| {case} | {_escape(MEASURES[m][0])}, level {finest} "
+            f"| {name(acc_key)} ({_cell(acc[m])}) "
+            f"| {name(fast_key)} ({_cell(fast['t_run'])} s, {_cell(fast[m])}) "
+            f"| {name(few_key)} ({few['newton']}) | {', '.join(failed) or 'none'} |"
+        )
+    return lines
+
+
+#: errors below this are round-off: "within 2x" of it means at round-off too
+ROUNDOFF_GUIDE = 1e-10
 
 
 def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
