@@ -29,16 +29,19 @@ from mpi4py import MPI
 from contactfx import _compat
 
 __all__ = ["Side", "Facets", "ContactPair", "side_of", "facet_normals", "gather_near",
-           "owners"]  # fmt: skip
+           "owners", "facet_order"]  # fmt: skip
 
 
 @dataclass
 class Facets:
     """Facets in the current configuration: ``x`` (m, d, gdim) vertex coordinates and
-    ``nodes`` (m, d) global node (dof block) indices."""
+    ``nodes`` (m, d) global node (dof block) indices; ``X`` (m, d, gdim) the reference
+    coordinates (the same bits on every partition, unlike the global indices: what orders
+    facets independently of the partition, :func:`facet_order`)."""
 
     x: np.ndarray
     nodes: np.ndarray
+    X: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -75,7 +78,7 @@ class Side:
 
     def current(self, u: np.ndarray) -> Facets:
         """The facets at x = X + u; ``u`` the local (owned + ghost) array, blocked (n, gdim)."""
-        return Facets(self.X + u[self.local], self.nodes)
+        return Facets(self.X + u[self.local], self.nodes, self.X)
 
     def __len__(self) -> int:
         return len(self.local)
@@ -150,17 +153,35 @@ def gather_near(comm, master: Facets, region: Facets, radius: float) -> Facets:
     boxes = comm.allgather(box)
     if comm.size == 1:
         keep = _boxes_meet(master.x.min(axis=1), master.x.max(axis=1), boxes[0])
-        return Facets(master.x[keep], master.nodes[keep])
+        return Facets(master.x[keep], master.nodes[keep],
+                      None if master.X is None else master.X[keep])  # fmt: skip
     lo, hi = master.x.min(axis=1), master.x.max(axis=1)
+    ref = master.x if master.X is None else master.X
     sends = []
     for b in boxes:
         keep = _boxes_meet(lo, hi, b)
-        sends.append((master.x[keep], master.nodes[keep]))
+        sends.append((master.x[keep], master.nodes[keep], ref[keep]))
     received = comm.alltoall(sends)
     d = master.x.shape[1]
     x = np.concatenate([r[0] for r in received]).reshape(-1, d, gdim)
     nodes = np.concatenate([r[1] for r in received]).reshape(-1, d)
-    return Facets(x, nodes)
+    X = np.concatenate([r[2] for r in received]).reshape(-1, d, gdim)
+    return Facets(x, nodes, None if master.X is None else X)
+
+
+def facet_order(X: np.ndarray) -> np.ndarray:
+    """(m,) the rank of each facet (reference vertex coordinates X (m, d, gdim)) in the
+    lexicographic order of its vertices' coordinates, the vertices sorted first: an order of
+    the facets that does not depend on the partition or on the order they came in."""
+    m, d, gdim = X.shape
+    if m == 0:
+        return np.zeros(0, dtype=np.int64)
+    vertices = X[np.arange(m)[:, None], np.lexsort(np.moveaxis(X[..., ::-1], -1, 0))]
+    flat = vertices.reshape(m, d * gdim)
+    order = np.lexsort(flat.T[::-1])
+    rank = np.empty(m, dtype=np.int64)
+    rank[order] = np.arange(m)
+    return rank
 
 
 def owners(imap, comm) -> np.ndarray:

@@ -39,7 +39,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
-from contactfx.contact.pair import Facets, Side, facet_normals
+from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
 from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
 
 __all__ = ["PointCoupling", "Law"]
@@ -232,7 +232,11 @@ class PointCoupling:
         rows, facets = rows[order], facets[order]
         slot = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
         cand[rows, slot] = facets
-        pick = pick_closest(xq, cand, near.x, fallback=True)
+        # ties (a point equally far from facets sharing an edge or a vertex, to round-off) go
+        # to the facet first in the order of the reference coordinates: the same choice on
+        # every partition (the candidates' order and the global numbers depend on it)
+        key = None if near.X is None else facet_order(near.X)
+        pick = pick_closest(xq, cand, near.x, fallback=True, key=key)
         off = (pick.index >= 0) & ~pick.inside
         if np.any(off):
             # the closest point is a vertex: in contact if another master facet shares it

@@ -325,9 +325,11 @@ def _pick(
     cand: np.ndarray,
     project: Callable[[np.ndarray, np.ndarray], FacetProjection],
     fallback: bool,
+    key: np.ndarray | None = None,
 ) -> Pick:
     """The choice of :func:`pick_closest`; project(points, facet indices) -> FacetProjection.
-    gap is left NaN."""
+    gap is left NaN. With ``key`` ((m,) per facet), distances equal to round-off are a tie
+    that the lowest key breaks."""
     n, d = p.shape
     k = cand.shape[1]
     rows, cols = np.nonzero(cand >= 0)
@@ -339,10 +341,21 @@ def _pick(
     slot = np.full((n, k), -1)
     slot[rows, cols] = np.arange(rows.size)
 
-    col = np.argmin(np.where(inside, dist, np.inf), axis=1) if k else np.zeros(n, np.int64)
+    def best(d: np.ndarray) -> np.ndarray:
+        if key is None or not k:
+            return np.argmin(d, axis=1) if k else np.zeros(n, np.int64)
+        least = np.min(d, axis=1, keepdims=True)
+        finite = np.where(np.isfinite(least), least, 0.0)
+        # a tie: within round-off of the least distance (relative to the point's size too)
+        scale = np.abs(p).max(axis=1, keepdims=True) + finite
+        tied = d <= least + 1e-12 * scale
+        keys = np.where(tied & (cand >= 0), key[np.maximum(cand, 0)], np.iinfo(np.int64).max)
+        return np.argmin(keys, axis=1)
+
+    col = best(np.where(inside, dist, np.inf))
     found = np.any(inside, axis=1)
     if fallback and k:
-        col = np.where(found, col, np.argmin(dist, axis=1))
+        col = np.where(found, col, best(dist))
         found = np.any(cand >= 0, axis=1)
 
     r = np.nonzero(found)[0]
@@ -364,6 +377,7 @@ def pick_closest(
     facets: ArrayLike,
     tol: float = TOL,
     fallback: bool = False,
+    key: ArrayLike | None = None,
 ) -> Pick:
     """Choose for each point the facet it projects onto, among its candidates.
 
@@ -371,13 +385,17 @@ def pick_closest(
     int indices into facets, padded with -1 (e.g. the hits of a bounding-box tree), or None
     for all m facets (an (n, m) search). Among the candidates whose orthogonal projection is
     inside (up to ``tol``), the one at the least distance wins (ties: the first in the
-    candidate order). With none inside, index is -1 - or, with ``fallback``, the candidate at
-    the least true distance (its ``inside`` False; e.g. a point off a convex corner of the
-    master surface). Rows without any candidate are always -1. gap is signed along
-    :func:`facet_normal` of the chosen facet."""
+    candidate order, or with ``key`` ((m,) int per facet) the lowest key among the distances
+    equal to round-off: a choice that does not depend on the order the facets came in, e.g.
+    the partition of the mesh). With none inside, index is -1 - or, with ``fallback``, the
+    candidate at the least true distance (its ``inside`` False; e.g. a point off a convex
+    corner of the master surface, equally far from the facets that share the corner). Rows
+    without any candidate are always -1. gap is signed along :func:`facet_normal` of the chosen
+    facet."""
     p, facets = np.asarray(points, float), np.asarray(facets, float)
     cand = _candidates(candidates, p.shape[0], facets.shape[0])
-    pick = _pick(p, cand, lambda q, j: closest_point_facets(q, facets[j], tol), fallback)
+    key = None if key is None else np.asarray(key, dtype=np.int64)
+    pick = _pick(p, cand, lambda q, j: closest_point_facets(q, facets[j], tol), fallback, key)
     r = np.nonzero(pick.index >= 0)[0]
     pick.gap[r] = _dot(p[r] - pick.closest[r], facet_normal(facets[pick.index[r]]))
     return pick

@@ -243,6 +243,29 @@ def test_pick_closest_triangles():
     assert np.allclose(r.closest[3], [0.5, 0.25, 1.0], rtol=0, atol=ROUND)
 
 
+def test_pick_closest_ties_do_not_depend_on_the_candidate_order():
+    """A point off a convex ridge is equally far from the two triangles that share the ridge
+    (its closest point is on the shared edge): with a key, the lowest key wins whatever order
+    the candidates come in (the order of the received facets depends on the mesh partition);
+    facet_order gives such a key from the reference coordinates alone."""
+    from contactfx.contact.pair import facet_order
+
+    ridge = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    left = np.array([ridge[0], [-1.0, 0.0, -0.5], ridge[1]])
+    right = np.array([ridge[0], ridge[1], [1.0, 0.0, -0.5]])
+    facets = np.stack([left, right])
+    p = np.array([[0.0, 0.5, 0.25]])  # above the ridge: the same distance to both
+    dist = [closest_point_triangles(p, f[None]).distance[0] for f in facets]
+    assert dist[0] == pytest.approx(dist[1], rel=1e-15)
+    key = facet_order(facets)
+    picked = {int(pick_closest(p, np.array([order]), facets, fallback=True, key=key).index[0])
+              for order in ([0, 1], [1, 0])}  # fmt: skip
+    assert picked == {int(np.argmin(key))}
+    # the key is the facets' own order: permuting the facets or their vertices keeps it
+    assert np.array_equal(facet_order(facets[::-1]), key[::-1])
+    assert np.array_equal(facet_order(facets[:, ::-1]), key)
+
+
 def test_pick_closest_matches_loop():
     # random surfaces and candidate lists against a per-point loop over the candidates
     for d in (2, 3):
