@@ -141,6 +141,9 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
             what.append(f"traction {np.array2string(b.traction, separator=', ')}")
         if b.pressure is not None:
             what.append(f"pressure {b.pressure:g}")
+        if b.stress is not None:
+            exact = all(isinstance(v, int | float) for row in b.stress for v in row)
+            what.append(f"stress {b.stress}" if exact else "stress (expressions in x, y)")
         amp = "" if b.amplitude == [(0.0, 0.0), (1.0, 1.0)] else f" x amplitude {b.amplitude}"
         print(f"  boundary   {b.group}: {'; '.join(what)}{amp}")
     if pb.obstacle is not None:
@@ -157,6 +160,11 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print("  initial    displacement given (Newton's start)")
     if pb.contact is not None:
         print(f"  contact    slave {pb.contact[0]}, master {pb.contact[1]}")
+    for point, comps in pb.pins:
+        print(f"  pin        {point.tolist()}: fixed {','.join('xyz'[c] for c in comps)}")
+    if pb.interface is not None:
+        keys = [k for k in pb.interface if k != "group"]
+        print(f"  interface  {pb.interface['group']}" + (f" ({', '.join(keys)})" if keys else ""))
     print(f"  numerics   method {numerics.method}, friction {numerics.friction}, "
           f"{numerics.steps} step(s), solver {numerics.solver}")  # fmt: skip
     if file_petsc:
