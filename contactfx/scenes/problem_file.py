@@ -748,8 +748,9 @@ class _FileMesh:
     and loads of the file, the reactions per group."""
 
     symmetry = 1.0
+    Params = FileParams
 
-    def _init(self, problem: ProblemFile) -> None:
+    def __init__(self, problem: ProblemFile) -> None:
         self.spec = problem
         self.p = FileParams(problem=str(problem.path), size=problem.size)
         # the name makes the output files and the PETSc options prefix
@@ -779,6 +780,7 @@ class _FileMesh:
         self._mesh = data.mesh
         self.gdim = max(g.dim for g in groups)
         self.cell_tags = data.cell_tags
+        self._facet_tags = data.facet_tags
         self._check_groups()
         return data.mesh, data.facet_tags
 
@@ -917,26 +919,43 @@ class _FileMesh:
                   for v in values]  # fmt: skip
         u.interpolate(_compat.expression(ufl.as_vector(values), u.function_space))
 
-    def _facet_size(self, mesh, facet_tags, tags: list[int]) -> float:
-        """The longest edge of the facets of the groups ``tags`` (all ranks)."""
-        fdim = mesh.topology.dim - 1
-        mesh.topology.create_connectivity(fdim, 0)
+    def _facet_points(self, mesh, facets: np.ndarray) -> np.ndarray:
+        """(m, vertices per facet, gdim) vertex coordinates of this rank's ``facets``."""
+        tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
+        for a, b in ((fdim, 0), (fdim, tdim), (tdim, 0)):
+            mesh.topology.create_connectivity(a, b)
         f2v = mesh.topology.connectivity(fdim, 0)
+        f2c = mesh.topology.connectivity(fdim, tdim)
+        c2v = mesh.topology.connectivity(tdim, 0)
         V = _compat.function_space(mesh, "Lagrange", 1)
-        X = _compat.dof_coordinates(V)
-        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
-        mesh.topology.create_connectivity(mesh.topology.dim, 0)
-        f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
-        c2v = mesh.topology.connectivity(mesh.topology.dim, 0)
-        h = 0.0
-        for f in facet_tags.indices[np.isin(facet_tags.values, tags)]:
+        X = _compat.dof_coordinates(V)[:, : self.gdim]
+        out = []
+        for f in facets:
             c = f2c.links(f)[0]
             dofs, verts = V.dofmap.cell_dofs(c), c2v.links(c)
-            pts = X[[dofs[np.flatnonzero(verts == v)[0]] for v in f2v.links(f)]]
-            for i in range(len(pts)):
-                for j in range(i):
-                    h = max(h, float(np.linalg.norm(pts[i] - pts[j])))
+            out.append(X[[dofs[np.flatnonzero(verts == v)[0]] for v in f2v.links(f)]])
+        return np.array(out).reshape(-1, fdim + 1, self.gdim)
+
+    def _facet_size(self, mesh, facet_tags, tags: list[int]) -> float:
+        """The longest edge of the facets of the groups ``tags`` (all ranks)."""
+        pts = self._facet_points(mesh, facet_tags.indices[np.isin(facet_tags.values, tags)])
+        n = pts.shape[1]
+        edges = [np.linalg.norm(pts[:, i] - pts[:, j], axis=1) for i in range(n) for j in range(i)]
+        h = float(np.max(edges, initial=0.0)) if edges else 0.0
         return mesh.comm.allreduce(h, op=MPI.MAX)
+
+    def _bodies_touching(self, mesh, facet_tags, tag: int) -> list[str]:
+        """The bodies (group names, file order) whose cells the facet group ``tag`` bounds,
+        on any rank."""
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        f2c = mesh.topology.connectivity(tdim - 1, tdim)
+        cell_body = dict(zip(self.cell_tags.indices, self.cell_tags.values, strict=True))
+        facets = facet_tags.indices[facet_tags.values == tag]
+        local = {int(cell_body.get(int(c), -1)) for f in facets for c in f2c.links(f)}
+        found = set().union(*mesh.comm.allgather(local))
+        return [g for (g, _), t in zip(self.spec.bodies, self.body_tags, strict=True)
+                if t in found]  # fmt: skip
 
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float, quantities) -> None:
@@ -991,14 +1010,8 @@ class _FileMesh:
 class FileObstacleScene(_FileMesh, ObstacleScene):
     """A problem file with a rigid obstacle."""
 
-    Params = FileParams
-
-    def __init__(self, problem: ProblemFile) -> None:
-        self._init(problem)
-
     def build_mesh(self, comm):
         mesh, facet_tags = self.read_mesh(comm)
-        self._facet_tags = facet_tags
         ob = self.spec.obstacle
         self.contact_tag = self.tag("obstacle.contact", ob["contact"], self.gdim - 1)
         for shape, dim, other in (("circle", 2, "sphere"), ("cylinder", 2, "sphere"),
@@ -1023,22 +1036,11 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         if len(self.spec.bodies) > 1 and len({m.nu for _, m in self.spec.bodies}) > 1:
             self._fail("bodies", "bodies of different nu against an obstacle are not supported "
                        "(one nu, E per body)")  # fmt: skip
-        self._contact_E = self._touching_modulus(mesh, facet_tags, self.contact_tag)
+        # the modulus of the body at the contact surface (the largest, if several touch)
+        moduli = dict(self.spec.bodies)
+        touching = self._bodies_touching(mesh, facet_tags, self.contact_tag) or list(moduli)
+        self._contact_E = max(moduli[g].E for g in touching)
         return mesh, facet_tags
-
-    def _touching_modulus(self, mesh, facet_tags, tag: int) -> float:
-        """The largest Young's modulus of the bodies whose cells touch the facet group."""
-        tdim = mesh.topology.dim
-        mesh.topology.create_connectivity(tdim - 1, tdim)
-        f2c = mesh.topology.connectivity(tdim - 1, tdim)
-        cells = np.unique([c for f in facet_tags.indices[facet_tags.values == tag]
-                           for c in f2c.links(f)])  # fmt: skip
-        cell_body = dict(zip(self.cell_tags.indices, self.cell_tags.values, strict=True))
-        moduli = {tag: m.E for tag, (_, m) in zip(self.body_tags, self.spec.bodies,
-                                                  strict=True)}  # fmt: skip
-        local = max((moduli.get(cell_body.get(int(c)), 0.0) for c in cells), default=0.0)
-        E = mesh.comm.allreduce(local, op=MPI.MAX)
-        return E if E > 0.0 else max(moduli.values())
 
     def material(self) -> Elastic:
         return self.spec.bodies[0][1]
@@ -1085,14 +1087,8 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
 class FileTwoBodyScene(_FileMesh, TwoBodyScene):
     """A problem file with a contact pair between two bodies."""
 
-    Params = FileParams
-
-    def __init__(self, problem: ProblemFile) -> None:
-        self._init(problem)
-
     def build_mesh(self, comm):
         mesh, facet_tags = self.read_mesh(comm)
-        self._facet_tags = facet_tags
         slave, master = self.spec.contact
         fdim = self.gdim - 1
         self._slave = self.tag("contact.0.slave", slave, fdim)
@@ -1101,22 +1097,12 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
                                                 strict=True)}  # fmt: skip
         contact = [self._slave, self._master]
         self._h = self.spec.pair.get("h") or self._facet_size(mesh, facet_tags, contact)
-        self._slave_body = self._body_of(mesh, facet_tags, self._slave, "contact.0.slave")
+        bodies = self._bodies_touching(mesh, facet_tags, self._slave)
+        if len(bodies) != 1:
+            self._fail("contact.0.slave", "the surface must bound one body, it bounds "
+                       f"{sorted(bodies) or 'none'}")  # fmt: skip
+        self._slave_body = bodies[0]
         return mesh, facet_tags
-
-    def _body_of(self, mesh, facet_tags, tag: int, key: str) -> str:
-        """The body (group name) whose cells the facet group ``tag`` bounds (all ranks)."""
-        tdim = mesh.topology.dim
-        mesh.topology.create_connectivity(tdim - 1, tdim)
-        f2c = mesh.topology.connectivity(tdim - 1, tdim)
-        cell_body = dict(zip(self.cell_tags.indices, self.cell_tags.values, strict=True))
-        facets = facet_tags.indices[facet_tags.values == tag]
-        local = {int(cell_body.get(int(c), -1)) for f in facets for c in f2c.links(f)}
-        found = set().union(*mesh.comm.allgather(local)) & set(self.body_tags)
-        if len(found) != 1:
-            names = sorted(g for g, t in self.cells.items() if t in found)
-            self._fail(key, f"the surface must bound one body, it bounds {names or 'none'}")
-        return next(g for g, t in self.cells.items() if t in found)
 
     # (before the mesh is read the tags are unknown; the file's names were checked distinct)
     @property
@@ -1167,14 +1153,8 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
     ``[[pins]]`` fix components at mesh vertices (removing the rigid motions of a plate held
     by tractions only)."""
 
-    Params = FileParams
-
-    def __init__(self, problem: ProblemFile) -> None:
-        self._init(problem)
-
     def build_mesh(self, comm):
         mesh, facet_tags = self.read_mesh(comm)
-        self._facet_tags = facet_tags
         if self.gdim != 2:
             self._fail("interface", "interfaces in problem files are 2D (plane strain) for now")
         self.interface_tag = self.tag("interface.group", self.spec.interface["group"], 1)
@@ -1229,23 +1209,9 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
     def _segments(self, mesh, facet_tags, selection) -> np.ndarray:
         """(m, 2, gdim) vertex coordinates of the facets (of the groups ``selection``, or the
         facet indices ``selection`` when facet_tags is None) of every rank."""
-        fdim = mesh.topology.dim - 1
-        mesh.topology.create_connectivity(fdim, 0)
-        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
-        mesh.topology.create_connectivity(mesh.topology.dim, 0)
-        f2v = mesh.topology.connectivity(fdim, 0)
-        f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
-        c2v = mesh.topology.connectivity(mesh.topology.dim, 0)
-        V = _compat.function_space(mesh, "Lagrange", 1)
-        X = _compat.dof_coordinates(V)[:, : self.gdim]
         facets = (selection if facet_tags is None
                   else facet_tags.indices[np.isin(facet_tags.values, selection)])  # fmt: skip
-        out = []
-        for f in facets:
-            c = f2c.links(f)[0]
-            dofs, verts = V.dofmap.cell_dofs(c), c2v.links(c)
-            out.append(X[[dofs[np.flatnonzero(verts == v)[0]] for v in f2v.links(f)]])
-        local = np.array(out).reshape(-1, 2, self.gdim)
+        local = self._facet_points(mesh, facets)
         # ghost facets appear on two ranks: keep each facet once
         every = np.concatenate(mesh.comm.allgather(local))
         keys = np.round(np.sort(every.reshape(len(every), -1), axis=1) * 1e9).astype(np.int64)

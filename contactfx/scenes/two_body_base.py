@@ -185,9 +185,6 @@ class TwoBodyScene(Scene):
         return contact_edge(self.edge_rule, x, p, self.edge_ring())
 
     # -- the scene as a problem file ----------------------------------------------------------
-    def mesh_builder(self):
-        raise NotImplementedError(f"scene '{self.name}' has no gmsh builder")
-
     def build_mesh(self, comm):
         """The mesh of :meth:`mesh_builder`, then :meth:`make_constants` on it."""
         mesh, facet_tags = super().build_mesh(comm)
