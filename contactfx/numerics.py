@@ -37,6 +37,13 @@ class _General:
                              "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
     steps: int = param(1, "load steps", positive=True)
     solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
+    nested: int = param(
+        0,
+        "nested iteration: solve every load step first on this many "
+        "coarser meshes (element sizes x2, x4, ...), each solution the start "
+        "of the next finer Newton solve (obstacle scenes)",
+        nonnegative=True,
+    )
     search_update: str = param("step", "two-body contact search: once per load step, or at "
                                "every Newton iteration", choices=("step", "newton"))  # fmt: skip
 

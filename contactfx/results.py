@@ -128,6 +128,7 @@ class StepLog:
     outer: int
     cutbacks: int
     reason: str
+    coarse_newton: int  # nested iteration: Newton iterations on the coarser meshes
     quantities: Quantities
 
     def to_json(self) -> dict[str, Any]:
@@ -211,7 +212,7 @@ class RunSummary:
         """The summary of a run.json written by :meth:`to_json` (a child process's run; the
         steps keep their iterations, their quantities are the final state's)."""
         q = Quantities.from_json(d)
-        steps = [StepLog(*(s[f.name] for f in dataclasses.fields(StepLog)[:-1]), q)
+        steps = [StepLog(*(s.get(f.name, 0) for f in dataclasses.fields(StepLog)[:-1]), q)
                  for s in d["steps"]]  # fmt: skip
         names = [f.name for f in dataclasses.fields(cls)
                  if f.name not in ("steps", "quantities") and f.name in d]  # fmt: skip

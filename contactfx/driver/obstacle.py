@@ -38,6 +38,8 @@ __all__ = ["ObstacleProblem", "closed_form_errors"]
 class ObstacleProblem(Problem):
     """A body against a rigid obstacle (see the module docstring)."""
 
+    nested = True
+
     @classmethod
     def check(cls, scene, numerics, method) -> None:
         if not method.supports.obstacles:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.io.provenance import versions, write_json
 from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog
@@ -51,6 +52,13 @@ def _checked_method(scene, numerics):
     collective); the scene reads the numerics' physical choices."""
     method = numerics.method_object()
     scene.problem.check(scene, numerics, method)
+    if numerics.nested:
+        if not scene.problem.nested:
+            raise ValueError(f"--nested: nested iteration is offered for obstacle scenes, not "
+                             f"for scene '{scene.name}'")  # fmt: skip
+        if scene.coarsened(2.0**numerics.nested) is None:
+            raise ValueError(f"--nested: scene '{scene.name}' cannot mesh itself coarser "
+                             "(its mesh comes from a file)")  # fmt: skip
     scene.configure(numerics)
     return method
 
@@ -92,6 +100,18 @@ class _Run:
     def execute(self) -> RunSummary:
         if self.out is not None:
             prepare_output(self.out, self.comm)
+        problem, post, solver = self.build()
+        try:
+            steps = self.load_program(problem, solver, post)
+            extra = post.finish(steps[-1].quantities, self.out)
+        finally:
+            solver.destroy()
+        return self.record(problem, problem.mesh, steps, extra)
+
+    def build(self):
+        """(problem, post-processor, solver): the stages up to the load program. With
+        ``--nested N``, the solver is started at every step by the chain of N coarser meshes
+        (built here; their mesh and compile times count in this run's)."""
         with self.timed("mesh"):
             mesh, facet_tags = self.scene.build_mesh(self.comm)
         problem = self.scene.problem(self.scene, self.num, self.method, mesh, facet_tags)
@@ -103,11 +123,26 @@ class _Run:
             with self.timed("initial_guess"):
                 problem.start(solver)
             solver = self.method.attach(solver, problem)
-            steps = self.load_program(problem, solver, post)
-            extra = post.finish(steps[-1].quantities, self.out)
-        finally:
+            levels = nested_levels(self.num.nested, problem.dofs(), mesh.topology.dim)
+            if levels:
+                solver = self.nested(problem, solver, levels)
+        except BaseException:
             solver.destroy()
-        return self.record(problem, mesh, steps, extra)
+            raise
+        return problem, post, solver
+
+    def nested(self, problem, solver, levels: int) -> NestedSolver:
+        """The fine solver wrapped by the coarse chain: the scene meshed twice as coarse,
+        with one level of nesting less."""
+        scene = self.scene.coarsened(2.0)
+        num = dataclasses.replace(self.num, nested=levels - 1)
+        method = _checked_method(scene, num)
+        coarse = _Run(scene, num, method, self.comm, None, self.petsc_options, False)
+        coarse.prefix = self.prefix + f"coarse{num.nested + 1}_"
+        c_problem, _, c_solver = coarse.build()
+        for phase in ("mesh", "compile", "initial_guess"):
+            self.timings[phase] = self.timings.get(phase, 0.0) + coarse.timings.get(phase, 0.0)
+        return NestedSolver(solver, problem, c_solver, c_problem)
 
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem, forms) -> ContactSNES:
@@ -138,11 +173,14 @@ class _Run:
                 self.scene.on_step(problem, solver, rec.load, quantities)
                 s = rec.stats
                 steps.append(StepLog(rec.step, rec.load, s.newton, s.ksp, s.outer,
-                                     rec.cutbacks, s.reason, quantities))  # fmt: skip
+                                     rec.cutbacks, s.reason, s.coarse_newton,
+                                     quantities))  # fmt: skip
                 if writer is not None:
                     with self.timed("output"):
                         writer.write(rec.load, post.fields())
                 problem.converged()
+                if isinstance(solver, NestedSolver):
+                    solver.converged()
                 self.say(_progress(steps[-1], problem.method.multiplier == "nodal"))
 
             t0 = time.perf_counter()
@@ -154,6 +192,8 @@ class _Run:
             self.timings["contact"] = solver.timer.contact
         output = self.timings.get("output", 0.0)
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
+        if isinstance(solver, NestedSolver):  # within the solve: the coarse chain's share
+            self.timings["nested"] = solver.coarse_time
         return steps
 
     def _output(self, suffix: str) -> str | None:

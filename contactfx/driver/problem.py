@@ -28,6 +28,9 @@ class Problem:
 
     #: the field count of the kind's displacement-like unknown per space dimension
     components_per_dim = 1
+    #: whether nested iteration (``--nested``) can start this kind from a coarser mesh's
+    #: solution (:mod:`contactfx.driver.nested`)
+    nested = False
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
@@ -141,6 +144,11 @@ class Problem:
         """A step converged: it is the history of the next."""
         if self.prev is not None:
             self.prev.x.array[:] = self.state.x.array
+
+    def nested_fields(self) -> list:
+        """The Functions nested iteration carries from a coarser mesh: the state and the
+        nodal multiplier."""
+        return [self.state] + ([self.multiplier] if self.multiplier is not None else [])
 
     def dofs(self) -> int:
         imap = self.state.function_space.dofmap

@@ -8,6 +8,7 @@ a rigid obstacle (the interface scenes are in :mod:`contactfx.scenes.interface_b
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar
@@ -23,7 +24,7 @@ from contactfx.numerics import Numerics
 from contactfx.params import Params, param
 from contactfx.results import RunSummary
 
-__all__ = ["SceneParams", "elastic", "Scene", "ObstacleScene"]
+__all__ = ["SceneParams", "elastic", "resized", "Scene", "ObstacleScene"]
 
 #: base of every scene's parameter dataclass (validated on construction)
 SceneParams = Params
@@ -44,6 +45,19 @@ def elastic(E0: float, nu0: float) -> type:
             Elastic(self.E, self.nu)
 
     return ElasticParams
+
+
+def resized(params, scale: float):
+    """The scene parameters with every mesh size (fields ``h``, ``h_*``) multiplied by
+    ``scale``; ValueError when the parameters have none."""
+    sizes = {
+        f.name: getattr(params, f.name) * scale
+        for f in dataclasses.fields(params)
+        if f.name == "h" or f.name.startswith("h_")
+    }
+    if not sizes:
+        raise ValueError(f"scene {type(params).__name__} has no mesh size to refine")
+    return dataclasses.replace(params, **sizes)
 
 
 class Scene:
@@ -70,6 +84,15 @@ class Scene:
         """Young's modulus of the material at the contact surface: it scales the methods'
         parameters (gamma_N = gamma0 E / h, kappa, r)."""
         return self.material().E
+
+    def coarsened(self, factor: float):
+        """The same scene with every mesh size (parameters ``h`` and ``h_*``) multiplied by
+        ``factor``: the coarser meshes of nested iteration (``--nested``); None when the
+        scene's mesh cannot be regenerated at another size (a mesh file)."""
+        try:
+            return type(self)(resized(self.p, factor))
+        except ValueError:
+            return None
 
     def mesh_builder(self):
         """(builder, gdim): the scene's gmsh geometry (:mod:`contactfx.meshes`) with its

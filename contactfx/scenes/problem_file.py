@@ -750,6 +750,10 @@ class _FileMesh:
     symmetry = 1.0
     Params = FileParams
 
+    def coarsened(self, factor: float):
+        """None: the file's mesh has one size (nested iteration needs a generated mesh)."""
+        return None
+
     def __init__(self, problem: ProblemFile) -> None:
         self.spec = problem
         self.p = FileParams(problem=str(problem.path), size=problem.size)

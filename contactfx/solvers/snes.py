@@ -116,6 +116,7 @@ class SolveStats:
     ksp: int = 0
     reason: str = ""
     outer: int = 1  # augmented Lagrangian (Uzawa) outer iterations
+    coarse_newton: int = 0  # nested iteration: Newton iterations on the coarser meshes
 
 
 @dataclass
@@ -220,6 +221,8 @@ class ContactSNES:
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
+        self._reuse = False
+        self.P = None
 
     # -- options -------------------------------------------------------------------------
     def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
@@ -229,6 +232,36 @@ class ContactSNES:
         for key, value in user.items():
             name = key if key.startswith("contactfx_") else self.prefix + key
             opts[name] = _option_value(value)
+
+    #: Krylov iterations at most with a reused factorisation (then it is refactorised)
+    REUSE_MAX_IT = 20
+
+    def reuse_factorisation(self) -> None:
+        """From the second Newton iteration of a solve on, keep the LU factorisation of an
+        earlier Jacobian as GMRES's preconditioner while GMRES converges with it within
+        REUSE_MAX_IT iterations; refactorise at the first iteration of every solve and after a
+        Krylov solve that needed more. For starts close to the solution (nested iteration),
+        where the later Jacobians differ from the first in a few contact rows only. Only with
+        a direct solver whose Krylov type is preonly (what the defaults give)."""
+        ksp = self.snes.getKSP()
+        if ksp.getPC().getType() != "lu" or ksp.getType() != "preonly":
+            return
+        ksp.setType("gmres")
+        ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=self.REUSE_MAX_IT)
+        # a Krylov solve stopped at REUSE_MAX_IT is still a descent step: take it, refactorise
+        self.snes.setMaxLinearSolveFailures(10**6)
+        # the preconditioner's own matrix, updated only when refactorising (an unchanged
+        # matrix is not factorised again: PCSetUp compares the matrix state)
+        self.P = self.J.duplicate(copy=True)
+        self.snes.setJacobian(self._jacobian, self.J, self.P)
+        self._reuse = True
+
+    def _update_preconditioner(self, snes, J: PETSc.Mat) -> None:
+        ksp = snes.getKSP()
+        fresh = (snes.getIterationNumber() == 0 or ksp.getConvergedReason() < 0
+                 or ksp.getIterationNumber() >= self.REUSE_MAX_IT)  # fmt: skip
+        if fresh:
+            J.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
@@ -306,6 +339,8 @@ class ContactSNES:
             _compat.assemble_matrix(self.Jc, self._a_c)
             J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
+        if self._reuse:
+            self._update_preconditioner(snes, J)
         self.timer.assembly += time.perf_counter() - t0
 
     def solve_linear(self, free: np.ndarray, extra=None) -> None:
@@ -428,7 +463,7 @@ class ContactSNES:
         return missed == 0
 
     def destroy(self) -> None:
-        for obj in (self.snes, self.K, self.J, self.Jc, self.b, self.fc, self.residual_vec):
+        for obj in (self.snes, self.K, self.J, self.P, self.Jc, self.b, self.fc, self.residual_vec):
             if obj is not None:
                 obj.destroy()
         opts = PETSc.Options()

@@ -32,6 +32,7 @@ from contactfx.contact.registry import METHODS, method_class
 from contactfx.numerics import Numerics
 from contactfx.params import option_name
 from contactfx.results import MEASURES, measure
+from contactfx.scenes.base import resized
 
 __all__ = ["CASES", "MEASURES", "run_bench", "expand_methods", "method_label",
            "linear_elastic_time", "observed_rates", "parallel_ceiling"]  # fmt: skip
@@ -101,7 +102,8 @@ def method_label(o: dict) -> str:
         name = option_name(f)
         if name in o and name != key:
             label += f" {name}={_short(o[name])}"
-    return label + (" nodal" if o.get("quadrature") == "nodal" else "")
+    label += " nodal" if o.get("quadrature") == "nodal" else ""
+    return label + (f" nested{o['nested']}" if o.get("nested") else "")
 
 
 def _short(value) -> str:
@@ -113,9 +115,11 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
     expands to the values of its ``sweep`` (nitsche: theta = 1, 0, -1; penalty: three penalty
     factors; compliance: three exponents); ``name@value`` picks one value of that option (for
     the augmented Lagrangian, r0); a ``+nodal`` suffix integrates the contact terms at the
-    nodes (``--quadrature nodal``)."""
+    nodes (``--quadrature nodal``); a ``+nestedN`` suffix starts every solve from N coarser
+    meshes (``--nested N``)."""
     out: list[dict] = []
     for token in filter(None, (t.strip() for t in spec.split(","))):
+        token, has_nested, nested = token.partition("+nested")
         token, nodal = token.removesuffix("+nodal"), token.endswith("+nodal")
         name, _, value = token.partition("@")
         if name not in METHODS:
@@ -125,6 +129,11 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
         except ValueError:
             raise ValueError(f"--method {token}: '{value}' is not a number") from None
         extra = {"quadrature": "nodal"} if nodal else {}
+        if has_nested:
+            if not nested.isdigit() or int(nested) < 1:
+                raise ValueError(f"--method {token}+nested{nested}: give the coarser levels, "
+                                 "e.g. +nested2")  # fmt: skip
+            extra["nested"] = int(nested)
         key, defaults = method_class(name).sweep
         values = defaults if number is None else (number,)
         if key and values:
@@ -137,19 +146,6 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
     return [(method_label(o), o) for o in out]
 
 
-def _refined(params, coarsen: float, level: int):
-    """The scene parameters with every mesh size (fields h, h_*) scaled by coarsen / 2^level."""
-    scale = coarsen * 0.5**level
-    sizes = {
-        f.name: getattr(params, f.name) * scale
-        for f in dataclasses.fields(params)
-        if f.name == "h" or f.name.startswith("h_")
-    }
-    if not sizes:
-        raise ValueError(f"scene {type(params).__name__} has no mesh size to refine")
-    return dataclasses.replace(params, **sizes)
-
-
 def run_case(
     case_name: str, label: str, overrides: dict, degree: int, level: int, comm,
     petsc_options: dict | None = None, solver: str = "lu",
@@ -160,7 +156,7 @@ def run_case(
 
     case = CASES[case_name]
     scene_cls = SCENES[case.scene]
-    params = _refined(scene_cls.Params(**case.params), case.coarsen, level)
+    params = resized(scene_cls.Params(**case.params), case.coarsen * 0.5**level)
     scene = scene_cls(params)
     row: dict = {"case": case_name, "method": label, "degree": degree, "level": level,
                  "h": scene.h_contact(), "ranks": comm.size}  # fmt: skip
@@ -178,6 +174,7 @@ def run_case(
     row.update(
         status="ok", reason="", dofs=res.dofs, newton=res.newton_iterations,
         ksp=res.ksp_iterations, outer=res.outer_iterations,
+        newton_coarse=sum(step.coarse_newton for step in res.steps),
         t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
         t_run=t["assembly"] + t["solve"],
     )  # fmt: skip
@@ -302,6 +299,8 @@ def _format_row(row: dict) -> str:
     if "speedup" in row:
         extra += f"  speed-up {row['speedup']:.2f} ({row['speedup_over_ceiling']:.2f} of ceiling)"
     return (
-        f"{head} dofs {row['dofs']:>7d} newton {row['newton']:>3d} ksp {row['ksp']:>4d} "
+        f"{head} dofs {row['dofs']:>7d} newton {row['newton']:>3d}"
+        + (f" (+{row['newton_coarse']} coarse)" if row.get("newton_coarse") else "")
+        + f" ksp {row['ksp']:>4d} "
         f"time {row['t_run']:7.2f} s  {errors}{extra}"
     )

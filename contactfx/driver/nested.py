@@ -1,0 +1,144 @@
+"""Nested iteration: every load step solved first on coarser meshes of the same scene.
+
+Semi-smooth Newton for contact spends its iterations finding the contact set: from the
+undeformed start the first active set is the geometric overlap, and the iterations shrink it
+a few elements at a time, so their count grows with refinement. Started from the solution on
+a mesh twice as coarse, interpolated, the active set is already right to within a coarse
+element and the fine solve needs two or three iterations; the coarse solve itself starts
+from a coarser one, down the chain (nested iteration, the "full multigrid" start of
+Hackbusch 1985, Multi-Grid Methods and Applications, ch. 5, doi:10.1007/978-3-662-02427-0).
+
+:class:`NestedSolver` wraps the fine solver (whatever the method attached) and at each solve
+(i) restores the coarse chain to its last converged state, (ii) solves the step's load on it,
+(iii) interpolates its fields (the state, and a nodal multiplier) at the fine dofs as the fine
+Newton start. A coarse failure leaves the fine start as the load program predicted it. The
+coarse chain keeps its own friction history, advanced with the fine steps.
+"""
+
+from __future__ import annotations
+
+import time
+
+import dolfinx
+import numpy as np
+from mpi4py import MPI
+
+from contactfx import _compat
+from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
+
+__all__ = ["NestedSolver", "transfer", "nested_levels", "MIN_DOFS"]
+
+#: the coarsest mesh of a chain has about this many unknowns at least (below, a coarse
+#: solve costs more in setup than it saves)
+MIN_DOFS = 2000
+
+
+def nested_levels(requested: int, dofs: int, tdim: int) -> int:
+    """The coarser levels used: at most ``requested``, and no level whose mesh (the unknowns
+    divide by 2^tdim per halving of the element sizes) would fall below MIN_DOFS."""
+    levels = 0
+    while levels < requested and dofs / 2.0 ** (tdim * (levels + 1)) >= MIN_DOFS:
+        levels += 1
+    return levels
+
+
+def _leaves(f: dolfinx.fem.Function, split: bool) -> list[tuple[object, np.ndarray]]:
+    """(collapsed space, indices into ``f.x.array``) per field of ``f`` (one for a plain
+    space, one per sub-space of a mixed one)."""
+    W = f.function_space
+    if not split:
+        return [(W, np.arange(len(f.x.array)))]
+    out = []
+    for i in range(W.num_sub_spaces):
+        V, dofs = W.sub(i).collapse()
+        out.append((V, np.asarray(dofs)))
+    return out
+
+
+def transfer(coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function, split: bool) -> int:
+    """fine = the interpolant of ``coarse`` (another mesh of the same domain) at fine's owned
+    dofs; a dof outside the coarse mesh keeps its value. Returns the number of such dofs on
+    all ranks. Collective."""
+    comm = fine.function_space.mesh.comm
+    gdim = fine.function_space.mesh.geometry.dim
+    kept = 0
+    for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split), strict=True):
+        fc = dolfinx.fem.Function(Vc)
+        fc.x.array[:] = coarse.x.array[dc]
+        bs = Vf.dofmap.index_map_bs
+        n_owned = Vf.dofmap.index_map.size_local
+        points = _compat.dof_coordinates(Vf)[:n_owned, :gdim]
+        counts = comm.allgather(n_owned)
+        everywhere = np.concatenate(comm.allgather(points))
+        values = _compat.point_values(fc, everywhere)
+        start = sum(counts[: comm.rank])
+        mine = values[start : start + n_owned].reshape(n_owned * bs)
+        found = np.isfinite(mine)
+        fine.x.array[df[: n_owned * bs][found]] = mine[found]
+        kept += int(np.count_nonzero(~found)) // bs
+    fine.x.scatter_forward()
+    return comm.allreduce(kept, op=MPI.SUM)
+
+
+def _innermost(solver):
+    """The ContactSNES inside a method's wrapper (Uzawa, bounds)."""
+    while hasattr(solver, "inner"):
+        solver = solver.inner
+    return solver
+
+
+class NestedSolver:
+    """The fine solver started, at every load step, from the coarse chain's solution.
+
+    ``coarse`` is the coarse problem's solver (itself a NestedSolver further down the chain);
+    ``problem`` / ``coarse_problem`` the two problem kinds, whose ``nested_fields()`` name the
+    Functions carried from coarse to fine. Other attributes are the fine solver's."""
+
+    def __init__(self, fine, problem, coarse, coarse_problem) -> None:
+        self.fine, self.problem = fine, problem
+        self.coarse, self.coarse_problem = coarse, coarse_problem
+        _innermost(fine).reuse_factorisation()
+        self._saved = [f.x.array.copy() for f in coarse_problem.nested_fields()]
+        #: Newton iterations of the coarse chain in the last solve
+        self.coarse_newton = 0
+        #: wall time of the coarse chain's solves
+        self.coarse_time = 0.0
+
+    def __getattr__(self, name):
+        return getattr(self.fine, name)
+
+    def solve(self) -> SolveStats:
+        t0 = time.perf_counter()
+        fields = self.coarse_problem.nested_fields()
+        for f, saved in zip(fields, self._saved, strict=True):
+            f.x.array[:] = saved
+        self.coarse_problem.apply_load(float(self.problem.tload.value))
+        self.coarse.assemble_load()
+        self.coarse_newton = 0
+        try:
+            stats = self.coarse.solve()
+        except TimeLimitExceeded:
+            raise
+        except ConvergenceError:
+            for f, saved in zip(fields, self._saved, strict=True):
+                f.x.array[:] = saved
+        else:
+            self.coarse_newton = stats.newton + stats.coarse_newton
+            split = self.problem.split
+            for c, f in zip(fields, self.problem.nested_fields(), strict=True):
+                transfer(c, f, split and c is fields[0])
+        self.coarse_time += time.perf_counter() - t0
+        stats = self.fine.solve()
+        stats.coarse_newton = self.coarse_newton
+        return stats
+
+    def converged(self) -> None:
+        """The fine step converged: the coarse chain's step becomes its history too."""
+        self.coarse_problem.converged()
+        if isinstance(self.coarse, NestedSolver):
+            self.coarse.converged()
+        self._saved = [f.x.array.copy() for f in self.coarse_problem.nested_fields()]
+
+    def destroy(self) -> None:
+        self.coarse.destroy()
+        self.fine.destroy()
