@@ -26,7 +26,7 @@ from mpi4py import MPI
 from contactfx import _compat
 from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
 
-__all__ = ["NestedSolver", "transfer", "nested_levels", "MIN_DOFS"]
+__all__ = ["NestedSolver", "Transfer", "transfer", "nested_levels", "MIN_DOFS"]
 
 #: the coarsest mesh of a chain has about this many unknowns at least (below, a coarse
 #: solve costs more in setup than it saves)
@@ -55,29 +55,46 @@ def _leaves(f: dolfinx.fem.Function, split: bool) -> list[tuple[object, np.ndarr
     return out
 
 
-def transfer(coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function, split: bool) -> int:
+class Transfer:
     """fine = the interpolant of ``coarse`` (another mesh of the same domain) at fine's owned
-    dofs; a dof outside the coarse mesh keeps its value. Returns the number of such dofs on
-    all ranks. Collective."""
-    comm = fine.function_space.mesh.comm
-    gdim = fine.function_space.mesh.geometry.dim
-    kept = 0
-    for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split), strict=True):
-        fc = dolfinx.fem.Function(Vc)
-        fc.x.array[:] = coarse.x.array[dc]
-        bs = Vf.dofmap.index_map_bs
-        n_owned = Vf.dofmap.index_map.size_local
-        points = _compat.dof_coordinates(Vf)[:n_owned, :gdim]
-        counts = comm.allgather(n_owned)
-        everywhere = np.concatenate(comm.allgather(points))
-        values = _compat.point_values(fc, everywhere)
-        start = sum(counts[: comm.rank])
-        mine = values[start : start + n_owned].reshape(n_owned * bs)
-        found = np.isfinite(mine)
-        fine.x.array[df[: n_owned * bs][found]] = mine[found]
-        kept += int(np.count_nonzero(~found)) // bs
-    fine.x.scatter_forward()
-    return comm.allreduce(kept, op=MPI.SUM)
+    dofs, each call; what depends on the meshes only (the fields' sub-spaces, the fine dof
+    coordinates gathered on every rank) is found once. A dof outside the coarse mesh keeps
+    its value. Collective."""
+
+    def __init__(self, coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function,
+                 split: bool) -> None:  # fmt: skip
+        self.coarse, self.fine = coarse, fine
+        comm = fine.function_space.mesh.comm
+        gdim = fine.function_space.mesh.geometry.dim
+        self.parts = []
+        for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split),
+                                      strict=True):  # fmt: skip
+            n_owned = Vf.dofmap.index_map.size_local
+            points = _compat.dof_coordinates(Vf)[:n_owned, :gdim]
+            start = sum(comm.allgather(n_owned)[: comm.rank])
+            everywhere = np.concatenate(comm.allgather(points))
+            bs = Vf.dofmap.index_map_bs
+            owned = slice(start, start + n_owned)
+            self.parts.append((dolfinx.fem.Function(Vc), dc, df[: n_owned * bs], everywhere,
+                               owned, bs))  # fmt: skip
+
+    def __call__(self) -> int:
+        """Interpolate; returns the number of fine nodes outside the coarse mesh (all
+        ranks)."""
+        kept = 0
+        for fc, dc, df, everywhere, owned, bs in self.parts:
+            fc.x.array[:] = self.coarse.x.array[dc]
+            mine = _compat.point_values(fc, everywhere)[owned].reshape(-1)
+            found = np.isfinite(mine)
+            self.fine.x.array[df[found]] = mine[found]
+            kept += int(np.count_nonzero(~found)) // bs
+        self.fine.x.scatter_forward()
+        return self.fine.function_space.mesh.comm.allreduce(kept, op=MPI.SUM)
+
+
+def transfer(coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function, split: bool) -> int:
+    """One :class:`Transfer` from ``coarse`` to ``fine``."""
+    return Transfer(coarse, fine, split)()
 
 
 def _innermost(solver):
@@ -98,7 +115,12 @@ class NestedSolver:
         self.fine, self.problem = fine, problem
         self.coarse, self.coarse_problem = coarse, coarse_problem
         _innermost(fine).reuse_factorisation()
-        self._saved = [f.x.array.copy() for f in coarse_problem.nested_fields()]
+        self.fields = coarse_problem.nested_fields()
+        self._saved = [f.x.array.copy() for f in self.fields]
+        # the state is mixed when the problem is split; a nodal multiplier never is
+        pairs = zip(self.fields, problem.nested_fields(), strict=True)
+        self.transfers = [Transfer(c, f, problem.split and i == 0)
+                          for i, (c, f) in enumerate(pairs)]  # fmt: skip
         #: Newton iterations of the coarse chain in the last solve
         self.coarse_newton = 0
         #: wall time of the coarse chain's solves
@@ -109,9 +131,7 @@ class NestedSolver:
 
     def solve(self) -> SolveStats:
         t0 = time.perf_counter()
-        fields = self.coarse_problem.nested_fields()
-        for f, saved in zip(fields, self._saved, strict=True):
-            f.x.array[:] = saved
+        self._restore()
         self.coarse_problem.apply_load(float(self.problem.tload.value))
         self.coarse.assemble_load()
         self.coarse_newton = 0
@@ -120,13 +140,11 @@ class NestedSolver:
         except TimeLimitExceeded:
             raise
         except ConvergenceError:
-            for f, saved in zip(fields, self._saved, strict=True):
-                f.x.array[:] = saved
+            self._restore()
         else:
             self.coarse_newton = stats.newton + stats.coarse_newton
-            split = self.problem.split
-            for c, f in zip(fields, self.problem.nested_fields(), strict=True):
-                transfer(c, f, split and c is fields[0])
+            for move in self.transfers:
+                move()
         self.coarse_time += time.perf_counter() - t0
         stats = self.fine.solve()
         stats.coarse_newton = self.coarse_newton
@@ -137,7 +155,12 @@ class NestedSolver:
         self.coarse_problem.converged()
         if isinstance(self.coarse, NestedSolver):
             self.coarse.converged()
-        self._saved = [f.x.array.copy() for f in self.coarse_problem.nested_fields()]
+        self._saved = [f.x.array.copy() for f in self.fields]
+
+    def _restore(self) -> None:
+        """The coarse chain back at its last converged state."""
+        for f, saved in zip(self.fields, self._saved, strict=True):
+            f.x.array[:] = saved
 
     def destroy(self) -> None:
         self.coarse.destroy()

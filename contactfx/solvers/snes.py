@@ -221,8 +221,7 @@ class ContactSNES:
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
-        self._reuse = False
-        self.P = None
+        self.P = None  # a separate preconditioner matrix: see reuse_factorisation
 
     # -- options -------------------------------------------------------------------------
     def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
@@ -254,7 +253,6 @@ class ContactSNES:
         # matrix is not factorised again: PCSetUp compares the matrix state)
         self.P = self.J.duplicate(copy=True)
         self.snes.setJacobian(self._jacobian, self.J, self.P)
-        self._reuse = True
 
     def _update_preconditioner(self, snes, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
@@ -339,7 +337,7 @@ class ContactSNES:
             _compat.assemble_matrix(self.Jc, self._a_c)
             J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
-        if self._reuse:
+        if self.P is not None:
             self._update_preconditioner(snes, J)
         self.timer.assembly += time.perf_counter() - t0
 
