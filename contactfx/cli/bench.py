@@ -33,7 +33,8 @@ def _parser() -> Parser:
     p.add_argument(
         "--linear",
         action="store_true",
-        help="also time one linear-elastic solve per mesh (contact / linear ratio)",
+        help="also time one linear-elastic solve per mesh (contact / linear ratio; "
+        "obstacle scenes)",
     )
     p.add_argument(
         "--speedup",

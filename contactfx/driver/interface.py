@@ -30,7 +30,6 @@ from contactfx.contact.laws import positive_part
 from contactfx.driver.fields import (
     NodalProjection,
     at_points,
-    confine,
     surface_mask,
     vertex_rule,
     zero_pattern,
@@ -96,7 +95,7 @@ class InterfaceProblem(Problem):
             parent = np.asarray(q_to_w)[dofs].astype(np.int32)
             bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
         for i in range(d):
-            bcs += confine(V.sub(d + i), self.free_mask)
+            bcs += self.confine(V.sub(d + i), self.free_mask)
         return bcs + self.confine_multiplier(self.tips)
 
     def free_mask(self, Q) -> np.ndarray:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import dolfinx
 import numpy as np
 import ufl
+from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.driver.fields import confine, surface_mask, vertex_rule
@@ -47,6 +48,7 @@ class Problem:
         self.h = _compat.cell_diameter(mesh)
         self.mult_shape = (self.gdim,) if self.friction is not None else ()
         self._spaces()
+        self.confined: list = []  # those of bcs that confine a field to a surface (confine)
         self.bcs = self.boundary_conditions()
         self.prev = None  # the last converged state: the history of friction
         if self.friction is not None:
@@ -92,8 +94,15 @@ class Problem:
         if self.method.multiplier != "field":
             return []
         W = self.state.function_space
-        return confine(W.sub(1), lambda Q: surface_mask(Q, self.fdim, self.contact_facets,
-                                                        excluded))  # fmt: skip
+        return self.confine(W.sub(1), lambda Q: surface_mask(Q, self.fdim, self.contact_facets,
+                                                             excluded))  # fmt: skip
+
+    def confine(self, Wsub, mask_of) -> list:
+        """:func:`contactfx.driver.fields.confine`, the conditions recorded in ``confined``:
+        the solver leaves their dofs out of its linear systems."""
+        bcs = confine(Wsub, mask_of)
+        self.confined += bcs
+        return bcs
 
     def previous(self):
         """The displacement part of the last converged state (friction history)."""
@@ -151,5 +160,10 @@ class Problem:
         return [self.state] + ([self.multiplier] if self.multiplier is not None else [])
 
     def dofs(self) -> int:
+        """The unknowns the solver solves for: the state's dofs but the confined ones."""
         imap = self.state.function_space.dofmap
-        return imap.index_map.size_global * imap.index_map_bs
+        owned = imap.index_map.size_local * imap.index_map_bs
+        dropped = [np.asarray(_compat.bc_dofs(bc)) for bc in self.confined]
+        confined = np.unique(np.concatenate(dropped)) if dropped else np.zeros(0)
+        fixed = self.mesh.comm.allreduce(int(np.sum(confined < owned)), op=MPI.SUM)
+        return imap.index_map.size_global * imap.index_map_bs - fixed

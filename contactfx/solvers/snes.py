@@ -164,7 +164,13 @@ class ContactSNES:
     Parameters are keyword-only: ``stiffness`` (bilinear form, compiled), ``load`` (linear
     form, compiled), ``contact_residual`` / ``contact_jacobian`` (compiled forms, or None),
     ``bcs`` (dolfinx DirichletBCs), ``prefix`` (PETSc options prefix), ``options`` (defaults,
-    overridden by the command line), ``user_options`` (from the command line).
+    overridden by the command line), ``user_options`` (from the command line), ``confined``
+    (those of ``bcs`` that confine a field to a surface: a multiplier or an interface
+    enrichment that the unknown carries on the whole mesh).
+
+    The confined dofs are not unknowns of Newton's linear systems: SNES works on the other dofs
+    only (:class:`_Reduced`), so that a field living on a surface costs its surface dofs, not
+    a copy of the mesh. Not with a two-body coupling or the AMG near-nullspace.
     """
 
     def __init__(
@@ -181,6 +187,7 @@ class ContactSNES:
         user_options: Mapping[str, object] | None = None,
         near_nullspace: bool = False,
         coupling=None,
+        confined=(),
     ) -> None:
         self.u = u
         self.comm = u.function_space.mesh.comm
@@ -207,6 +214,14 @@ class ContactSNES:
         dofs = [_compat.bc_dofs(bc) for bc in self.bcs]
         rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0)
         self._bc_rows = rows[rows < n_owned].astype(np.int32)
+        self.reduced = None
+        if confined and coupling is None and not near_nullspace:
+            dropped = np.unique(np.concatenate([_compat.bc_dofs(bc) for bc in confined]))
+            keep = np.ones(n_owned, dtype=bool)
+            keep[dropped[dropped < n_owned]] = False
+            self.reduced = _Reduced(self.K, np.flatnonzero(keep), self._bc_rows)
+            self.J.destroy()
+            self.J = self.reduced.K.duplicate(copy=True)
 
         self.nullspace = None
         if near_nullspace and u.function_space.mesh.geometry.dim > 1:
@@ -216,7 +231,7 @@ class ContactSNES:
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
         self._set_options({**DEFAULT_OPTIONS, **(options or {})}, user_options or {})
-        self.residual_vec = self.K.createVecLeft()
+        self.residual_vec = self.J.createVecLeft()
         self.snes.setFunction(self._residual, self.residual_vec)
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
@@ -263,13 +278,18 @@ class ContactSNES:
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
+        if self.reduced is not None:
+            lower, upper = self.reduced.restrict(lower), self.reduced.restrict(upper)
         self.snes.setVariableBounds(lower, upper)
 
     # -- callbacks -----------------------------------------------------------------------
     def _sync(self, x: PETSc.Vec) -> None:
-        """Make u (which the compiled forms read) equal to the SNES iterate x."""
+        """Make u (which the compiled forms read) equal to the SNES iterate x (or to x on all
+        dofs)."""
         uvec = _compat.petsc_vec(self.u)
-        if x.handle != uvec.handle:
+        if self.reduced is not None and x.getSize() != uvec.getSize():
+            self.reduced.extend(x, uvec)
+        elif x.handle != uvec.handle:
             x.copy(uvec)
         uvec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
@@ -288,8 +308,14 @@ class ContactSNES:
             F.set(np.nan)
             return
         self._sync(x)
-        self._unconstrained_residual(x, F, search=True)
-        dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
+        if self.reduced is not None:  # on all dofs, then the kept rows
+            uvec, full = _compat.petsc_vec(self.u), self.reduced.F
+            self._unconstrained_residual(uvec, full, search=True)
+            dolfinx.fem.petsc.set_bc(full, self.bcs, uvec, -1.0)
+            self.reduced.restrict(full, F)
+        else:
+            self._unconstrained_residual(x, F, search=True)
+            dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
         self.timer.assembly += time.perf_counter() - t0
 
     def _unconstrained_residual(self, x: PETSc.Vec, F: PETSc.Vec, search: bool) -> None:
@@ -327,16 +353,19 @@ class ContactSNES:
     def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
         t0 = time.perf_counter()
         self._sync(x)
-        if self.coupling is not None:
-            t1 = time.perf_counter()
-            self.coupling.jacobian(x, self.K, J)
-            self.timer.contact += time.perf_counter() - t1
+        if self.reduced is not None:
+            self.reduced.jacobian(J, self.Jc, self._a_c)
         else:
-            self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        if self._a_c is not None:
-            _compat.assemble_matrix(self.Jc, self._a_c)
-            J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
+            if self.coupling is not None:
+                t1 = time.perf_counter()
+                self.coupling.jacobian(x, self.K, J)
+                self.timer.contact += time.perf_counter() - t1
+            else:
+                self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            if self._a_c is not None:
+                _compat.assemble_matrix(self.Jc, self._a_c)
+                J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
         if self.P is not None:
             self._update_preconditioner(snes, J)
         self.timer.assembly += time.perf_counter() - t0
@@ -419,12 +448,15 @@ class ContactSNES:
         limit = self.snes.getTolerances()[3]
         if max_it is not None and max_it < limit:
             self.snes.setTolerances(max_it=max_it)
+        xs = x if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
         try:
-            self.snes.solve(None, x)
+            self.snes.solve(None, xs)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
             raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
         finally:
             self.snes.setTolerances(max_it=limit)
+            if self.reduced is not None:
+                self.reduced.extend(xs, x)
         if self._late:
             raise TimeLimitExceeded()
         self._sync(x)
@@ -464,10 +496,60 @@ class ContactSNES:
         for obj in (self.snes, self.K, self.J, self.P, self.Jc, self.b, self.fc, self.residual_vec):
             if obj is not None:
                 obj.destroy()
+        if self.reduced is not None:
+            self.reduced.destroy()
         opts = PETSc.Options()
         for key in list(opts.getAll()):
             if key.startswith(self.prefix):
                 opts.delValue(key)
+
+
+class _Reduced:
+    """The system on the kept dofs: the rows and columns of the confined dofs dropped.
+
+    A confined dof is fixed to zero and its column is zero in every Jacobian (Dirichlet rows
+    and columns), so the kept rows of F(x) and J(x) at x with the confined entries zero are
+    exactly the system of the kept unknowns. ``keep``: the owned kept dofs (local indices);
+    ``bc_rows``: the owned Dirichlet rows (local indices, confined ones included)."""
+
+    def __init__(self, K: PETSc.Mat, keep: np.ndarray, bc_rows: np.ndarray) -> None:
+        rstart = K.getOwnershipRange()[0]
+        self.rows = PETSc.IS().createGeneral((rstart + keep).astype(PETSc.IntType),
+                                             comm=K.getComm())  # fmt: skip
+        self.K = K.createSubMatrix(self.rows, self.rows)
+        kept_bc = np.flatnonzero(np.isin(keep, bc_rows))  # positions among the kept dofs
+        self.bc_rows = (self.K.getOwnershipRange()[0] + kept_bc).astype(PETSc.IntType)
+        self.x = self.K.createVecRight()
+        self.F = K.createVecLeft()  # a residual on all dofs
+        self.scatter = PETSc.Scatter().create(self.F, self.rows, self.x, None)
+        self.Jc = None
+
+    def restrict(self, full: PETSc.Vec, out: PETSc.Vec | None = None) -> PETSc.Vec:
+        """The kept entries of ``full`` (into ``out``, a new vector if None)."""
+        out = self.x.duplicate() if out is None else out
+        self.scatter.scatter(full, out, addv=PETSc.InsertMode.INSERT,
+                             mode=PETSc.ScatterMode.FORWARD)  # fmt: skip
+        return out
+
+    def extend(self, kept: PETSc.Vec, full: PETSc.Vec) -> None:
+        """Set the kept entries of ``full`` (its confined entries stay zero), ghosts too."""
+        self.scatter.scatter(kept, full, addv=PETSc.InsertMode.INSERT,
+                             mode=PETSc.ScatterMode.REVERSE)  # fmt: skip
+        full.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    def jacobian(self, J: PETSc.Mat, Jc: PETSc.Mat | None, a_c) -> None:
+        """J = the kept block of K + dF_c/du, Dirichlet rows and columns identity."""
+        self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        if a_c is not None:
+            _compat.assemble_matrix(Jc, a_c)
+            self.Jc = Jc.createSubMatrix(self.rows, self.rows, submat=self.Jc)
+            J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        J.zeroRowsColumns(self.bc_rows, diag=1.0)
+
+    def destroy(self) -> None:
+        for obj in (self.rows, self.K, self.x, self.F, self.scatter, self.Jc):
+            if obj is not None:
+                obj.destroy()
 
 
 def _option_value(value: object) -> str:

@@ -199,3 +199,53 @@ def test_load_program_cutback():
     assert (err.value.step, err.value.load, err.value.reason) == (1, 0.25, "DIVERGED_MAX_IT")
     # owned entries restored exactly (run_load_program does not update the ghosts then)
     assert _compat.petsc_vec(u).norm(3) == 0.0
+
+
+def test_confined_field_leaves_the_system():
+    """The spring force as a second field lam of a mixed space [P1] x P1, confined to the end
+    node x = L (``confined``: zero at every other node): u-equation E u'v' - t F v + lam v at
+    x = L, lam-equation (lam - K u^3) mu at x = L. Its root is the cubic-spring bar's with
+    lam = K u_L^3, and Newton's iterates are the bar's (lam is eliminated exactly by each
+    linear solve), so the root, the count and the system size are all predicted: SNES works on
+    the N + 1 displacement dofs and the one kept multiplier dof, not on 2 (N + 1)."""
+    from contactfx.driver.fields import confine, surface_mask
+
+    mesh = _compat.create_interval(COMM, N, L)
+    W = _compat.mixed_space(mesh, 1, 1, ())
+    w, dw, tw = dolfinx.fem.Function(W), ufl.TrialFunction(W), ufl.TestFunction(W)
+    (u, lam), (du, _), (v, mu) = ufl.split(w), ufl.split(dw), ufl.split(tw)
+    right = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], L))
+    tags = dolfinx.mesh.meshtags(mesh, 0, right, np.full(len(right), 2, dtype=np.int32))
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+    left = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], 0.0))
+    dofs = _compat.locate_dofs_topological(W.sub(0).sub(0), 0, left)
+    bc = _compat.dirichletbc(PETSc.ScalarType(0.0), dofs, W.sub(0).sub(0))
+    confined = confine(W.sub(1), lambda Q: surface_mask(Q, 0, right))
+    Fc = lam * v[0] * ds(2) + (lam - K * u[0] ** 3) * mu * ds(2)
+    solver = ContactSNES(
+        w,
+        stiffness=dolfinx.fem.form(E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx),
+        load=dolfinx.fem.form(F * v[0] * ufl.dx),
+        contact_residual=dolfinx.fem.form(Fc),
+        contact_jacobian=dolfinx.fem.form(ufl.derivative(Fc, w, dw)),
+        bcs=[bc, *confined],
+        prefix="cfx_unit_confined_",
+        confined=confined,
+    )
+    solver.assemble_load()
+    stats = solver.solve()
+    size = solver.J.getSize()[0]
+    solver.destroy()
+    assert size == N + 2  # the displacement and the one multiplier dof at x = L
+    u_h = w.sub(0).sub(0).collapse()
+    lam_h = w.sub(1).collapse()
+    assert nodal_error(u_h, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+    # lam = K u_L^3 at the root (a residual row, met to the same tolerance times the spring's
+    # stiffness 3 K u_L^2 <= 3 K), zero at the other nodes exactly (confined)
+    n = lam_h.function_space.dofmap.index_map.size_local
+    x = _compat.dof_coordinates(lam_h.function_space)[:n, 0]
+    end = np.isclose(x, L)
+    err = np.abs(lam_h.x.array[:n][end] - K * root(1.0) ** 3).max(initial=0.0)
+    assert COMM.allreduce(err, op=MPI.MAX) < 3 * K * tolerance(f0_from_zero(1.0)) + 1e-13
+    assert COMM.allreduce(np.abs(lam_h.x.array[:n][~end]).max(initial=0.0), op=MPI.MAX) == 0.0
+    assert stats.newton == newton_count(0.0, 1.0, f0_from_zero(1.0))
