@@ -11,7 +11,7 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["vertex_rule", "surface_mask", "at_points", "confine", "assemble_array",
+__all__ = ["vertex_rule", "surface_mask", "at_points", "at_nodes", "confine", "assemble_array",
            "NodalProjection", "nodal_contact", "global_sum", "zero_pattern"]  # fmt: skip
 
 
@@ -58,6 +58,18 @@ def at_points(Q, points) -> np.ndarray:
         return hit
 
     return dolfinx.fem.locate_dofs_geometrical(Q, at)
+
+
+def at_nodes(Q, points: np.ndarray) -> np.ndarray:
+    """Bool per local dof (block) of the collapsed space Q: at one of ``points`` (dof
+    coordinates of another space on the same mesh; the same vertex gives the same coordinates
+    to round-off)."""
+    x = _compat.dof_coordinates(Q)
+    if len(points) == 0:
+        return np.zeros(len(x), dtype=bool)
+    scale = 1e-9 * max(float(np.abs(x).max(initial=0.0)), float(np.abs(points).max()), 1e-300)
+    keys = {tuple(k) for k in np.round(points / scale).astype(np.int64)}
+    return np.array([tuple(k) in keys for k in np.round(x / scale).astype(np.int64)], dtype=bool)
 
 
 def confine(Wsub, mask_of) -> list:

@@ -63,7 +63,8 @@ class ObstacleProblem(Problem):
         return material if modulus is None else dataclasses.replace(material, modulus=modulus)
 
     def boundary_conditions(self) -> list:
-        return self.scene.dirichlet(self.V, self.facet_tags) + self.confine_multiplier()
+        supports = self.scene.dirichlet(self.V, self.facet_tags)
+        return supports + self.confine_multiplier(supports=supports)
 
     def make_surface(self) -> ContactSurface:
         mesh, scene = self.mesh, self.scene

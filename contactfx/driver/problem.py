@@ -17,7 +17,7 @@ import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.driver.fields import confine, surface_mask, vertex_rule
+from contactfx.driver.fields import at_nodes, confine, surface_mask, vertex_rule
 
 __all__ = ["Problem"]
 
@@ -89,13 +89,30 @@ class Problem:
         self.lam, self.lam_test = (extra, extra_test) if field else (None, None)
         self.p, self.dp, self.q = (extra, d_extra, extra_test) if self.up else (None,) * 3
 
-    def confine_multiplier(self, excluded=()) -> list:
-        """The ``"field"`` multiplier is zero away from the contact surface."""
+    def confine_multiplier(self, excluded=(), supports=()) -> list:
+        """The ``"field"`` multiplier is zero away from the contact surface, and a traction
+        multiplier's component i is zero where the displacement's component i is held by one
+        of the ``supports`` (a symmetry plane through the contact zone): there that component
+        of the contact law has no displacement left to act on, and its row and column of the
+        Jacobian would be zero (a singular system). On a symmetry plane the traction component
+        normal to the plane vanishes anyway."""
         if self.method.multiplier != "field":
             return []
-        W = self.state.function_space
-        return self.confine(W.sub(1), lambda Q: surface_mask(Q, self.fdim, self.contact_facets,
-                                                             excluded))  # fmt: skip
+        W1 = self.state.function_space.sub(1)
+
+        def on_surface(Q):
+            return surface_mask(Q, self.fdim, self.contact_facets, excluded)
+
+        held = [np.asarray(_compat.bc_dofs(bc)) for bc in supports]
+        if not self.mult_shape or not held:
+            return self.confine(W1, on_surface)
+        held = np.concatenate(held)
+        bcs = []
+        for i in range(self.gdim):
+            Vi, to_w = self.V.sub(i).collapse()
+            points = _compat.dof_coordinates(Vi)[np.isin(np.asarray(to_w), held)]
+            bcs += self.confine(W1.sub(i), lambda Q, p=points: on_surface(Q) & ~at_nodes(Q, p))
+        return bcs
 
     def confine(self, Wsub, mask_of) -> list:
         """:func:`contactfx.driver.fields.confine`, the conditions recorded in ``confined``:
