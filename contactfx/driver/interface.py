@@ -22,7 +22,6 @@ import functools
 import dolfinx
 import numpy as np
 import ufl
-from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.contact.interface import InterfaceSurface, oriented_jump, tangent
@@ -231,8 +230,6 @@ class InterfaceProblem(Problem):
         return InterfacePost(self)
 
     def dofs(self) -> int:
-        """Free unknowns: the enrichment's fixed dofs away from the interface do not count."""
-        total = super().dofs()
-        owned = owned_size(self.state.function_space)
-        fixed = sum(int(np.sum(np.asarray(_compat.bc_dofs(bc)) < owned)) for bc in self.bcs)
-        return total - self.mesh.comm.allreduce(fixed, op=MPI.SUM)
+        """Free unknowns: the enrichment's fixed dofs away from the interface and the
+        supported dofs do not count."""
+        return self.dofs_less(self.bcs)

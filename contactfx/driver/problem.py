@@ -18,6 +18,7 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.driver.fields import at_nodes, confine, surface_mask, vertex_rule
+from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
 __all__ = ["Problem"]
 
@@ -178,9 +179,13 @@ class Problem:
 
     def dofs(self) -> int:
         """The unknowns the solver solves for: the state's dofs but the confined ones."""
-        imap = self.state.function_space.dofmap
-        owned = imap.index_map.size_local * imap.index_map_bs
-        dropped = [np.asarray(_compat.bc_dofs(bc)) for bc in self.confined]
-        confined = np.unique(np.concatenate(dropped)) if dropped else np.zeros(0)
-        fixed = self.mesh.comm.allreduce(int(np.sum(confined < owned)), op=MPI.SUM)
-        return imap.index_map.size_global * imap.index_map_bs - fixed
+        return self.dofs_less(self.confined)
+
+    def dofs_less(self, bcs) -> int:
+        """The state's dofs less those the DirichletBCs ``bcs`` fix (each once)."""
+        W = self.state.function_space
+        fixed = len(owned_bc_dofs(bcs, owned_size(W)))
+        imap = W.dofmap
+        return imap.index_map.size_global * imap.index_map_bs - self.mesh.comm.allreduce(
+            fixed, op=MPI.SUM
+        )

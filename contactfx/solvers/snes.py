@@ -30,7 +30,7 @@ from petsc4py import PETSc
 from contactfx import _compat
 
 __all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "ContactSNES",
-           "time_limit", "owned_size", "rigid_body_modes", "DEFAULT_OPTIONS",
+           "time_limit", "owned_size", "owned_bc_dofs", "rigid_body_modes", "DEFAULT_OPTIONS",
            "GAMG_OPTIONS"]  # fmt: skip
 
 
@@ -133,6 +133,13 @@ def owned_size(space) -> int:
     return space.dofmap.index_map.size_local * space.dofmap.index_map_bs
 
 
+def owned_bc_dofs(bcs, n_owned: int) -> np.ndarray:
+    """The owned dofs (local indices, each once) that the DirichletBCs ``bcs`` fix."""
+    dofs = [np.asarray(_compat.bc_dofs(bc)) for bc in bcs]
+    rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, dtype=np.int32)
+    return rows[rows < n_owned].astype(np.int32)
+
+
 def rigid_body_modes(V) -> PETSc.NullSpace:
     """Orthonormalised rigid-body modes of a 2D / 3D vector space (near-nullspace for AMG)."""
     mesh = V.mesh
@@ -211,14 +218,11 @@ class ContactSNES:
         self.timer.assembly += time.perf_counter() - t0
 
         n_owned = owned_size(u.function_space)
-        dofs = [_compat.bc_dofs(bc) for bc in self.bcs]
-        rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0)
-        self._bc_rows = rows[rows < n_owned].astype(np.int32)
+        self._bc_rows = owned_bc_dofs(self.bcs, n_owned)
         self.reduced = None
         if confined and coupling is None and not near_nullspace:
-            dropped = np.unique(np.concatenate([_compat.bc_dofs(bc) for bc in confined]))
             keep = np.ones(n_owned, dtype=bool)
-            keep[dropped[dropped < n_owned]] = False
+            keep[owned_bc_dofs(confined, n_owned)] = False
             self.reduced = _Reduced(self.K, np.flatnonzero(keep), self._bc_rows)
             self.J.destroy()
             self.J = self.reduced.K.duplicate(copy=True)
@@ -308,14 +312,12 @@ class ContactSNES:
             F.set(np.nan)
             return
         self._sync(x)
-        if self.reduced is not None:  # on all dofs, then the kept rows
-            uvec, full = _compat.petsc_vec(self.u), self.reduced.F
-            self._unconstrained_residual(uvec, full, search=True)
-            dolfinx.fem.petsc.set_bc(full, self.bcs, uvec, -1.0)
+        uvec = _compat.petsc_vec(self.u)  # = x on all dofs
+        full = F if self.reduced is None else self.reduced.F
+        self._unconstrained_residual(uvec, full, search=True)
+        dolfinx.fem.petsc.set_bc(full, self.bcs, uvec, -1.0)
+        if self.reduced is not None:  # its kept rows
             self.reduced.restrict(full, F)
-        else:
-            self._unconstrained_residual(x, F, search=True)
-            dolfinx.fem.petsc.set_bc(F, self.bcs, x, -1.0)
         self.timer.assembly += time.perf_counter() - t0
 
     def _unconstrained_residual(self, x: PETSc.Vec, F: PETSc.Vec, search: bool) -> None:
@@ -353,19 +355,22 @@ class ContactSNES:
     def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
         t0 = time.perf_counter()
         self._sync(x)
-        if self.reduced is not None:
-            self.reduced.jacobian(J, self.Jc, self._a_c)
+        red = self.reduced
+        if self.coupling is not None:
+            t1 = time.perf_counter()
+            self.coupling.jacobian(x, self.K, J)
+            self.timer.contact += time.perf_counter() - t1
         else:
-            if self.coupling is not None:
-                t1 = time.perf_counter()
-                self.coupling.jacobian(x, self.K, J)
-                self.timer.contact += time.perf_counter() - t1
-            else:
-                self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            if self._a_c is not None:
-                _compat.assemble_matrix(self.Jc, self._a_c)
-                J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            K = self.K if red is None else red.K
+            K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        if self._a_c is not None:
+            _compat.assemble_matrix(self.Jc, self._a_c)
+            Jc = self.Jc if red is None else red.kept_block(self.Jc)
+            J.axpy(1.0, Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        if red is None:
             J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
+        else:
+            J.zeroRowsColumns(red.bc_rows, diag=1.0)
         if self.P is not None:
             self._update_preconditioner(snes, J)
         self.timer.assembly += time.perf_counter() - t0
@@ -456,7 +461,7 @@ class ContactSNES:
         finally:
             self.snes.setTolerances(max_it=limit)
             if self.reduced is not None:
-                self.reduced.extend(xs, x)
+                self._sync(xs)  # into x = u
         if self._late:
             raise TimeLimitExceeded()
         self._sync(x)
@@ -532,19 +537,15 @@ class _Reduced:
         return out
 
     def extend(self, kept: PETSc.Vec, full: PETSc.Vec) -> None:
-        """Set the kept entries of ``full`` (its confined entries stay zero), ghosts too."""
+        """Set the owned kept entries of ``full`` (its confined entries stay zero)."""
         self.scatter.scatter(kept, full, addv=PETSc.InsertMode.INSERT,
                              mode=PETSc.ScatterMode.REVERSE)  # fmt: skip
-        full.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
-    def jacobian(self, J: PETSc.Mat, Jc: PETSc.Mat | None, a_c) -> None:
-        """J = the kept block of K + dF_c/du, Dirichlet rows and columns identity."""
-        self.K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        if a_c is not None:
-            _compat.assemble_matrix(Jc, a_c)
-            self.Jc = Jc.createSubMatrix(self.rows, self.rows, submat=self.Jc)
-            J.axpy(1.0, self.Jc, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        J.zeroRowsColumns(self.bc_rows, diag=1.0)
+    def kept_block(self, A: PETSc.Mat) -> PETSc.Mat:
+        """The kept rows and columns of A (a matrix of A's pattern, reused from call to
+        call)."""
+        self.Jc = A.createSubMatrix(self.rows, self.rows, submat=self.Jc)
+        return self.Jc
 
     def destroy(self) -> None:
         for obj in (self.rows, self.K, self.x, self.F, self.scatter, self.Jc):
