@@ -76,7 +76,11 @@ class _AugmentedBase(MethodBase):
         if s.friction is None:
             return p, None, None
         trial = lam_t - self.r(s) * s.slip_increment(n)
-        return p, trial, ball_projection(trial, s.friction.bound(p), s.E)
+        return p, trial, ball_projection(trial, s.friction.bound(p), s.E, stick=s.stick)
+
+    def trial_traction(self, s: Surface):
+        """The trial tangential traction lambda_T - r du_T (None without friction)."""
+        return self._augmented(s, s.multiplier)[1]
 
     def _slip(self, s: Surface, lam):
         p, trial, _ = self._augmented(s, lam)

@@ -20,6 +20,7 @@ __all__ = [
     "positive_part",
     "active",
     "ball_projection",
+    "reversal",
     "norm",
     "fischer_burmeister",
     "Friction",
@@ -49,11 +50,30 @@ def norm(x, scale: float):
     return ufl.sqrt(ufl.dot(x, x) + (1e-12 * scale) ** 2)
 
 
-def ball_projection(x, s, scale: float):
+def ball_projection(x, s, scale: float, stick=None):
     """Projection of the vector x onto the ball of radius s >= 0: x where |x| <= s, else
-    s x / |x|. ``scale`` is a typical magnitude of x (regularises |x| at 0)."""
+    s x / |x|. ``scale`` is a typical magnitude of x (regularises |x| at 0). ``stick``
+    (optional): where it is > 0 and s > 0, x itself whatever |x| (the stick branch; see
+    :func:`reversal`)."""
     nx = norm(x, scale)
-    return ufl.conditional(ufl.le(nx, s), x, s / nx * x)
+    inside = ufl.le(nx, s)
+    if stick is not None:
+        inside = ufl.Or(inside, ufl.And(ufl.gt(stick, 0.0), ufl.gt(s, 0.0)))
+    return ufl.conditional(inside, x, s / nx * x)
+
+
+def reversal(x, x_last):
+    """1 where the trial tangential traction x points against x_last, its value at Newton's
+    previous iterate, else 0.
+
+    Newton's guard against stick/slip cycling: with a stiff stick (r = gamma0 E / h large) a
+    point sticks only while |du_T| < s / r, a window far narrower than a Newton update, so an
+    iterate that crosses it leaves a point slipping the other way, and the next crosses back
+    (the traction jumps between +s and -s with a zero tangential derivative in between). A
+    point whose slip direction reversed between two iterates went through stick: the next
+    Newton step takes it as sticking (t_T = x, linear in u). At a converged iterate nothing
+    reverses, so the solution is the law's own."""
+    return ufl.conditional(ufl.lt(ufl.dot(x, x_last), 0.0), 1.0, 0.0)
 
 
 def fischer_burmeister(a, b, scale: float):

@@ -68,7 +68,13 @@ class Nitsche(MethodBase):
         return s.sigma_t(s.stress, n) - self.gamma(s) * s.slip_increment(n)
 
     def tangential_traction(self, s: Surface):
-        return ball_projection(self._trial_t(s), s.friction.bound(self.pressure(s)), s.E)
+        return ball_projection(
+            self._trial_t(s), s.friction.bound(self.pressure(s)), s.E, stick=s.stick
+        )
+
+    def trial_traction(self, s: Surface):
+        """The trial tangential traction sigma_T(u) - gamma_N du_T."""
+        return self._trial_t(s)
 
     def slip_indicator(self, s: Surface):
         """1 where the friction bound is reached (slip), else 0."""

@@ -153,7 +153,7 @@ class _Run:
             problem.state, stiffness=a, load=L, contact_residual=F_c, contact_jacobian=J_c,
             bcs=problem.bcs, prefix=self.prefix, options=options,
             user_options=self.petsc_options, near_nullspace=self.num.solver == "gamg",
-            coupling=problem.coupling(), confined=problem.confined,
+            coupling=problem.coupling(), confined=problem.confined, iterate=problem.iterate,
         )  # fmt: skip
 
     # -- load program ----------------------------------------------------------------------

@@ -11,12 +11,15 @@ post-processing.
 
 from __future__ import annotations
 
+import dataclasses
+
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
+from contactfx.contact.laws import reversal
 from contactfx.driver.fields import at_nodes, confine, surface_mask, vertex_rule
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
@@ -60,6 +63,8 @@ class Problem:
             self.multiplier = dolfinx.fem.Function(space, name="multiplier")
             self.lam = self.multiplier
         self.surface = self.make_surface()
+        #: Newton's previous iterate (the friction law's reversal guard), or None
+        self.iterate = None
 
     def material_of(self, mesh):
         return self.scene.material()
@@ -148,12 +153,25 @@ class Problem:
             )
         L = self.extra_load(L)
         # two bodies: no UFL surface, the contact terms are the solver's coupling
-        F = None if self.surface is None else self.method.residual(self.surface)
+        F = None if self.surface is None else self.method.residual(self.newton_surface())
         compiled = [dolfinx.fem.form(a), dolfinx.fem.form(L)]
         if F is None:
             return (*compiled, None, None)
         J = ufl.derivative(F, self.state, self.trial)
         return (*compiled, dolfinx.fem.form(F), dolfinx.fem.form(J))
+
+    def newton_surface(self):
+        """The surface of Newton's residual: with friction, a point whose trial tangential
+        traction reversed since Newton's previous iterate (``iterate``, kept by the solver)
+        takes the stick branch (:func:`contactfx.contact.laws.reversal`); at a converged
+        iterate this is the surface itself."""
+        s = self.surface
+        trial = getattr(self.method, "trial_traction", None)
+        if s.friction is None or trial is None:
+            return s
+        self.iterate = dolfinx.fem.Function(self.state.function_space, name="iterate")
+        x = trial(s)
+        return dataclasses.replace(s, stick=reversal(x, ufl.replace(x, {self.state: self.iterate})))
 
     def extra_load(self, L):
         return L

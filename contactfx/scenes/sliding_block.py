@@ -47,12 +47,9 @@ class SlidingBlock(ObstacleScene):
     name = "sliding-block"
     summary = "block pressed on a rigid plane, then dragged: stick, then gross slip at Q = mu P"
     Params = SlidingBlockParams
-    #: a stiff stick (gamma0, r0 or penalty >= 10) makes Newton cycle between stick and slip at
-    #: the block's edges; skew Nitsche is stable for any gamma0, AL exact for any r0
-    numerics_defaults = {
-        "friction": "coulomb", "mu": 0.3, "steps": 10,
-        "theta": -1, "gamma0": 1.0, "r0": 1.0, "penalty": 1.0,
-    }  # fmt: skip
+    #: the methods' own parameters (a stiff stick: gamma0 = r0 = 10); Newton's reversal guard
+    #: (contactfx.contact.laws.reversal) keeps it from cycling between stick and slip
+    numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 10}
     contact_tag = RectangleFacets.TOP
 
     def mesh_builder(self):

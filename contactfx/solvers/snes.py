@@ -173,7 +173,9 @@ class ContactSNES:
     ``bcs`` (dolfinx DirichletBCs), ``prefix`` (PETSc options prefix), ``options`` (defaults,
     overridden by the command line), ``user_options`` (from the command line), ``confined``
     (those of ``bcs`` that confine a field to a surface: a multiplier or an interface
-    enrichment that the unknown carries on the whole mesh).
+    enrichment that the unknown carries on the whole mesh), ``iterate`` (a Function of u's
+    space that the contact forms read as Newton's previous iterate: the friction law's
+    reversal guard, :func:`contactfx.contact.laws.reversal`).
 
     The confined dofs are not unknowns of Newton's linear systems: SNES works on the other dofs
     only (:class:`_Reduced`), so that a field living on a surface costs its surface dofs, not
@@ -195,8 +197,10 @@ class ContactSNES:
         near_nullspace: bool = False,
         coupling=None,
         confined=(),
+        iterate=None,
     ) -> None:
         self.u = u
+        self.iterate = iterate
         self.comm = u.function_space.mesh.comm
         self.bcs = list(bcs)
         self._a_c = contact_jacobian
@@ -373,7 +377,14 @@ class ContactSNES:
             J.zeroRowsColumns(red.bc_rows, diag=1.0)
         if self.P is not None:
             self._update_preconditioner(snes, J)
+        self._remember()
         self.timer.assembly += time.perf_counter() - t0
+
+    def _remember(self) -> None:
+        """The iterate the contact forms compare with becomes the current u (at every Jacobian,
+        so the next residual and Jacobian see the step just taken)."""
+        if self.iterate is not None:
+            self.iterate.x.array[:] = self.u.x.array
 
     def solve_linear(self, free: np.ndarray, extra=None) -> None:
         """u = the solution of (K + extra) u = b with the owned dofs not marked ``free`` (and
@@ -417,6 +428,7 @@ class ContactSNES:
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
         self._late = False
+        self._remember()
         stats = SolveStats(newton=0, ksp=0, reason="")
         if self.coupling is None or self.coupling.search_each_newton:
             if self.coupling is not None:
@@ -471,7 +483,24 @@ class ContactSNES:
                            reason=snes_reason_name(reason))  # fmt: skip
         if reason <= 0:
             raise ConvergenceError(stats.reason, stats=stats)
+        if self.iterate is not None and not self._law_converged(xs):
+            return self._newton(x, stats, max_it)  # from the law's own residual
         return stats
+
+    def _law_converged(self, xs: PETSc.Vec) -> bool:
+        """After a converged solve with the reversal guard: the guard compared the last iterate
+        with the one before; with the iterate remembered the residual is the law's own. True
+        unless it is well above the norm SNES converged on (a point reversed in the last,
+        vanishing step: only by round-off)."""
+        converged = self.snes.getFunctionNorm()
+        self._remember()
+        F = self.residual_vec.duplicate()
+        try:
+            self._residual(self.snes, xs, F)
+            atol = self.snes.getTolerances()[1]
+            return F.norm() <= max(10.0 * converged, atol)
+        finally:
+            F.destroy()
 
     #: searches per load step at most (``--search-update step``)
     SEARCH_ROUNDS = 5
