@@ -79,8 +79,10 @@ class _AugmentedBase(MethodBase):
         return p, trial, ball_projection(trial, s.friction.bound(p), s.E, stick=s.stick)
 
     def trial_traction(self, s: Surface):
-        """The trial tangential traction lambda_T - r du_T (None without friction)."""
-        return self._augmented(s, s.multiplier)[1]
+        """The trial tangential traction lambda_T - r du_T and the friction bound (with
+        friction)."""
+        p, trial, _ = self._augmented(s, s.multiplier)
+        return trial, s.friction.bound(p)
 
     def _slip(self, s: Surface, lam):
         p, trial, _ = self._augmented(s, lam)

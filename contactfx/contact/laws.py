@@ -62,9 +62,10 @@ def ball_projection(x, s, scale: float, stick=None):
     return ufl.conditional(inside, x, s / nx * x)
 
 
-def reversal(x, x_last):
-    """1 where the trial tangential traction x points against x_last, its value at Newton's
-    previous iterate, else 0.
+def reversal(x, x_last, s):
+    """1 where the point slipped at Newton's previous iterate (its trial tangential traction
+    there, x_last, outside the ball of radius s) and the trial x now points against x_last,
+    else 0.
 
     Newton's guard against stick/slip cycling: with a stiff stick (r = gamma0 E / h large) a
     point sticks only while |du_T| < s / r, a window far narrower than a Newton update, so an
@@ -73,7 +74,8 @@ def reversal(x, x_last):
     point whose slip direction reversed between two iterates went through stick: the next
     Newton step takes it as sticking (t_T = x, linear in u). At a converged iterate nothing
     reverses, so the solution is the law's own."""
-    return ufl.conditional(ufl.lt(ufl.dot(x, x_last), 0.0), 1.0, 0.0)
+    slipped = ufl.gt(ufl.dot(x_last, x_last), s**2)  # not a trial at round-off level
+    return ufl.conditional(ufl.And(slipped, ufl.lt(ufl.dot(x, x_last), 0.0)), 1.0, 0.0)
 
 
 def fischer_burmeister(a, b, scale: float):

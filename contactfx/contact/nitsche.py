@@ -73,8 +73,8 @@ class Nitsche(MethodBase):
         )
 
     def trial_traction(self, s: Surface):
-        """The trial tangential traction sigma_T(u) - gamma_N du_T."""
-        return self._trial_t(s)
+        """The trial tangential traction sigma_T(u) - gamma_N du_T and the friction bound."""
+        return self._trial_t(s), s.friction.bound(self.pressure(s))
 
     def slip_indicator(self, s: Surface):
         """1 where the friction bound is reached (slip), else 0."""

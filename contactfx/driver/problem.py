@@ -170,8 +170,9 @@ class Problem:
         if s.friction is None or trial is None:
             return s
         self.iterate = dolfinx.fem.Function(self.state.function_space, name="iterate")
-        x = trial(s)
-        return dataclasses.replace(s, stick=reversal(x, ufl.replace(x, {self.state: self.iterate})))
+        x, bound = trial(s)
+        x_last = ufl.replace(x, {self.state: self.iterate})
+        return dataclasses.replace(s, stick=reversal(x, x_last, bound))
 
     def extra_load(self, L):
         return L

@@ -244,6 +244,9 @@ class ContactSNES:
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
+        self._initial_norm = 0.0
+        if iterate is not None:
+            self.snes.setMonitor(self._record_initial_norm)
         self.P = None  # a separate preconditioner matrix: see reuse_factorisation
 
     # -- options -------------------------------------------------------------------------
@@ -490,17 +493,22 @@ class ContactSNES:
     def _law_converged(self, xs: PETSc.Vec) -> bool:
         """After a converged solve with the reversal guard: the guard compared the last iterate
         with the one before; with the iterate remembered the residual is the law's own. True
-        unless it is well above the norm SNES converged on (a point reversed in the last,
-        vanishing step: only by round-off)."""
-        converged = self.snes.getFunctionNorm()
+        if it meets the solve's own tolerances (it fails only if a point reversed in the
+        last, vanishing step)."""
         self._remember()
         F = self.residual_vec.duplicate()
         try:
             self._residual(self.snes, xs, F)
-            atol = self.snes.getTolerances()[1]
-            return F.norm() <= max(10.0 * converged, atol)
+            rtol, atol = self.snes.getTolerances()[:2]
+            return F.norm() <= max(atol, rtol * self._initial_norm)
         finally:
             F.destroy()
+
+    def _record_initial_norm(self, snes, its: int, norm: float) -> None:
+        """SNES monitor: the residual norm at a solve's start (its relative tolerance's
+        reference)."""
+        if its == 0:
+            self._initial_norm = norm
 
     #: searches per load step at most (``--search-update step``)
     SEARCH_ROUNDS = 5
