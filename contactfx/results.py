@@ -161,6 +161,9 @@ class RunSummary:
     paraview: str | None = None
     paraview_surface: str | None = None
     plot: str | None = None
+    #: peak resident memory of the run's processes (MiB, summed over the ranks; the peak so
+    #: far of each process, so within one process the largest run sets it)
+    memory_mib: float = 0.0
 
     # -- named views of the final state ---------------------------------------------------
     @property

@@ -70,6 +70,7 @@ def table(res: RunSummary) -> str:
         ("time mesh / compile / assembly / solve [s]",
          " / ".join(f"{t.get(k, 0.0):.2f}" for k in ("mesh", "compile", "assembly", "solve"))),
     ]  # fmt: skip
+    rows.append(("peak memory, all ranks [MiB]", f"{res.memory_mib:.0f}"))
     if "contact" in t:  # two bodies: the coupling's part of the assembly time
         rows.append(("time of search + contact terms [s]", f"{t['contact']:.2f}"))
     rows += _interface_rows(res) if res.interface is not None else _obstacle_rows(res, ref)

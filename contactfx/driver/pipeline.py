@@ -11,6 +11,7 @@ post-processing; it has no copy of the pipeline.
 from __future__ import annotations
 
 import dataclasses
+import resource
 import time
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
@@ -217,11 +218,17 @@ class _Run:
             quantities=steps[-1].quantities,
             paraview=self._output(".pvd"),
             paraview_surface=self._output("_surface.pvd"),
+            memory_mib=peak_memory_mib(self.comm),
             **extra,
         )
         if self.out is not None:
             write_json(self.out / "run.json", summary.to_json(), self.comm)
         return summary
+
+
+def peak_memory_mib(comm) -> float:
+    """Peak resident memory (MiB) of this run's processes, summed over the ranks."""
+    return comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
 
 
 def _progress(step: StepLog, outer: bool) -> str:

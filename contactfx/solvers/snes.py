@@ -86,8 +86,13 @@ DEFAULT_OPTIONS: dict[str, object] = {
     "pc_factor_mat_solver_type": "mumps",
 }
 
-#: Iterative alternative: GMRES + smoothed aggregation AMG with the rigid-body near-nullspace.
+#: Iterative alternative: GMRES + smoothed aggregation AMG with the rigid-body near-nullspace,
+#: in an inexact Newton method: each Krylov solve is stopped at the relative tolerance that
+#: the Eisenstat-Walker forcing chooses from Newton's progress (Eisenstat & Walker 1996,
+#: doi:10.1137/0917003), tight near the solution, loose far from it. The AMG hierarchy is
+#: kept across Newton iterations (:meth:`ContactSNES.reuse_preconditioner`).
 GAMG_OPTIONS: dict[str, object] = {
+    "snes_ksp_ew": True,
     "ksp_type": "gmres",
     "ksp_rtol": 1e-10,
     "ksp_max_it": 500,
@@ -248,6 +253,7 @@ class ContactSNES:
         if iterate is not None:
             self.snes.setMonitor(self._record_initial_norm)
         self.P = None  # a separate preconditioner matrix: see reuse_factorisation
+        self.reuse_preconditioner()
 
     # -- options -------------------------------------------------------------------------
     def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
@@ -260,6 +266,8 @@ class ContactSNES:
 
     #: Krylov iterations at most with a reused factorisation (then it is refactorised)
     REUSE_MAX_IT = 20
+    #: Krylov iterations above which a kept AMG preconditioner is rebuilt at the next Jacobian
+    AMG_REBUILD_IT = 30
 
     def reuse_factorisation(self) -> None:
         """From the second Newton iteration of a solve on, keep the LU factorisation of an
@@ -275,17 +283,41 @@ class ContactSNES:
         ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=self.REUSE_MAX_IT)
         # a Krylov solve stopped at REUSE_MAX_IT is still a descent step: take it, refactorise
         self.snes.setMaxLinearSolveFailures(10**6)
-        # the preconditioner's own matrix, updated only when refactorising (an unchanged
-        # matrix is not factorised again: PCSetUp compares the matrix state)
+        self._keep_preconditioner(self.REUSE_MAX_IT)
+
+    def reuse_preconditioner(self) -> None:
+        """Keep an iterative solver's preconditioner (the AMG hierarchy, whose Galerkin
+        products cost most of a Newton step) across Newton iterations: rebuild it at the
+        first iteration of every solve, after a failed Krylov solve and after one that needed
+        more than AMG_REBUILD_IT iterations. The contact rows change between Newton
+        iterations, the bulk does not, so an earlier Jacobian's hierarchy still preconditions
+        well. No-op with a direct solver."""
+        if self.snes.getKSP().getPC().getType() in ("lu", "cholesky"):
+            return
+        self._keep_preconditioner(self.AMG_REBUILD_IT)
+
+    def _keep_preconditioner(self, rebuild_it: int) -> None:
+        # the preconditioner's own matrix, updated only when rebuilding (an unchanged matrix
+        # is not set up again: PCSetUp compares the matrix state)
+        self._rebuild_it = rebuild_it
         self.P = self.J.duplicate(copy=True)
+        if self.nullspace is not None:  # AMG reads the near-nullspace from its own matrix
+            self.P.setNearNullSpace(self.nullspace)
         self.snes.setJacobian(self._jacobian, self.J, self.P)
 
     def _update_preconditioner(self, snes, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
         fresh = (snes.getIterationNumber() == 0 or ksp.getConvergedReason() < 0
-                 or ksp.getIterationNumber() >= self.REUSE_MAX_IT)  # fmt: skip
+                 or ksp.getIterationNumber() >= self._rebuild_it)  # fmt: skip
         if fresh:
-            J.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            # a two-body coupling's search may add couplings to J's pattern
+            same = self.coupling is None
+            structure = (
+                PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+                if same
+                else PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+            )
+            J.copy(self.P, structure=structure)
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""

@@ -176,7 +176,7 @@ def run_case(
         ksp=res.ksp_iterations, outer=res.outer_iterations,
         newton_coarse=sum(step.coarse_newton for step in res.steps),
         t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
-        t_run=t["assembly"] + t["solve"],
+        t_run=t["assembly"] + t["solve"], memory_mib=res.memory_mib,
     )  # fmt: skip
     if "contact" in t:  # two bodies: search + contact terms against bulk assembly + solve
         row["t_contact"] = t["contact"]
@@ -303,5 +303,5 @@ def _format_row(row: dict) -> str:
         f"{head} dofs {row['dofs']:>7d} newton {row['newton']:>3d}"
         + (f" (+{row['newton_coarse']} coarse)" if row.get("newton_coarse") else "")
         + f" ksp {row['ksp']:>4d} "
-        f"time {row['t_run']:7.2f} s  {errors}{extra}"
+        f"time {row['t_run']:7.2f} s  mem {row['memory_mib']:6.0f} MiB  {errors}{extra}"
     )

@@ -134,7 +134,7 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
         cols = [("method", "method"), ("degree", "P"), ("level", "level"), ("h", "h"),
                 ("dofs", "dofs"), ("newton", "Newton"), ("ksp", "KSP"),
                 ("t_mesh", "t mesh"), ("t_compile", "t compile"), ("t_assembly", "t assembly"),
-                ("t_solve", "t solve")]  # fmt: skip
+                ("t_solve", "t solve"), ("memory_mib", "memory MiB")]  # fmt: skip
         cols += [(m, MEASURES[m][0]) for m in measures]
         cols += [(k, k.replace("_", " "))
                  for k in ("t_contact", "contact_over_bulk", "contact_over_linear", "speedup")
