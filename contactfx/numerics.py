@@ -36,7 +36,8 @@ class _General:
                              "(Taylor-Hood P2 displacement / P1 pressure, near-incompressible "
                              "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
     steps: int = param(1, "load steps", positive=True)
-    solver: str = param("lu", "linear solver: MUMPS LU or GMRES + GAMG", choices=("lu", "gamg"))
+    solver: str = param("lu", "linear solver: MUMPS LU, or GMRES + GAMG in an inexact "
+                        "Newton method (large 3D meshes)", choices=("lu", "gamg"))  # fmt: skip
     nested: int = param(
         0,
         "nested iteration: solve every load step first on this many "

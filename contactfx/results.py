@@ -161,8 +161,8 @@ class RunSummary:
     paraview: str | None = None
     paraview_surface: str | None = None
     plot: str | None = None
-    #: peak resident memory of the run's processes (MiB, summed over the ranks; the peak so
-    #: far of each process, so within one process the largest run sets it)
+    #: peak resident memory of the run's processes during the run (MiB, summed over the
+    #: ranks; on Linux, else each process's peak so far)
     memory_mib: float = 0.0
 
     # -- named views of the final state ---------------------------------------------------

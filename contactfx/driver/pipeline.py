@@ -99,6 +99,7 @@ class _Run:
             print(msg, flush=True)
 
     def execute(self) -> RunSummary:
+        reset_peak_memory()
         if self.out is not None:
             prepare_output(self.out, self.comm)
         problem, post, solver = self.build()
@@ -226,9 +227,25 @@ class _Run:
         return summary
 
 
+def reset_peak_memory() -> None:
+    """Start a new peak of this process's resident memory (Linux: writing 5 to
+    /proc/self/clear_refs resets VmHWM); elsewhere the peak stays the process's."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        pass
+
+
 def peak_memory_mib(comm) -> float:
-    """Peak resident memory (MiB) of this run's processes, summed over the ranks."""
-    return comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)
+    """Peak resident memory (MiB) since :func:`reset_peak_memory`, summed over the ranks
+    (Linux VmHWM; elsewhere the process's peak, getrusage)."""
+    kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    try:
+        status = Path("/proc/self/status").read_text().splitlines()
+        kib = next(float(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        pass
+    return comm.allreduce(kib / 1024.0)
 
 
 def _progress(step: StepLog, outer: bool) -> str:
