@@ -255,7 +255,7 @@ class ContactSNES:
         self._initial_norm = 0.0
         if iterate is not None:
             self.snes.setMonitor(self._record_initial_norm)
-        self.P = None  # a separate preconditioner matrix: see reuse_factorisation
+        self.P = None  # the preconditioner's own matrix: see _keep_preconditioner
         self.reuse_preconditioner()
 
     # -- options -------------------------------------------------------------------------
