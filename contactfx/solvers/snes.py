@@ -169,7 +169,12 @@ def rigid_body_modes(V) -> PETSc.NullSpace:
         arrays[5][:, 2], arrays[5][:, 1] = x[:, 1], -x[:, 2]
     for vec, arr in zip(vecs, arrays, strict=True):
         vec.array[:] = arr.ravel()
-    dolfinx.la.orthonormalize(vecs)
+    # modified Gram-Schmidt (dolfinx.la.orthonormalize takes PETSc vectors in 0.5, its own
+    # vectors in 0.9)
+    for i, vec in enumerate(vecs):
+        for prev in vecs[:i]:
+            vec.axpy(-vec.dot(prev), prev)
+        vec.normalize()
     return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)
 
 

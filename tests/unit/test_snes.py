@@ -250,3 +250,30 @@ def test_confined_field_leaves_the_system():
     assert COMM.allreduce(err, op=MPI.MAX) < 3 * K * tolerance(f0_from_zero(1.0)) + 1e-13
     assert COMM.allreduce(np.abs(lam_h.x.array[:n][~end]).max(initial=0.0), op=MPI.MAX) == 0.0
     assert stats.newton == newton_count(0.0, 1.0, f0_from_zero(1.0))
+
+
+@pytest.mark.parametrize("gdim", [2, 3])
+def test_rigid_body_modes(gdim):
+    """The AMG near-nullspace: orthonormal, and in the kernel of the unconstrained
+    elasticity stiffness (rigid motions have zero strain, exactly for P1)."""
+    from contactfx.solvers.snes import rigid_body_modes
+
+    comm = MPI.COMM_WORLD
+    if gdim == 2:
+        mesh = dolfinx.mesh.create_unit_square(comm, 4, 3)
+    else:
+        mesh = dolfinx.mesh.create_unit_cube(comm, 3, 2, 2)
+    V = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    a = dolfinx.fem.form(ufl.inner(ufl.sym(ufl.grad(u)), ufl.sym(ufl.grad(v))) * ufl.dx)
+    K = _compat.assemble_matrix(_compat.create_matrix(a), a)
+    modes = rigid_body_modes(V).getVecs()
+    assert len(modes) == (3 if gdim == 2 else 6)
+    Kz = K.createVecLeft()
+    for i, z in enumerate(modes):
+        for j, w in enumerate(modes):
+            # Gram-Schmidt in double precision: orthonormal to round-off
+            assert z.dot(w) == pytest.approx(1.0 if i == j else 0.0, abs=1e-12)
+        K.mult(z, Kz)
+        # K's entries are O(1) on this mesh, z has unit norm: K z is round-off
+        assert Kz.norm() < 1e-12
