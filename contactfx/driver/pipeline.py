@@ -11,7 +11,6 @@ post-processing; it has no copy of the pipeline.
 from __future__ import annotations
 
 import dataclasses
-import resource
 import time
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
@@ -19,6 +18,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from contactfx.driver.nested import NestedSolver, nested_levels
+from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json
 from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog
@@ -225,27 +225,6 @@ class _Run:
         if self.out is not None:
             write_json(self.out / "run.json", summary.to_json(), self.comm)
         return summary
-
-
-def reset_peak_memory() -> None:
-    """Start a new peak of this process's resident memory (Linux: writing 5 to
-    /proc/self/clear_refs resets VmHWM); elsewhere the peak stays the process's."""
-    try:
-        Path("/proc/self/clear_refs").write_text("5")
-    except OSError:
-        pass
-
-
-def peak_memory_mib(comm) -> float:
-    """Peak resident memory (MiB) since :func:`reset_peak_memory`, summed over the ranks
-    (Linux VmHWM; elsewhere the process's peak, getrusage)."""
-    kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    try:
-        status = Path("/proc/self/status").read_text().splitlines()
-        kib = next(float(line.split()[1]) for line in status if line.startswith("VmHWM:"))
-    except (OSError, StopIteration):
-        pass
-    return comm.allreduce(kib / 1024.0)
 
 
 def _progress(step: StepLog, outer: bool) -> str:

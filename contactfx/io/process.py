@@ -1,10 +1,13 @@
-"""Child processes under mpirun (stress's parallel axis, the command-line tests)."""
+"""Processes: child processes under mpirun (stress's parallel axis, the command-line tests)
+and this process's peak memory (run summaries)."""
 
 from __future__ import annotations
 
 import os
+import resource
+from pathlib import Path
 
-__all__ = ["child_env"]
+__all__ = ["child_env", "peak_memory_mib", "reset_peak_memory"]
 
 
 def child_env() -> dict[str, str]:
@@ -20,3 +23,24 @@ def child_env() -> dict[str, str]:
         OMP_NUM_THREADS="1",
     )
     return env
+
+
+def reset_peak_memory() -> None:
+    """Start a new peak of this process's resident memory (Linux: writing 5 to
+    /proc/self/clear_refs resets VmHWM); elsewhere the peak stays the process's."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        pass
+
+
+def peak_memory_mib(comm) -> float:
+    """Peak resident memory (MiB) since :func:`reset_peak_memory`, summed over the ranks
+    (Linux VmHWM; elsewhere the process's peak, getrusage)."""
+    kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    try:
+        status = Path("/proc/self/status").read_text().splitlines()
+        kib = next(float(line.split()[1]) for line in status if line.startswith("VmHWM:"))
+    except (OSError, StopIteration):
+        pass
+    return comm.allreduce(kib / 1024.0)

@@ -317,15 +317,10 @@ class ContactSNES:
         ksp = snes.getKSP()
         fresh = (snes.getIterationNumber() == 0 or ksp.getConvergedReason() < 0
                  or ksp.getIterationNumber() >= self._rebuild_it)  # fmt: skip
-        if fresh:
-            # a two-body coupling's search may add couplings to J's pattern
-            same = self.coupling is None
-            structure = (
-                PETSc.Mat.Structure.SAME_NONZERO_PATTERN
-                if same
-                else PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-            )
-            J.copy(self.P, structure=structure)
+        if fresh:  # a two-body coupling's search may add couplings to J's pattern
+            S = PETSc.Mat.Structure
+            J.copy(self.P, structure=S.SAME_NONZERO_PATTERN if self.coupling is None
+                   else S.DIFFERENT_NONZERO_PATTERN)  # fmt: skip
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
