@@ -53,7 +53,11 @@ BAD = [
         "friction law 'coulomb' is not supported by method 'vi'",
     ),
     (["run", "hertz2d", "--mu", "0.3"], "--mu needs --friction coulomb"),
-    (["run", "sliding-block", "--method", "penalty"], "not supported by method 'penalty'"),
+    (["run", "sliding-block", "--method", "vi"], "not supported by method 'vi'"),
+    (
+        ["run", "cattaneo-cylinders", "--method", "penalty", "--friction", "coulomb", "--mu=0.3"],
+        "method penalty has no friction between two meshed bodies",
+    ),
     (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
     (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),
     (["run", "hertz2d", "--quadrature", "nodal", "--degree", "2"], "--quadrature nodal needs"),

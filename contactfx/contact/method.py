@@ -27,13 +27,16 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
-__all__ = ["Supports", "ContactMethod", "MethodBase"]
+from contactfx.contact.laws import active, ball_projection, norm
+
+__all__ = ["Supports", "ContactMethod", "MethodBase", "TrialFriction"]
 
 
 @dataclass(frozen=True)
 class Supports:
     """What a method handles. ``why_not`` maps a capability name (``friction``, ``obstacles``,
-    ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``dim1``, ``iterative``)
+    ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``two_body_friction``,
+    ``dim1``, ``iterative``)
     to the reason it is not supported, quoted in the error a user sees."""
 
     friction: tuple[str, ...] = ("none",)
@@ -42,6 +45,8 @@ class Supports:
     nodal_quadrature: bool = False
     interfaces: bool = False
     two_body: bool = False
+    #: friction between two meshed bodies too (if it supports friction and two bodies)
+    two_body_friction: bool = True
     dim1: bool = True
     iterative: bool = True
     why_not: dict[str, str] = field(default_factory=dict)
@@ -70,6 +75,9 @@ class MethodBase:
     """Defaults of the protocol for the dataclass methods."""
 
     multiplier: ClassVar[str] = "none"
+    #: with friction, whether the method's law needs the tangential traction of the last
+    #: converged step (the surface's ``traction_prev``, kept by the driver)
+    traction_history: ClassVar[bool] = False
     supports: ClassVar[Supports] = Supports()
     #: the option that tells the method's variants apart, and the values ``contactfx bench
     #: --method NAME`` runs ("": none)
@@ -99,3 +107,28 @@ class MethodBase:
     def attach(self, solver, problem):
         """The solver the load program drives (``solver`` itself unless wrapped)."""
         return solver
+
+
+class TrialFriction:
+    """Friction by a trial tangential traction: t_T = proj_{B(0, s(p))}(trial), the return map of
+    the regularised law (Alart & Curnier 1991, doi:10.1016/0045-7825(91)90022-X). A method
+    writes ``_trial_t(s)`` and ``pressure(s)``; this gives the traction, the trial with its
+    bound (Newton's reversal guard, :func:`contactfx.contact.laws.reversal`) and the slip
+    indicator."""
+
+    def _trial_t(self, s):
+        raise NotImplementedError
+
+    def tangential_traction(self, s):
+        return ball_projection(
+            self._trial_t(s), s.friction.bound(self.pressure(s)), s.E, stick=s.stick
+        )
+
+    def trial_traction(self, s):
+        """The trial tangential traction and the friction bound."""
+        return self._trial_t(s), s.friction.bound(self.pressure(s))
+
+    def slip_indicator(self, s):
+        """1 where the friction bound is reached (slip), else 0."""
+        p = self.pressure(s)
+        return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))

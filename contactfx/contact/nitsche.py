@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import ufl
 
-from contactfx.contact.laws import active, ball_projection, norm, positive_part
-from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.laws import positive_part
+from contactfx.contact.method import MethodBase, Supports, TrialFriction
 from contactfx.contact.surface import Surface
 from contactfx.params import param, validate
 
@@ -40,7 +40,7 @@ __all__ = ["Nitsche"]
 
 
 @dataclass(frozen=True)
-class Nitsche(MethodBase):
+class Nitsche(TrialFriction, MethodBase):
     """theta in {1, 0, -1}; gamma0 > 0 (gamma_N = gamma0 E / h)."""
 
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
@@ -64,22 +64,9 @@ class Nitsche(MethodBase):
         return positive_part(-s.sigma_n(s.stress, n) - self.gamma(s) * s.gap())
 
     def _trial_t(self, s: Surface):
+        """The trial tangential traction sigma_T(u) - gamma_N du_T."""
         n = s.normal()
         return s.sigma_t(s.stress, n) - self.gamma(s) * s.slip_increment(n)
-
-    def tangential_traction(self, s: Surface):
-        return ball_projection(
-            self._trial_t(s), s.friction.bound(self.pressure(s)), s.E, stick=s.stick
-        )
-
-    def trial_traction(self, s: Surface):
-        """The trial tangential traction sigma_T(u) - gamma_N du_T and the friction bound."""
-        return self._trial_t(s), s.friction.bound(self.pressure(s))
-
-    def slip_indicator(self, s: Surface):
-        """1 where the friction bound is reached (slip), else 0."""
-        p = self.pressure(s)
-        return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))
 
     def residual(self, s: Surface):
         n = s.normal()

@@ -1,20 +1,33 @@
-"""Penalty method for frictionless contact with a rigid obstacle.
+"""Penalty method for contact, frictionless or with Tresca / Coulomb friction.
 
 p = kappa [-g(u)]_+ with kappa = kappa0 E / h; the residual adds int p v.n ds (Kikuchi & Oden
 1988, doi:10.1137/1.9781611970845). The penetration is O(p h / (kappa0 E)): the method is not
-consistent, the error falls as kappa0 grows (and the conditioning worsens). Friction is not
-offered: a penalised stick needs the tangential traction of the last step as history
-(t_T = proj(t_T_prev - kappa du_T)), which this module does not store.
+consistent, the error falls as kappa0 grows (and the conditioning worsens).
+
+Friction: the stick is a tangential spring of the same stiffness, and the slip its plastic
+part (Wriggers 2006, Computational Contact Mechanics, 2nd ed., chapter 5,
+doi:10.1007/978-3-540-32609-0). With t_prev the tangential traction of the last converged load
+step (the method's history, :attr:`Penalty.traction_history`) and du_T the slip increment since
+then,
+
+    t_T = proj_{B(0, s(p))}(t_prev - kappa du_T)
+
+(s = mu p for Coulomb, the threshold for Tresca): a backward-Euler return map. Without the
+history the stick traction would restart from zero at every step. The history lives at the
+nodes of the contact surface (a P1 field, :meth:`contactfx.driver.problem.Problem.converged`
+evaluates t_T there); with the vertex rule (``--quadrature nodal``) the return map is exact at
+every quadrature point, with Gauss points the history between nodes is its P1 interpolant.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import ufl
 
-from contactfx.contact.laws import positive_part
-from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.laws import positive_part, tangential
+from contactfx.contact.method import MethodBase, Supports, TrialFriction
 from contactfx.contact.surface import Surface
 from contactfx.params import param, validate
 
@@ -22,7 +35,7 @@ __all__ = ["Penalty"]
 
 
 @dataclass(frozen=True)
-class Penalty(MethodBase):
+class Penalty(TrialFriction, MethodBase):
     """kappa0 > 0 (kappa = kappa0 E / h)."""
 
     kappa0: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True,
@@ -30,9 +43,13 @@ class Penalty(MethodBase):
     name = "penalty"
     sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
-        mixed_up=True, nodal_quadrature=True, interfaces=True, two_body=True,
-        why_not={"friction": "its stick traction needs the tangential traction history"},
+        friction=("none", "tresca", "coulomb"), mixed_up=True, nodal_quadrature=True,
+        interfaces=True, two_body=True, two_body_friction=False,
+        why_not={"two_body_friction": "its traction history is kept on one body's surface "
+                                      "only"},
     )  # fmt: skip
+    #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
+    traction_history: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         validate(self)
@@ -43,8 +60,16 @@ class Penalty(MethodBase):
     def pressure(self, s: Surface):
         return self.kappa(s) * positive_part(-s.gap())
 
+    def _trial_t(self, s: Surface):
+        """The trial tangential traction t_prev - kappa du_T."""
+        n = s.normal()
+        return tangential(s.traction_prev, n) - self.kappa(s) * s.slip_increment(n)
+
     def residual(self, s: Surface):
-        return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds
+        form = self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds
+        if s.friction is not None:
+            form -= ufl.dot(self.tangential_traction(s), s.v) * s.ds
+        return form
 
     def coupling(self, pair):
         """Between two bodies: p = kappa [-g]_+ at the slave facets' Gauss points."""

@@ -67,13 +67,17 @@ class SurfaceData:
     ``u_prev``, the relative motion of the last converged load step (friction only, the slip
     increment is measured from it); ``ds_nodal``, the contact measure with the vertex
     (trapezoidal) rule for laws collocated at the nodes; a method's ``multiplier`` and its test
-    function; ``stick``, Newton's reversal guard."""
+    function; ``traction_prev``, a method's traction history; ``stick``, Newton's reversal
+    guard."""
 
     friction: Friction | None = None
     u_prev: Expr | None = None
     ds_nodal: ufl.Measure | None = None
     multiplier: Expr | None = None
     multiplier_test: Expr | None = None
+    #: with friction, the tangential traction of the last converged step at the surface, for a
+    #: method whose law has it as history (``traction_history``); else None
+    traction_prev: Expr | None = None
     #: with friction, where > 0 a closed point takes the stick branch of the friction law
     #: whatever its trial traction (Newton's reversal guard, :func:`contactfx.contact.laws.
     #: reversal`); None: the law itself

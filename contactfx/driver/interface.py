@@ -120,10 +120,14 @@ class InterfaceProblem(Problem):
             scene.contact_modulus(), self.h, floor=scene.floor(self.s_coord), fluid=self.fluid,
             joint=scene.joint(), friction=self.friction,
             u_prev=None if self.prev is None else self.total(self.previous()),
+            traction_prev=None if self.t_prev is None else self.t_prev("+"),
             ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
             multiplier=None if self.lam is None else self.lam("+"),
             multiplier_test=None if self.lam_test is None else self.lam_test("+"),
         )  # fmt: skip
+
+    def nodal_rule(self):
+        return self.dS_nodal, "+"
 
     def bulk_form(self):
         a = ufl.inner(self.material.sigma(self.dw), ufl.sym(ufl.grad(self.v_load))) * ufl.dx

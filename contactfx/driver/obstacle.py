@@ -81,11 +81,13 @@ class ObstacleProblem(Problem):
             self.sigma(self.U, self.p), self.sigma(self.V_test, self.q),
             scene.contact_modulus(), self.h, friction=self.friction,
             u_prev=None if self.prev is None else self.previous(),
-            offset_prev=self.offset_prev,
-            ds_nodal=self.ds(scene.contact_tag, metadata=vertex_rule(self.fdim))
-            if self.method.multiplier == "field" else None,
+            offset_prev=self.offset_prev, traction_prev=self.t_prev,
+            ds_nodal=self.nodal_rule()[0] if self.method.multiplier == "field" else None,
             multiplier=self.lam, multiplier_test=self.lam_test,
         )  # fmt: skip
+
+    def nodal_rule(self):
+        return self.ds(self.scene.contact_tag, metadata=vertex_rule(self.fdim)), None
 
     def sigma(self, u, p):
         return self.material.sigma(u, p)

@@ -3,7 +3,8 @@
 
 :class:`Problem` builds what every kind shares: the unknown (the kind's displacement field,
 extended by a multiplier field for a ``"field"`` method or by the pressure of the mixed u-p
-formulation), the friction history, the nodal multiplier of a ``"nodal"`` method, and the forms
+formulation), the friction history (the last converged state, and the last tangential traction
+for a method that keeps it), the nodal multiplier of a ``"nodal"`` method, and the forms
 (bulk, load, contact residual). A kind adds its unknowns' meaning, its boundary conditions and
 measures, its :class:`contactfx.contact.surface.Surface`, its load program and its
 post-processing.
@@ -20,7 +21,7 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.contact.laws import reversal
-from contactfx.driver.fields import at_nodes, confine, surface_mask, vertex_rule
+from contactfx.driver.fields import NodalProjection, at_nodes, confine, surface_mask, vertex_rule
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
 __all__ = ["Problem"]
@@ -57,6 +58,13 @@ class Problem:
         self.prev = None  # the last converged state: the history of friction
         if self.friction is not None:
             self.prev = dolfinx.fem.Function(self.state.function_space)
+        #: the tangential traction of the last converged step at the surface's nodes (P1),
+        #: for a method whose friction law keeps it (``traction_history``), else None
+        self.t_prev = None
+        self._history = None
+        if self.friction is not None and method.traction_history:
+            space = _compat.function_space(mesh, "Lagrange", 1, (self.gdim,))
+            self.t_prev = dolfinx.fem.Function(space, name="traction_history")
         self.multiplier = None
         if method.multiplier == "nodal":
             space = _compat.function_space(mesh, "Lagrange", 1, self.mult_shape or None)
@@ -186,8 +194,22 @@ class Problem:
         """The solver's two-body coupling (:mod:`contactfx.contact.coupling`), or None."""
         return None
 
+    def nodal_rule(self):
+        """(the contact measure with the vertex rule, the restriction of its integrands or
+        None): where the traction history is evaluated."""
+        raise NotImplementedError(f"{type(self).__name__} keeps no traction history")
+
     def converged(self) -> None:
-        """A step converged: it is the history of the next."""
+        """A step converged: it is the history of the next (the state and, for a method that
+        keeps it, the tangential traction at the surface's nodes: with the vertex rule the
+        law's own nodal values, averaged over the facets of a node where they differ)."""
+        if self.t_prev is not None:
+            if self._history is None:
+                measure, restrict = self.nodal_rule()
+                proj = NodalProjection(measure, self.t_prev.function_space, restrict)
+                self._history = (proj, proj.form(self.method.tangential_traction(self.surface)))
+            proj, form = self._history
+            proj(form, self.t_prev)
         if self.prev is not None:
             self.prev.x.array[:] = self.state.x.array
 

@@ -49,6 +49,13 @@ class TwoBodyProblem(Problem):
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
+        if numerics.friction != "none" and not method.supports.two_body_friction:
+            raise ValueError(
+                f"method {method.name} has no friction between two meshed bodies ("
+                f"{method.supports.why_not.get('two_body_friction', 'not implemented')}); use "
+                + ", ".join(methods_supporting(lambda c: c.two_body and c.two_body_friction
+                                               and "coulomb" in c.friction))
+            )  # fmt: skip
         if numerics.friction == "tresca":
             raise ValueError("Tresca friction between two meshed bodies is not implemented: use "
                              "--friction coulomb or none")  # fmt: skip

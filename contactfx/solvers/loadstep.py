@@ -32,15 +32,20 @@ def run_load_program(
     """Solve at load factors t = 1/steps, 2/steps, ..., 1.
 
     ``apply_load(t)`` sets the load program's constants (obstacle position, tractions) for the
-    load factor t. Each step starts from the secant extrapolation of the last two converged
-    states. A failed step is retried with half the increment, up to ``max_cutbacks`` halvings in
+    load factor t. Each step but the first starts from the secant extrapolation of the last two
+    converged states, the unloaded state u = 0 at t = 0 being the first of them (not the
+    starting iterate: that is a guess of the first step's solution, and a secant through it can
+    carry a stiffly enforced contact off its obstacle everywhere, where the Jacobian is
+    singular). A failed step is retried with half the increment, up to ``max_cutbacks`` halvings in
     a row; then ``ConvergenceError`` names the SNES reason, the step and the load factor.
     """
     if steps < 1:
         raise ValueError(f"load steps must be >= 1, got {steps}")
     x = _compat.petsc_vec(solver.u)
     previous = x.copy()  # last converged state
-    older = None  # the one before, for the secant predictor
+    older = x.duplicate()  # the one before, for the secant predictor: u = 0 at t = 0
+    older.set(0.0)
+    solved = False  # whether ``previous`` is a converged state (not the starting iterate)
     t_prev, t_older = 0.0, 0.0
     records: list[StepRecord] = []
     dt = 1.0 / steps
@@ -49,7 +54,7 @@ def run_load_program(
     try:
         while t_prev < 1.0 - 1e-12:
             t = min(1.0, t_prev + dt)
-            factor = 0.0 if older is None else (t - t_prev) / (t_prev - t_older)
+            factor = (t - t_prev) / (t_prev - t_older) if solved else 0.0
             _predict(x, previous, older, factor)
             apply_load(t)
             solver.assemble_load()
@@ -66,10 +71,9 @@ def run_load_program(
                 dt *= 0.5
                 continue
             step += 1
-            if older is None:
-                older = previous.copy()
-            else:
+            if solved:
                 previous.copy(older)
+            solved = True
             x.copy(previous)
             t_older, t_prev = t_prev, t
             record = StepRecord(step=step, load=t, stats=stats, cutbacks=cutbacks)
@@ -81,16 +85,15 @@ def run_load_program(
             cutbacks = 0
     finally:
         previous.destroy()
-        if older is not None:
-            older.destroy()
+        older.destroy()
     return records
 
 
-def _predict(x: PETSc.Vec, previous: PETSc.Vec, older, factor: float) -> None:
+def _predict(x: PETSc.Vec, previous: PETSc.Vec, older: PETSc.Vec, factor: float) -> None:
     """x = previous + factor (previous - older): the secant extrapolation of the last two
-    converged states (previous alone before the second step)."""
+    converged states (previous alone, factor 0, in the first step)."""
     previous.copy(x)
-    if older is not None:
+    if factor != 0.0:
         x.axpy(factor, previous)
         x.axpy(-factor, older)
     x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)

@@ -7,9 +7,10 @@ exists (which measure is named), and the wall time. A failure is a row, never a 
 command. Axes (see ``cases``): Nitsche gamma0 for theta = 1, 0, -1 (Chouly, Hild & Renard 2015,
 doi:10.1051/m2an/2014046: theta = 1 needs gamma0 large enough, theta = -1 is stable for any
 gamma0), the penalty parameter, Poisson's ratio up to 0.4999 (P1, P2, mixed u-p where
-available), friction mu up to 1, contact onset (zero gap, grazing, clearance, a front crossing
-many element edges), the flat punch's singular edge, one huge load step against many small
-ones, interference (the indenter starts inside the body), and 1 / 2 / 3 ranks.
+available), friction mu up to 1 and a stiff stick (1000), contact onset (zero gap, grazing,
+clearance, a front crossing many element edges), the flat punch's singular edge, one huge load
+step against many small ones, interference (the indenter starts inside the body), and 1 / 2 / 3
+ranks.
 
 Outputs (``--out``): stress.csv, stress.md and gamma0.png (error and Newton iterations against
 gamma0, one line per theta).
@@ -86,10 +87,16 @@ def cases() -> list[StressCase]:
                               "hertz2d", {**hz, **layer}, {"method": "nitsche"},
                               quick=ratio == 1e6))  # fmt: skip
     for mu in (0.0, 0.3, 0.6, 1.0):
-        for method in ({"method": "nitsche"}, {"method": "al-ssn"}):
+        for method in ({"method": "nitsche"}, {"method": "penalty"}, {"method": "al-ssn"}):
             out.append(StressCase(f"mu={mu:g} {method['method']}", "friction", "sliding-block",
                                   {"h": 0.1}, {**method, "friction": "coulomb", "mu": mu},
                                   quick=mu == 1.0 and method["method"] == "nitsche"))  # fmt: skip
+    # a stick 100 times stiffer than the defaults (see test_friction.py)
+    stiff = {"nitsche": "gamma0", "penalty": "penalty", "al-uzawa": "r0", "al-ssn": "r0"}
+    for method, key in stiff.items():
+        out.append(StressCase(f"mu=0.3 {method} {key}=1000", "friction", "sliding-block",
+                              {"h": 0.1}, {"method": method, key: 1000.0,
+                                           "friction": "coulomb", "mu": 0.3}))  # fmt: skip
     onset = [
         ("zero initial gap, 1 step", {}, {"steps": 1}, True),
         ("grazing (a ~ h/2)", {"depth": 2e-5}, {"steps": 1}, True),

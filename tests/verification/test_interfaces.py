@@ -123,11 +123,13 @@ def test_inclined_crack_KII_table(mu, column, beta):
     assert data.errors["pressure_L2_rel"] < 0.045 * q / ref["sigma_n"]
 
 
-@pytest.mark.parametrize("numerics", CONSISTENT[2:], ids=IDS[2:])
+@pytest.mark.parametrize("numerics", CONSISTENT[2:] + [dict(method="penalty")],
+                         ids=IDS[2:] + ["penalty"])  # fmt: skip
 def test_inclined_crack_methods_agree(numerics):
     scene = CrackInclined(CrackInclined.Params(beta=45.0))
     ref = _run(scene, mu=0.3, **numerics).reference
-    # the same discretisation of the same law: K within 0.5 % of Nitsche's 1.3 %
+    # the same discretisation of the same law: K within 0.5 % of Nitsche's 1.3 % (penalty 10,
+    # not consistent: 1.27 % measured)
     assert ref["K_rel_error"] < 0.03
 
 

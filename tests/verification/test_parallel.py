@@ -41,9 +41,12 @@ def test_serial_and_parallel_agree(scene, num):
         (Hertz2D(Hertz2DParams()), Numerics(method="al-ssn", ncp="fb")),
         (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="nitsche")),
         (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="al-ssn")),
+        (SlidingBlock(SlidingBlockParams(shift=1e-4)),
+         SlidingBlock.default_numerics(method="penalty", penalty=1.0, mu=2.0)),
     ],
-    ids=["hertz2d-al-uzawa", "hertz2d-al-ssn-fb", "sliding-nitsche", "sliding-al-ssn"],
-)
+    ids=["hertz2d-al-uzawa", "hertz2d-al-ssn-fb", "sliding-nitsche", "sliding-al-ssn",
+         "sliding-penalty-stick"],
+)  # fmt: skip
 def test_serial_and_parallel_agree_al_and_friction(scene, num):
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
@@ -67,6 +70,7 @@ def _interface_cases():
         ("sneddon-nitsche", CrackSneddon(CrackSneddon.Params()), {"method": "nitsche"}),
         ("inclined-nitsche", inclined, {"method": "nitsche", "mu": 0.3}),
         ("inclined-al-uzawa", inclined, {"method": "al-uzawa", "mu": 0.3}),
+        ("inclined-penalty", inclined, {"method": "penalty", "mu": 0.3}),
         ("propped-al-ssn", propped, {"method": "al-ssn"}),
         ("propped-nitsche", propped, {"method": "nitsche", "theta": -1}),
         ("joint-al-ssn", JointColumn(JointColumn.Params()), {"method": "al-ssn"}),
