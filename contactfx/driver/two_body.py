@@ -32,30 +32,33 @@ from contactfx.results import Friction, Quantities
 __all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
 
 
+def _not_offered(method, capability: str, what: str, test) -> ValueError:
+    """The one-line refusal: the method, what it lacks, its reason (``why_not``) and the
+    methods whose ``supports`` pass ``test``."""
+    from contactfx.contact.registry import methods_supporting
+
+    reason = method.supports.why_not.get(capability, "not implemented")
+    return ValueError(f"method {method.name} {what} ({reason}); use "
+                      + ", ".join(methods_supporting(test)))  # fmt: skip
+
+
 class TwoBodyProblem(Problem):
     """Bodies in contact through a pair of non-matching surfaces (see the module docstring)."""
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
-        from contactfx.contact.registry import methods_supporting
-
         if not method.supports.two_body:
-            raise ValueError(
-                f"method {method.name} is not offered between two meshed bodies ("
-                f"{method.supports.why_not.get('two_body', 'not implemented')}); use "
-                + ", ".join(methods_supporting(lambda c: c.two_body))
-            )
+            raise _not_offered(method, "two_body", "is not offered between two meshed bodies",
+                               lambda c: c.two_body)  # fmt: skip
         if numerics.degree != 1:
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
         if numerics.friction != "none" and not method.supports.two_body_friction:
-            raise ValueError(
-                f"method {method.name} has no friction between two meshed bodies ("
-                f"{method.supports.why_not.get('two_body_friction', 'not implemented')}); use "
-                + ", ".join(methods_supporting(lambda c: c.two_body and c.two_body_friction
-                                               and "coulomb" in c.friction))
-            )  # fmt: skip
+            raise _not_offered(method, "two_body_friction",
+                               "has no friction between two meshed bodies",
+                               lambda c: c.two_body and c.two_body_friction
+                               and "coulomb" in c.friction)  # fmt: skip
         if numerics.friction == "tresca":
             raise ValueError("Tresca friction between two meshed bodies is not implemented: use "
                              "--friction coulomb or none")  # fmt: skip

@@ -45,7 +45,6 @@ def run_load_program(
     previous = x.copy()  # last converged state
     older = x.duplicate()  # the one before, for the secant predictor: u = 0 at t = 0
     older.set(0.0)
-    solved = False  # whether ``previous`` is a converged state (not the starting iterate)
     t_prev, t_older = 0.0, 0.0
     records: list[StepRecord] = []
     dt = 1.0 / steps
@@ -54,7 +53,8 @@ def run_load_program(
     try:
         while t_prev < 1.0 - 1e-12:
             t = min(1.0, t_prev + dt)
-            factor = (t - t_prev) / (t_prev - t_older) if solved else 0.0
+            # before the first converged step ``previous`` is the starting iterate
+            factor = (t - t_prev) / (t_prev - t_older) if step > 0 else 0.0
             _predict(x, previous, older, factor)
             apply_load(t)
             solver.assemble_load()
@@ -70,10 +70,9 @@ def run_load_program(
                     raise ConvergenceError(err.reason, step + 1, t) from None
                 dt *= 0.5
                 continue
-            step += 1
-            if solved:
+            if step > 0:
                 previous.copy(older)
-            solved = True
+            step += 1
             x.copy(previous)
             t_older, t_prev = t_prev, t
             record = StepRecord(step=step, load=t, stats=stats, cutbacks=cutbacks)
