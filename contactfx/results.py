@@ -249,6 +249,7 @@ MEASURES: dict[str, tuple[str, str, str]] = {
     "err_u_H1": ("displacement, H1 semi-norm", "errors", "displacement_H1_rel"),
     "err_punch": ("punch pressure on |x| <= 0.8 a", "scores", "normalised_pressure_error"),
     "err_Q": ("gross-slip force Q = mu P", "reference", "Q_rel_error"),
+    "err_c": ("stick half-width c (Cattaneo-Mindlin)", "reference", "c_rel_error"),
     "err_opening": ("crack opening, L2 on the crack", "errors", "opening_L2_rel"),
     "err_slip": ("crack slip, L2 on the crack", "errors", "slip_L2_rel"),
     "err_K": ("stress intensity factor", "reference", "K_rel_error"),
@@ -257,8 +258,8 @@ MEASURES: dict[str, tuple[str, str, str]] = {
 
 #: stress's primary error, most specific first, with the short name it prints
 PRIMARY = (("K", "err_K"), ("settlement", "err_settlement"), ("opening L2", "err_opening"),
-           ("p L2", "err_p_L2"), ("punch p", "err_punch"), ("Q = mu P", "err_Q"),
-           ("force", "err_force"))  # fmt: skip
+           ("stick c", "err_c"), ("p L2", "err_p_L2"), ("punch p", "err_punch"),
+           ("Q = mu P", "err_Q"), ("force", "err_force"))  # fmt: skip
 
 
 def measure(summary: RunSummary, column: str) -> float:

@@ -53,17 +53,22 @@ def _indent_then_shift(t: float, depth: float, shift: float, gdim: int) -> np.nd
     return offset
 
 
-def cattaneo_mindlin(f, a: float, exponent: float) -> dict[str, float]:
+def cattaneo_mindlin(f, a: float, exponent: float, exact: bool = False) -> dict[str, float]:
     """Stick size c = a (1 - Q / (mu P))^exponent (2D: 1/2, 3D: 1/3) at the computed normal
     force P and tangential force Q (Johnson 1985, section 7.1; approximate on a rigid-elastic
     pair, Dundurs beta != 0). With Q the x component and the bound mu P of the friction
-    quantities ``f`` (:class:`contactfx.results.Friction`)."""
+    quantities ``f`` (:class:`contactfx.results.Friction`). ``exact`` (two bodies of one
+    material, Dundurs beta = 0): the computed stick size's relative error is an error measure
+    (``c_rel_error``); otherwise c is reported only."""
     if f.bound <= 0.0:
         return {}
     ratio = abs(f.tangential_force[0]) / f.bound
     c = a * max(0.0, 1.0 - ratio) ** exponent
-    return {"Q_over_bound": ratio, "c": c, "c_computed": f.stick_size,
-            "c_over_a_computed": f.stick_size / a, "c_over_a": c / a}  # fmt: skip
+    out = {"Q_over_bound": ratio, "c": c, "c_computed": f.stick_size,
+           "c_over_a_computed": f.stick_size / a, "c_over_a": c / a}  # fmt: skip
+    if exact and c > 0.0:
+        out["c_rel_error"] = abs(f.stick_size - c) / c
+    return out
 
 
 def _indenter(profile: str, radius: float) -> Obstacle:

@@ -337,4 +337,4 @@ class CattaneoCylinders(HertzCylinders):
 
     def friction_reference(self, q, friction) -> dict[str, float]:
         ref = self.reference(q.force)
-        return cattaneo_mindlin(q.friction, ref["a"], exponent=0.5)
+        return cattaneo_mindlin(q.friction, ref["a"], exponent=0.5, exact=True)

@@ -251,7 +251,14 @@ class ContactSNES:
 
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
-        self._set_options({**DEFAULT_OPTIONS, **(options or {})}, user_options or {})
+        defaults = {**DEFAULT_OPTIONS, **(options or {})}
+        if iterate is not None:
+            # the reversal guard's stick branch is unbounded (t_T = trial): at an iterate just
+            # after a reversal the residual may grow by orders of magnitude, and the next step,
+            # linear there, removes it. It is no merit function, so no divergence test on it
+            # (max_it still bounds a solve)
+            defaults.setdefault("snes_divergence_tolerance", -1)
+        self._set_options(defaults, user_options or {})
         self.residual_vec = self.J.createVecLeft()
         self.snes.setFunction(self._residual, self.residual_vec)
         self.snes.setJacobian(self._jacobian, self.J, self.J)

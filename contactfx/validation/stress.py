@@ -97,6 +97,12 @@ def cases() -> list[StressCase]:
         out.append(StressCase(f"mu=0.3 {method} {key}=1000", "friction", "sliding-block",
                               {"h": 0.1}, {"method": method, key: 1000.0,
                                            "friction": "coulomb", "mu": 0.3}))  # fmt: skip
+        # partial slip under a curved indenter (the vertex rule where a method has a choice)
+        nodal = {"quadrature": "nodal"} if method in ("nitsche", "penalty") else {}
+        out.append(StressCase(f"hertz2d shift mu=0.3 {method} {key}=1000", "friction",
+                              "hertz2d", {"shift": 5e-4},
+                              {"method": method, key: 1000.0, "friction": "coulomb", "mu": 0.3,
+                               "steps": 8, **nodal}))  # fmt: skip
     onset = [
         ("zero initial gap, 1 step", {}, {"steps": 1}, True),
         ("grazing (a ~ h/2)", {"depth": 2e-5}, {"steps": 1}, True),

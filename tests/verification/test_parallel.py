@@ -43,9 +43,12 @@ def test_serial_and_parallel_agree(scene, num):
         (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="al-ssn")),
         (SlidingBlock(SlidingBlockParams(shift=1e-4)),
          SlidingBlock.default_numerics(method="penalty", penalty=1.0, mu=2.0)),
+        (Hertz2D(Hertz2DParams(shift=5e-4)),
+         Hertz2D.default_numerics(method="nitsche", gamma0=1000.0, quadrature="nodal",
+                                  friction="coulomb", mu=0.3, steps=8)),
     ],
     ids=["hertz2d-al-uzawa", "hertz2d-al-ssn-fb", "sliding-nitsche", "sliding-al-ssn",
-         "sliding-penalty-stick"],
+         "sliding-penalty-stick", "hertz2d-shift-stiff"],
 )  # fmt: skip
 def test_serial_and_parallel_agree_al_and_friction(scene, num):
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
