@@ -155,9 +155,9 @@ def test_cattaneo_stiff_stick_methods_agree():
     reversal guard sticks it, and the residual there (the stick branch's unbounded traction)
     grew 3e4-fold: SNES's divergence test stopped every method at every cut-back. With the
     test off under the guard all converge (28 / 29 / 34 Newton iterations at h_contact 3e-3).
-    The stick half-width c: the methods agree within 5 % (the issue's bar; measured: the
-    same stick nodes, c = 7.46e-3 = 5 h), and each Q / (mu P) within 1 % of Nitsche's
-    (measured 1.4e-4: the laws differ at the slip zone's edges, an O(h) strip)."""
+    The stick half-width c: the methods agree within 5 % (measured: the same stick nodes,
+    c = 7.46e-3 = 5 h), and each Q / (mu P) within 1 % of Nitsche's (measured 1.4e-4: the
+    laws differ at the slip zone's edges, an O(h) strip)."""
     params = Hertz2DParams(h_contact=1.5e-3, shift=5e-4)
     res = {}
     for method, stiff in STIFF_SHIFT:
