@@ -68,7 +68,7 @@ CASES: dict[str, BenchCase] = {
         "(a and p0 against frictionless Hertz: approximate, Dundurs beta = 0.29)",
         p2_levels=2,
         numerics={"friction": "coulomb", "mu": 0.3, "steps": 8},
-    ),  # fmt: skip
+    ),
     # level 0 has about 2e3 dofs and level 4 about 9e5 (P1)
     "hertz3d": BenchCase("hertz3d", {}, 1.4, "Hertz sphere, quarter model", p2_levels=2),
     "westergaard-partial": BenchCase(
