@@ -31,7 +31,7 @@ test: install
 	$(PY) -m pytest -q tests
 	mpirun -n $(NP) $(PY) -m mpi4py -m pytest -q -m "not serial_only" tests
 
-# The committed results page docs/results.md (about 30 min on 2 cores): error against run time
+# The committed results page docs/results.md (over an hour on 2 cores: up to 850 runs): error against run time
 # for every case and method, and the robustness matrix.
 BENCH_METHODS := nitsche,nitsche@1+nodal,penalty,al-uzawa,al-ssn,vi
 results: install
