@@ -256,8 +256,8 @@ class ContactSNES:
             # the reversal guard's stick branch is unbounded (t_T = trial): at an iterate just
             # after a reversal the residual may grow by orders of magnitude, and the next step,
             # linear there, removes it. It is no merit function, so no divergence test on it
-            # (max_it still bounds a solve)
-            defaults.setdefault("snes_divergence_tolerance", -1)
+            # (max_it still bounds a solve). Not -1: PETSc >= 3.22 reads it as "the default"
+            defaults.setdefault("snes_divergence_tolerance", 1e300)
         self._set_options(defaults, user_options or {})
         self.residual_vec = self.J.createVecLeft()
         self.snes.setFunction(self._residual, self.residual_vec)
