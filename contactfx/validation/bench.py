@@ -276,9 +276,9 @@ def run_bench(cases: list[str], variants: list[tuple[str, dict]], degrees: list[
     ceiling = parallel_ceiling(comm) if speedup and comm.size > 1 else 1.0
     rows: list[dict] = []
     for case_name in cases:
+        case = CASES[case_name]
         for label, overrides in variants:
             for degree in degrees:
-                case = CASES[case_name]
                 n = min(levels, case.levels if degree == 1 else case.p2_levels)
                 for level in range(n):
                     row, scene, num = run_case(case_name, label, overrides, degree, level, comm,

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from contactfx.contact.registry import method_class
 from contactfx.io.process import child_env
 from contactfx.results import PRIMARY, RunSummary, measure
 from contactfx.validation.bench import method_label
@@ -98,7 +99,7 @@ def cases() -> list[StressCase]:
                               {"h": 0.1}, {"method": method, key: 1000.0,
                                            "friction": "coulomb", "mu": 0.3}))  # fmt: skip
         # partial slip under a curved indenter (the vertex rule where a method has a choice)
-        nodal = {"quadrature": "nodal"} if method in ("nitsche", "penalty") else {}
+        nodal = {"quadrature": "nodal"} if method_class(method).supports.nodal_quadrature else {}
         out.append(StressCase(f"hertz2d shift mu=0.3 {method} {key}=1000", "friction",
                               "hertz2d", {"shift": 5e-4},
                               {"method": method, key: 1000.0, "friction": "coulomb", "mu": 0.3,
