@@ -37,7 +37,10 @@ def run_load_program(
     starting iterate: that is a guess of the first step's solution, and a secant through it can
     carry a stiffly enforced contact off its obstacle everywhere, where the Jacobian is
     singular). A failed step is retried with half the increment, up to ``max_cutbacks`` halvings in
-    a row; then ``ConvergenceError`` names the SNES reason, the step and the load factor.
+    a row, and never below 1 / (steps 4^max_cutbacks) (the increment grows back only after a
+    step that needed no cut-back, so without a floor steps that each fail once would shrink it
+    without end); then ``ConvergenceError`` names the SNES reason, the step and the load
+    factor.
     """
     if steps < 1:
         raise ValueError(f"load steps must be >= 1, got {steps}")
@@ -48,6 +51,7 @@ def run_load_program(
     t_prev, t_older = 0.0, 0.0
     records: list[StepRecord] = []
     dt = 1.0 / steps
+    dt_min = dt / 4**max_cutbacks
     cutbacks = 0
     step = 0
     try:
@@ -65,7 +69,7 @@ def run_load_program(
                 raise TimeLimitExceeded(f" at load factor {t:.6g}") from None
             except ConvergenceError as err:
                 cutbacks += 1
-                if cutbacks > max_cutbacks:
+                if cutbacks > max_cutbacks or 0.5 * dt < dt_min * (1.0 - 1e-12):
                     _restore(previous, x)
                     raise ConvergenceError(err.reason, step + 1, t) from None
                 dt *= 0.5

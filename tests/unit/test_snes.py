@@ -201,6 +201,43 @@ def test_load_program_cutback():
     assert _compat.petsc_vec(u).norm(3) == 0.0
 
 
+class _ShrinkingWindow:
+    """A solver stand-in whose step converges only if its load increment is at most ``limit``,
+    and each success halves the limit: steps that each need one cut-back, the pattern that
+    shrank the increment without end (a Nitsche contact cycling at one load factor)."""
+
+    def __init__(self, limit: float) -> None:
+        mesh = _compat.create_interval(COMM, N, L)
+        self.u = dolfinx.fem.Function(_compat.function_space(mesh, "Lagrange", 1))
+        self.limit, self.t, self.t_done = limit, 0.0, 0.0
+
+    def set_load(self, t: float) -> None:
+        self.t = t
+
+    def assemble_load(self) -> None:
+        pass
+
+    def solve(self):
+        from contactfx.solvers.snes import SolveStats
+
+        if self.t - self.t_done > self.limit:
+            raise ConvergenceError("DIVERGED_MAX_IT")
+        self.limit, self.t_done = 0.5 * (self.t - self.t_done), self.t
+        return SolveStats()
+
+
+def test_load_program_increment_floor():
+    # max_cutbacks 2, steps 1: the increment never drops below 1 / 4^2. Increments 1, 1/2 fail,
+    # 1/4 converges (t = 1/4); 1/4 fails, 1/8 converges (3/8); 1/8 fails, 1/16 converges
+    # (7/16); 1/16 fails and 1/32 would be below the floor: ConvergenceError at step 4,
+    # t = 7/16 + 1/16. Without the floor t crept towards 1/2 until t - t_prev was 0
+    stub = _ShrinkingWindow(limit=0.3)
+    with pytest.raises(ConvergenceError) as err:
+        run_load_program(stub, stub.set_load, steps=1, max_cutbacks=2)
+    assert (err.value.step, err.value.load) == (4, 0.5)
+    assert stub.t_done == 7 / 16
+
+
 def test_confined_field_leaves_the_system():
     """The spring force as a second field lam of a mixed space [P1] x P1, confined to the end
     node x = L (``confined``: zero at every other node): u-equation E u'v' - t F v + lam v at
