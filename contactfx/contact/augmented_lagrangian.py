@@ -25,6 +25,10 @@ lambda_n = p and lambda_T = T.
   The multiplier's dofs away from the contact boundary are fixed to zero (a trace space on
   dolfinx versions without mixed-dimensional assembly; Hueeber & Wohlmuth 2005,
   doi:10.1016/j.cma.2004.09.012 for the semi-smooth Newton view of these equations).
+
+At a crack tip the gap vanishes identically, so no contact law fixes the multiplier there:
+both methods tie it to its neighbour's (:meth:`contactfx.contact.surface.SurfaceData.
+collocated`).
 """
 
 from __future__ import annotations
@@ -128,10 +132,12 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
 
     def update(self, s: Surface):
         """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
-        p, _, t_T = self._augmented(s, s.multiplier)
-        if t_T is None:
-            return p
-        return -p * s.normal() + t_T
+        lam = s.multiplier
+        p, _, t_T = self._augmented(s, lam)
+        new = p if t_T is None else -p * s.normal() + t_T
+        if s.multiplier_tie is None:
+            return new
+        return lam - s.collocated(lam - new)  # at a crack tip: the neighbour's multiplier
 
     def residual(self, s: Surface):
         p, _, t_T = self._augmented(s, s.multiplier)
@@ -185,7 +191,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         else:
             c_n = fischer_burmeister(lam_n, r * s.gap(), s.E)
         if lam_t is None:  # scalar pressure multiplier
-            return lam * ufl.dot(s.v, n) * s.ds + c_n * mu * s.ds_nodal
+            return lam * ufl.dot(s.v, n) * s.ds + s.collocated(c_n) * mu * s.ds_nodal
         # traction multiplier t = lam: -int t . v, and C(lam, u) = -c_n n + (lam_T - T) = 0
-        c = -c_n * n + lam_t - t_T
+        c = s.collocated(-c_n * n + lam_t - t_T)
         return -ufl.dot(lam, s.v) * s.ds + ufl.dot(c, mu) * s.ds_nodal

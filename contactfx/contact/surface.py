@@ -82,6 +82,13 @@ class SurfaceData:
     #: whatever its trial traction (Newton's reversal guard, :func:`contactfx.contact.laws.
     #: reversal`); None: the law itself
     stick: Expr | None = None
+    #: a multiplier's tie at the tips of a crack, where the jump and so the gap vanish
+    #: identically and the contact law cannot fix the multiplier: at a tip node, the
+    #: multiplier's value at the neighbouring node of the interface minus its own; zero at the
+    #: other nodes. None: no tips, or no multiplier
+    multiplier_tie: Expr | None = None
+    #: with ``multiplier_tie``: 1 at the tip nodes, 0 at the other nodes
+    at_tips: Expr | None = None
 
     sigma_n = staticmethod(sigma_n)
     sigma_t = staticmethod(sigma_t)
@@ -89,3 +96,14 @@ class SurfaceData:
     @property
     def mesh(self):
         return self.ds.ufl_domain()
+
+    def collocated(self, law):
+        """A multiplier's equation at the nodes (vertex rule): ``law``, the multiplier minus
+        its law's value, and at a crack tip the tie lambda(tip) = lambda(neighbour) instead.
+        This merges the tip node's multiplier basis function into its neighbour's, so that
+        the multiplier is constant on the tip element (the modified multiplier basis at the
+        ends of a contact surface: Wohlmuth 2000, doi:10.1137/S0036142999350929). Held to
+        zero there instead, the traction would fall to zero across the tip element."""
+        if self.multiplier_tie is None:
+            return law
+        return (1.0 - self.at_tips) * law - self.multiplier_tie

@@ -95,7 +95,7 @@ class InterfaceProblem(Problem):
             bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
         for i in range(d):
             bcs += self.confine(V.sub(d + i), self.free_mask)
-        return bcs + self.confine_multiplier(self.tips)
+        return bcs + self.confine_multiplier()  # tied at the tips (SurfaceData.collocated)
 
     def free_mask(self, Q) -> np.ndarray:
         """On the interface and not at a tip."""
@@ -124,7 +124,39 @@ class InterfaceProblem(Problem):
             ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
             multiplier=None if self.lam is None else self.lam("+"),
             multiplier_test=None if self.lam_test is None else self.lam_test("+"),
+            **self._multiplier_tie(),
         )  # fmt: skip
+
+    def _multiplier_tie(self) -> dict:
+        """The multiplier's tie at the crack tips (``SurfaceData.multiplier_tie``, ``at_tips``):
+        lambda(neighbour) - lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the
+        P1 multiplier on the tip's facet."""
+        if self.lam is None or not self.tips:
+            return {}
+        step = self._tip_steps()
+        return {
+            "multiplier_tie": ufl.dot(ufl.grad(self.lam), step)("+"),
+            "at_tips": ufl.conditional(ufl.gt(ufl.dot(step, step), 0.0), 1.0, 0.0)("+"),
+        }
+
+    def _tip_steps(self) -> dolfinx.fem.Function:
+        """P1 vector field: at each tip's node, the vector to the nearest other node of the
+        interface (its neighbour along the crack); zero at every other node."""
+        V1 = _compat.function_space(self.mesh, "Lagrange", 1, (self.gdim,))
+        x = _compat.dof_coordinates(V1)[:, : self.gdim]
+        on = surface_mask(V1, self.fdim, self.contact_facets)
+        step = dolfinx.fem.Function(V1, name="tip_step")
+        values = step.x.array.reshape(-1, self.gdim)
+        for point, tol in self.tips:
+            d = np.linalg.norm(x - point[: self.gdim], axis=1)
+            d[~on | (d < tol)] = np.inf
+            i = int(np.argmin(d)) if len(d) else 0
+            local = (float(d[i]), x[i]) if len(d) and np.isfinite(d[i]) else (np.inf, None)
+            dist, neighbour = min(self.mesh.comm.allgather(local), key=lambda c: c[0])
+            if not np.isfinite(dist):
+                raise ValueError(f"crack tip {point} has no neighbouring node on the interface")
+            values[at_points(V1, [(point, tol)])] = neighbour - point[: self.gdim]
+        return step
 
     def nodal_rule(self):
         return self.dS_nodal, "+"
@@ -149,7 +181,8 @@ class InterfaceProblem(Problem):
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
-        return self.free_mask(self.multiplier.function_space)
+        """On the interface, the tips included (tied to their neighbours)."""
+        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets)
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:

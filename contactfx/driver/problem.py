@@ -103,7 +103,7 @@ class Problem:
         self.lam, self.lam_test = (extra, extra_test) if field else (None, None)
         self.p, self.dp, self.q = (extra, d_extra, extra_test) if self.up else (None,) * 3
 
-    def confine_multiplier(self, excluded=(), supports=()) -> list:
+    def confine_multiplier(self, supports=()) -> list:
         """The ``"field"`` multiplier is zero away from the contact surface, and a traction
         multiplier's component i is zero where the displacement's component i is held by one
         of the ``supports`` (a symmetry plane through the contact zone): there that component
@@ -115,7 +115,7 @@ class Problem:
         W1 = self.state.function_space.sub(1)
 
         def on_surface(Q):
-            return surface_mask(Q, self.fdim, self.contact_facets, excluded)
+            return surface_mask(Q, self.fdim, self.contact_facets)
 
         held = [np.asarray(_compat.bc_dofs(bc)) for bc in supports]
         if not self.mult_shape or not held:
