@@ -27,8 +27,9 @@ lambda_n = p and lambda_T = T.
   doi:10.1016/j.cma.2004.09.012 for the semi-smooth Newton view of these equations).
 
 At a crack tip the gap vanishes identically, so no contact law fixes the multiplier there:
-both methods tie it to its neighbour's (:meth:`contactfx.contact.surface.SurfaceData.
-collocated`).
+al-ssn ties it to its neighbour's (:meth:`contactfx.contact.surface.SurfaceData.collocated`);
+al-uzawa holds it at zero (its outer loop, with the tip's update lagging its neighbour's,
+stopped converging on propped-fracture's closing branch).
 """
 
 from __future__ import annotations
@@ -132,12 +133,10 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
 
     def update(self, s: Surface):
         """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
-        lam = s.multiplier
-        p, _, t_T = self._augmented(s, lam)
-        new = p if t_T is None else -p * s.normal() + t_T
-        if s.multiplier_tie is None:
-            return new
-        return lam - s.collocated(lam - new)  # at a crack tip: the neighbour's multiplier
+        p, _, t_T = self._augmented(s, s.multiplier)
+        if t_T is None:
+            return p
+        return -p * s.normal() + t_T
 
     def residual(self, s: Surface):
         p, _, t_T = self._augmented(s, s.multiplier)

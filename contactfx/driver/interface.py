@@ -95,7 +95,7 @@ class InterfaceProblem(Problem):
             bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
         for i in range(d):
             bcs += self.confine(V.sub(d + i), self.free_mask)
-        return bcs + self.confine_multiplier()  # tied at the tips (SurfaceData.collocated)
+        return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_multiplier_tie)
 
     def free_mask(self, Q) -> np.ndarray:
         """On the interface and not at a tip."""
@@ -131,7 +131,7 @@ class InterfaceProblem(Problem):
         """The multiplier's tie at the crack tips (``SurfaceData.multiplier_tie``, ``at_tips``):
         lambda(neighbour) - lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the
         P1 multiplier on the tip's facet."""
-        if self.lam is None or not self.tips:
+        if self.method.multiplier != "field" or not self.tips:
             return {}
         step = self._tip_steps()
         return {
@@ -181,8 +181,8 @@ class InterfaceProblem(Problem):
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
-        """On the interface, the tips included (tied to their neighbours)."""
-        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets)
+        """On the interface and not at a tip (al-uzawa's tip multiplier is held at zero)."""
+        return self.free_mask(self.multiplier.function_space)
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:
