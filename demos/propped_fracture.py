@@ -43,7 +43,7 @@
 # fracture is open, the field of its faces' net pressure (docs/verification.md section 6).
 # The complementarity conditions are, for any $r > 0$, the equation
 # $\lambda = [\lambda - r g(w)]_+$ (Alart & Curnier 1991, doi:10.1016/0045-7825(91)90022-X).
-# The method `al-ssn` takes $\lambda$ as a P1 field on $\Gamma$ (zero at the tips), solved with
+# The method `al-ssn` takes $\lambda$ as a P1 field on $\Gamma$, solved with
 # $w$ by semi-smooth Newton (Hueeber & Wohlmuth 2005, doi:10.1016/j.cma.2004.09.012), and
 # collocates that equation at the nodes (vertex quadrature, $\mathrm{d}S_\text{nodal}$), with
 # $r = r_0 E / \{h\}$: for all $(v, \mu)$
@@ -58,6 +58,10 @@
 # &= 0.
 # \end{aligned}
 # $$
+#
+# At a tip the gap vanishes identically and the second equation cannot fix $\lambda$: there it
+# is replaced by $\lambda(\text{tip}) = \lambda(\text{neighbour})$ (`s.collocated`,
+# docs/verification.md section 6).
 #
 # The layer is first touched at $x = \pm b$ when the net pressure drops to
 # $p^* = h_p E' / (4 \sqrt{a^2 - b^2})$, $E' = E / (1 - \nu^2)$ (docs/verification.md section
@@ -111,7 +115,7 @@ def al_ssn_residual(s, r0):
     r = r0 * s.E / s.h
     g = ufl.dot(s.u, n_I) - s.floor
     lam, mu = s.multiplier, s.multiplier_test
-    C = lam - ufl.max_value(lam - r * g, 0.0)
+    C = s.collocated(lam - ufl.max_value(lam - r * g, 0.0))  # tied at the tips
     return -lam * ufl.dot(s.v, n_I) * s.ds + C * mu * s.ds_nodal
 
 
