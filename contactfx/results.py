@@ -245,6 +245,7 @@ MEASURES: dict[str, tuple[str, str, str]] = {
     "err_a": ("half-width a", "reference", "a_rel_error"),
     "err_p0": ("peak pressure p0", "reference", "p0_rel_error"),
     "err_p_L2": ("pressure, L2 on contact", "errors", "pressure_L2_rel"),
+    "err_p_in": ("crack pressure, L2 on |s| <= 0.8 a", "errors", "pressure_interior_L2_rel"),
     "err_u_L2": ("displacement, L2", "errors", "displacement_L2_rel"),
     "err_u_H1": ("displacement, H1 semi-norm", "errors", "displacement_H1_rel"),
     "err_punch": ("punch pressure on |x| <= 0.8 a", "scores", "normalised_pressure_error"),

@@ -96,7 +96,8 @@ class InterfacePost:
         self.a_expr = _compat.expression(ufl.as_vector([U[d + i] for i in range(d)]), V1)
 
     def _error_forms(self, s, p, t_I) -> dict[str, tuple]:
-        """Errors against the closed forms, integrated with a degree-12 rule."""
+        """Errors against the closed forms (the pressure also away from the tips), integrated
+        with a degree-12 rule."""
         out = {}
         sc, dSf = self.pb.s_coord, self.pb.dS_fine
         for name, computed, exact in (
@@ -107,6 +108,11 @@ class InterfacePost:
             if exact is not None:
                 out[name] = (dolfinx.fem.form((computed - exact) ** 2 * dSf),
                              dolfinx.fem.form(exact**2 * dSf))  # fmt: skip
+        interior = self.scene.away_from_tips(sc)
+        exact = self.scene.exact_pressure_interface(sc)
+        if interior is not None and exact is not None:
+            out["pressure_interior"] = (dolfinx.fem.form(interior * (p - exact) ** 2 * dSf),
+                                        dolfinx.fem.form(interior * exact**2 * dSf))  # fmt: skip
         return out
 
     def evaluate(self, solver) -> Quantities:

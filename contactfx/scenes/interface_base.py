@@ -75,6 +75,12 @@ class InterfaceScene(Scene):
         """Closed-form contact pressure on the interface (UFL in s), or None."""
         return None
 
+    def away_from_tips(self, s) -> Any:
+        """Indicator (UFL in s) of the part of the interface a fixed distance away from the
+        crack tips, where the pressure error is measured once more ('pressure_interior'), or
+        None (no tips, or no such measure)."""
+        return None
+
     def reference_profile(self, s: np.ndarray) -> dict[str, np.ndarray]:
         """Closed-form 'opening' / 'slip' at the coordinates s (numpy) for the plots."""
         return {}

@@ -122,6 +122,24 @@ def test_inclined_crack_KII_table(mu, column, beta):
     # proportional to the driving shear q, 2.7-3.6 % of q / sigma_n on this mesh
     q = ref["K_II_exact"] / math.sqrt(math.pi)
     assert data.errors["pressure_L2_rel"] < 0.045 * q / ref["sigma_n"]
+    # a fixed distance from the tips (|s| <= 0.8 a) that pollution is O(h): 0.26-0.46 % of
+    # q / sigma_n on this mesh over the table (section 6, "Tractions at the tips")
+    assert data.errors["pressure_interior_L2_rel"] < 0.007 * q / ref["sigma_n"]
+
+
+@pytest.mark.parametrize("method", ["nitsche", "al-ssn"])
+def test_inclined_crack_pressure_converges_away_from_tips(method):
+    """beta = 45, mu = 0.3 at h_crack = 0.05, 0.025, 0.0125 (the bench's levels): on
+    |s| <= 0.8 a the pressure error converges like O(h), while over the whole crack the tips
+    keep it at a few per cent on every mesh (docs/verification.md section 6)."""
+    errors = []
+    for h in (0.05, 0.025, 0.0125):
+        params = CrackInclined.Params(beta=45.0, h_crack=h, h_tip=h / 10, h_far=20 * h)
+        errors.append(_run(CrackInclined(params), method=method, mu=0.3)
+                      .errors["pressure_interior_L2_rel"])  # fmt: skip
+    rate = math.log2(errors[0] / errors[2]) / 2.0
+    # O(h) expected; 0.94 (al-ssn) and 1.14 (Nitsche) measured over the three levels
+    assert rate > 0.8, errors
 
 
 @pytest.mark.parametrize("numerics", CONSISTENT[2:] + [dict(method="penalty")],
@@ -140,6 +158,11 @@ def test_inclined_crack_methods_agree(numerics):
         # elements; al-ssn ties it to the neighbour's, docs/verification.md section 6)
         q = ref["K_II_exact"] / math.sqrt(math.pi)
         assert data.errors["pressure_L2_rel"] < 0.045 * q / ref["sigma_n"]
+    if numerics["method"] in ("al-ssn", "al-uzawa"):
+        # away from the tips as Nitsche's bound in test_inclined_crack_KII_table (0.37 % of
+        # q / sigma_n measured for both: they differ only at the tip nodes)
+        q = ref["K_II_exact"] / math.sqrt(math.pi)
+        assert data.errors["pressure_interior_L2_rel"] < 0.007 * q / ref["sigma_n"]
 
 
 def test_inclined_crack_tresca():
