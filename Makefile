@@ -33,7 +33,7 @@ test: install
 
 # The committed results page docs/results.md (over an hour on 2 cores: up to 850 runs): error against run time
 # for every case and method, and the robustness matrix.
-BENCH_METHODS := nitsche,nitsche@1+nodal,penalty,al-uzawa,al-ssn,vi
+BENCH_METHODS := nitsche,nitsche@1+nodal,penalty,al-uzawa,al-ssn,vi,mortar
 results: install
 	mpirun -n $(NP) $(VENV)/bin/contactfx bench --scene all --method $(BENCH_METHODS) \
 		--degree 1,2 --levels 3 --out docs/results/bench

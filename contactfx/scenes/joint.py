@@ -43,6 +43,10 @@ class JointColumnParams(elastic(10e9, 0.25)):
         super().__post_init__()
         if self.Vm > self.aperture:
             raise ValueError(f"--Vm ({self.Vm}) must be <= --aperture ({self.aperture})")
+        if self.fluid_pressure > self.closure_stress:
+            raise ValueError(f"--fluid-pressure ({self.fluid_pressure:g}) exceeds --closure-stress "
+                             f"({self.closure_stress:g}): the joint would open and the upper "
+                             "block has no equilibrium")  # fmt: skip
 
 
 class JointColumn(InterfaceScene):

@@ -274,7 +274,7 @@ def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = [write_csv(rows, out / "stress.csv")]
-    failed = [r for r in rows if r["status"] not in ("converged", "n/a")]
+    failed = [r for r in rows if r["status"] not in ("converged", "n/a", "refused")]
     md = [
         "# contactfx stress: robustness matrix",
         "",

@@ -43,6 +43,31 @@ def test_every_method_converges_on_default_case(case):
             assert row["newton"] > 0 and row["dofs"] > 0
 
 
+def test_refusals_are_not_applicable():
+    """What a problem kind refuses before any solve is n/a, not failed: methods without two-body
+    contact, P2 between bodies, mortar against an obstacle."""
+    for case, method, degree, words in (("patch-test", "al-ssn", 1, "two meshed bodies"),
+                                        ("patch-test", "vi", 1, "two meshed bodies"),
+                                        ("patch-test", "nitsche", 2, "P1"),
+                                        ("hertz2d", "mortar", 1, "mortar")):  # fmt: skip
+        row, _, _ = run_case(case, method, {"method": method}, degree, 0, COMM)
+        assert row["status"] == "n/a", (case, method, row)
+        assert words in row["reason"], row["reason"]
+
+
+def test_stress_refuses_joint_without_equilibrium(shared_dir):
+    """Fluid pressure above the closure stress: the scene refuses it (status refused, not
+    counted as a failure); the cases with an equilibrium converge."""
+    assert cmd_stress(["--axis", "joint closure", "--out", str(shared_dir)], {}, COMM) == 0
+    if COMM.rank == 0:
+        rows = {r["case"]: r for r in _read_csv(shared_dir / "stress.csv")}
+        refused = rows["joint s_c=3e+07 p=4e+07"]
+        assert refused["status"] == "refused"
+        assert "exceeds --closure-stress" in refused["reason"]
+        assert all(r["status"] == "converged" for c, r in rows.items() if r is not refused)
+        assert ", 0 not converged" in (shared_dir / "stress.md").read_text()
+
+
 def test_bench_outputs_well_formed(shared_dir):
     argv = ["--scene", "hertz2d,westergaard-full", "--method", "nitsche@1,al-ssn",
             "--levels", "2", "--out", str(shared_dir)]  # fmt: skip
@@ -92,7 +117,7 @@ def test_stress_quick_rows(shared_dir):
             assert r["status"] == "converged"
             assert float(r["penetration_over_h"]) < 1e-3
         for r in rows:
-            assert r["status"] in ("converged", "failed", "time limit", "n/a")
+            assert r["status"] in ("converged", "failed", "time limit", "n/a", "refused")
             if r["status"] == "converged":
                 assert math.isfinite(float(r["error"])) and int(r["newton"]) >= 0
         if COMM.size == 1:  # the parallel axis launches mpirun children from a serial run
