@@ -79,7 +79,7 @@ CASES: dict[str, BenchCase] = {
         {"mean_pressure_ratio": 1.5, "h_contact": 1 / 8, "h_far": 1 / 8},
         1.0,
         "Westergaard, full contact p_m = 1.5 p*, uniform mesh, exact displacement",
-    ),
+    ),  # fmt: skip
     "punch2d": BenchCase("punch2d", {}, 2.0, "flat rigid punch, plane strain"),
     "sliding-block": BenchCase("sliding-block", {}, 2.0, "Coulomb block dragged to gross slip"),
     "crack-sneddon": BenchCase("crack-sneddon", {}, 2.0, "pressurised crack, Sneddon opening"),
@@ -98,7 +98,7 @@ CASES: dict[str, BenchCase] = {
         {"net_pressure": 1e6},
         2.0,
         "propped fracture, open branch p_net > p* (Sneddon)",
-    ),
+    ),  # fmt: skip
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
     "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
     "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),

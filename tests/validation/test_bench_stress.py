@@ -64,7 +64,7 @@ def test_stress_refuses_joint_without_equilibrium(shared_dir):
         refused = rows["joint s_c=3e+07 p=4e+07"]
         assert refused["status"] == "refused"
         assert "exceeds --closure-stress" in refused["reason"]
-        assert all(r["status"] == "converged" for c, r in rows.items() if r is not refused)
+        assert all(r["status"] == "converged" for r in rows.values() if r is not refused)
         assert ", 0 not converged" in (shared_dir / "stress.md").read_text()
 
 
