@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 
 from contactfx.cli.args import Parser, finish_table
-from contactfx.validation.report import write_stress
+from contactfx.validation.report import STRESS_SETTLED, write_stress
 from contactfx.validation.stress import cases, run_stress
 
 __all__ = ["cmd_stress"]
@@ -37,7 +37,7 @@ def cmd_stress(argv: list[str], petsc_options: dict, comm) -> int:
         selected = [c for c in selected if c.axis in axes]
     started = time.perf_counter()
     rows = run_stress(selected, comm, ns.time_limit)
-    failed = sum(r["status"] not in ("converged", "n/a", "refused") for r in rows)
+    failed = sum(r["status"] not in STRESS_SETTLED for r in rows)
     finish_table(rows, comm, started, f"stress: {len(rows)} cases, {failed} not converged, "
                  "{total:.0f} s", ns.out, write_stress)  # fmt: skip
     return 0

@@ -100,19 +100,16 @@ class InterfacePost:
         with a degree-12 rule."""
         out = {}
         sc, dSf = self.pb.s_coord, self.pb.dS_fine
-        for name, computed, exact in (
-            ("opening", s.opening(), self.scene.exact_opening(sc)),
-            ("slip", ufl.dot(s.u, t_I), self.scene.exact_slip(sc)),
-            ("pressure", p, self.scene.exact_pressure_interface(sc)),
+        exact_p, interior = self.scene.exact_pressure_interface(sc), self.scene.away_from_tips(sc)
+        for name, computed, exact, weight in (
+            ("opening", s.opening(), self.scene.exact_opening(sc), 1.0),
+            ("slip", ufl.dot(s.u, t_I), self.scene.exact_slip(sc), 1.0),
+            ("pressure", p, exact_p, 1.0),
+            ("pressure_interior", p, None if interior is None else exact_p, interior),
         ):
             if exact is not None:
-                out[name] = (dolfinx.fem.form((computed - exact) ** 2 * dSf),
-                             dolfinx.fem.form(exact**2 * dSf))  # fmt: skip
-        interior = self.scene.away_from_tips(sc)
-        exact = self.scene.exact_pressure_interface(sc)
-        if interior is not None and exact is not None:
-            out["pressure_interior"] = (dolfinx.fem.form(interior * (p - exact) ** 2 * dSf),
-                                        dolfinx.fem.form(interior * exact**2 * dSf))  # fmt: skip
+                out[name] = (dolfinx.fem.form(weight * (computed - exact) ** 2 * dSf),
+                             dolfinx.fem.form(weight * exact**2 * dSf))  # fmt: skip
         return out
 
     def evaluate(self, solver) -> Quantities:

@@ -269,12 +269,16 @@ def method_guide(rows: list[dict]) -> list[str]:
 ROUNDOFF_GUIDE = 1e-10
 
 
+#: stress statuses that are not failures (a refusal is one only where the case expects it)
+STRESS_SETTLED = ("converged", "n/a", "refused")
+
+
 def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
     """stress.csv, stress.md and gamma0.png; returns the paths written."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = [write_csv(rows, out / "stress.csv")]
-    failed = [r for r in rows if r["status"] not in ("converged", "n/a", "refused")]
+    failed = [r for r in rows if r["status"] not in STRESS_SETTLED]
     md = [
         "# contactfx stress: robustness matrix",
         "",
