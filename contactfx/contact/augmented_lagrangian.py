@@ -28,8 +28,12 @@ lambda_n = p and lambda_T = T.
 
 At a crack tip the gap vanishes identically, so no contact law fixes the multiplier there:
 al-ssn ties it to its neighbour's (:meth:`contactfx.contact.surface.SurfaceData.collocated`);
-al-uzawa holds it at zero (its outer loop, with the tip's update lagging its neighbour's,
-stopped converging on propped-fracture's closing branch).
+al-uzawa writes its augmented traction on the tip's element with the neighbour's multiplier,
+gap and slip (:meth:`contactfx.contact.interface.InterfaceSurface.tip_extended`), so that the
+tip carries its neighbour's augmented traction inside each Newton solve. (A tie in its nodal
+update alone, the tip taking its neighbour's last multiplier as a fixed traction without the
+augmentation's stiffness, stopped the outer loop converging on propped-fracture's closing
+branch.)
 """
 
 from __future__ import annotations
@@ -73,10 +77,17 @@ class _AugmentedBase(MethodBase):
     def r(self, s: Surface):
         return self.r0 * s.E / s.h
 
-    def _augmented(self, s: Surface, lam):
-        """(p, T trial, T) from the multiplier lam; T and its trial are None without friction."""
+    def _continued(self, s: Surface) -> Surface:
+        """The surface the augmented tractions are written on (al-uzawa: continued over the
+        crack tips' elements)."""
+        return s
+
+    def _augmented(self, s: Surface):
+        """(p, T trial, T) from the surface's multiplier; T and its trial are None without
+        friction."""
+        s = self._continued(s)
         n = s.normal()
-        lam_n, lam_t = split_multiplier(lam, n)
+        lam_n, lam_t = split_multiplier(s.multiplier, n)
         p = positive_part(lam_n - self.r(s) * s.gap())
         if s.friction is None:
             return p, None, None
@@ -86,11 +97,11 @@ class _AugmentedBase(MethodBase):
     def trial_traction(self, s: Surface):
         """The trial tangential traction lambda_T - r du_T and the friction bound (with
         friction)."""
-        p, trial, _ = self._augmented(s, s.multiplier)
+        p, trial, _ = self._augmented(s)
         return trial, s.friction.bound(p)
 
-    def _slip(self, s: Surface, lam):
-        p, trial, _ = self._augmented(s, lam)
+    def _slip(self, s: Surface):
+        p, trial, _ = self._augmented(s)
         return active(p) * active(norm(trial, s.E) - s.friction.bound(p))
 
 
@@ -122,24 +133,30 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
         return Uzawa(solver, problem.multiplier, update, problem.multiplier_mask,
                      tol=self.al_tol, max_it=self.al_max_it)  # fmt: skip
 
+    def _continued(self, s: Surface) -> Surface:
+        """At a crack tip the gap and the slip vanish identically, so the augmented traction
+        there would be the held multiplier alone: the tip's element takes its neighbour's
+        augmented traction instead (``tip_extended``), with its derivative in the Jacobian."""
+        return s.tip_extended()
+
     def pressure(self, s: Surface):
-        return self._augmented(s, s.multiplier)[0]
+        return self._augmented(s)[0]
 
     def tangential_traction(self, s: Surface):
-        return self._augmented(s, s.multiplier)[2]
+        return self._augmented(s)[2]
 
     def slip_indicator(self, s: Surface):
-        return self._slip(s, s.multiplier)
+        return self._slip(s)
 
     def update(self, s: Surface):
         """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
-        p, _, t_T = self._augmented(s, s.multiplier)
+        p, _, t_T = self._augmented(s)
         if t_T is None:
             return p
         return -p * s.normal() + t_T
 
     def residual(self, s: Surface):
-        p, _, t_T = self._augmented(s, s.multiplier)
+        p, _, t_T = self._augmented(s)
         form = p * ufl.dot(s.v, s.normal()) * s.ds
         if t_T is not None:
             form -= ufl.dot(t_T, s.v) * s.ds
@@ -174,17 +191,17 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     def contact_indicator(self, s: Surface):
         """[lambda_n - r g]_+: > 0 exactly where the surfaces are closed (between the nodes
         too; lambda_n itself only vanishes up to the solver tolerance where open)."""
-        return self._augmented(s, s.multiplier)[0]
+        return self._augmented(s)[0]
 
     def slip_indicator(self, s: Surface):
-        return self._slip(s, s.multiplier)
+        return self._slip(s)
 
     def residual(self, s: Surface):
         n = s.normal()
         lam, mu = s.multiplier, s.multiplier_test
         lam_n, lam_t = split_multiplier(lam, n)
         r = self.r(s)
-        p, _, t_T = self._augmented(s, lam)
+        p, _, t_T = self._augmented(s)
         if self.ncp == "min":
             c_n = lam_n - p
         else:

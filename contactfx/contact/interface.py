@@ -41,7 +41,7 @@ Interface laws beyond Signorini, all through the gap (the laws module's forms ar
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import ufl
 
@@ -113,6 +113,9 @@ class InterfaceSurface(SurfaceData):
     floor: Expr | None = None
     fluid: Expr | None = None
     joint: BartonBandis | None = None
+    #: P1 vector field: at each crack tip's node the vector to its neighbouring node on the
+    #: interface, zero at the other nodes (unrestricted); None without tips
+    tip_step: Expr | None = None
 
     # -- the ContactSurface members the methods use -----------------------------------------
     @property
@@ -170,6 +173,34 @@ class InterfaceSurface(SurfaceData):
         if self.joint is not None:
             g = g + self.joint.closure(positive_part(self.effective_pressure()))
         return g
+
+    def tip_extended(self):
+        """This surface with the motion w, the previous motion and the multiplier replaced, on
+        each tip's element, by their values at the tip's neighbour, and unchanged elsewhere.
+        With d = ``tip_step`` = (x_neighbour - x_tip) phi_tip (phi_tip the tip node's P1 basis
+        function), x + d is the neighbour's node at every point x of the tip's facet and x
+        elsewhere, so the Taylor expansion f + grad(f) . d + d . grad(grad(f)) . d / 2 is the
+        constant f(neighbour) on the tip's element for any field of degree <= 2 in the cell
+        (P1 and P2). The jump, and so the gap and the slip, vanish identically at a tip, so a
+        law written on them alone (al-uzawa's augmented pressure [lambda - r g]_+ with a
+        multiplier held at the nodes) would otherwise let the traction fall to the tip's value
+        across the element; continued, the tip element carries its neighbour's augmented
+        traction, with its derivative in Newton's Jacobian. This is al-ssn's tie
+        (``collocated``) written into the law instead of a multiplier row."""
+        if self.tip_step is None:
+            return self
+        d = self.tip_step
+
+        def extend(f):
+            if f is None:
+                return None
+            return f + ufl.dot(ufl.grad(f), d) + 0.5 * ufl.dot(ufl.dot(ufl.grad(ufl.grad(f)), d), d)
+
+        lam = self.multiplier
+        if lam is not None and self.multiplier_tie is not None:
+            lam = lam + self.multiplier_tie
+        return replace(self, w=extend(self.w), u_prev=extend(self.u_prev), multiplier=lam,
+                       tip_step=None)  # fmt: skip
 
     def slip_increment(self, n):
         """Tangential jump increment since the last converged step."""

@@ -107,3 +107,9 @@ class SurfaceData:
         if self.multiplier_tie is None:
             return law
         return (1.0 - self.at_tips) * law - self.multiplier_tie
+
+    def tip_extended(self):
+        """The surface whose motion and multiplier are continued over each crack tip's
+        element from its other node (see :meth:`contactfx.contact.interface.InterfaceSurface.
+        tip_extended`); without crack tips the surface itself."""
+        return self

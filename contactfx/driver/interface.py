@@ -95,7 +95,7 @@ class InterfaceProblem(Problem):
             bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
         for i in range(d):
             bcs += self.confine(V.sub(d + i), self.free_mask)
-        return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_multiplier_tie)
+        return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_tip_terms)
 
     def free_mask(self, Q) -> np.ndarray:
         """On the interface and not at a tip."""
@@ -124,20 +124,23 @@ class InterfaceProblem(Problem):
             ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
             multiplier=None if self.lam is None else self.lam("+"),
             multiplier_test=None if self.lam_test is None else self.lam_test("+"),
-            **self._multiplier_tie(),
+            **self._tip_terms(),
         )  # fmt: skip
 
-    def _multiplier_tie(self) -> dict:
-        """The multiplier's tie at the crack tips (``SurfaceData.multiplier_tie``, ``at_tips``):
-        lambda(neighbour) - lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the
-        P1 multiplier on the tip's facet."""
-        if self.method.multiplier != "field" or not self.tips:
+    def _tip_terms(self) -> dict:
+        """What the methods need at the crack tips: ``tip_step`` (the vector from each tip's
+        node to its neighbour's, ``InterfaceSurface.tip_extended``) and, with a multiplier,
+        its tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) - lambda(tip)
+        = grad(lambda) . (x_neighbour - x_tip), exact for the P1 multiplier on the tip's
+        facet."""
+        if not self.tips:
             return {}
         step = self._tip_steps()
-        return {
-            "multiplier_tie": ufl.dot(ufl.grad(self.lam), step)("+"),
-            "at_tips": ufl.conditional(ufl.gt(ufl.dot(step, step), 0.0), 1.0, 0.0)("+"),
-        }
+        terms = {"tip_step": step}
+        if self.lam is not None:
+            terms["multiplier_tie"] = ufl.dot(ufl.grad(self.lam), step)("+")
+            terms["at_tips"] = ufl.conditional(ufl.gt(ufl.dot(step, step), 0.0), 1.0, 0.0)("+")
+        return terms
 
     def _tip_steps(self) -> dolfinx.fem.Function:
         """P1 vector field: at each tip's node, the vector to the nearest other node of the
@@ -181,8 +184,9 @@ class InterfaceProblem(Problem):
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
-        """On the interface and not at a tip (al-uzawa's tip multiplier is held at zero)."""
-        return self.free_mask(self.multiplier.function_space)
+        """On the interface, the tips included (al-uzawa's update gives a tip its neighbour's
+        value: ``InterfaceSurface.tip_extended``)."""
+        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets)
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:
