@@ -128,19 +128,19 @@ class InterfaceProblem(Problem):
         )  # fmt: skip
 
     def _tip_terms(self) -> dict:
-        """What the methods need at the crack tips: ``tip_step`` (the vector from each tip's
-        node to its neighbour's, ``InterfaceSurface.tip_extended``) and, with a multiplier,
-        its tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) - lambda(tip)
-        = grad(lambda) . (x_neighbour - x_tip), exact for the P1 multiplier on the tip's
-        facet."""
-        if not self.tips:
+        """What the multiplier methods need at the crack tips: ``tip_step`` (the vector from
+        each tip's node to its neighbour's, ``InterfaceSurface.tip_extended``) and the
+        multiplier's tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) -
+        lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the P1 multiplier on the
+        tip's facet."""
+        if self.lam is None or not self.tips:
             return {}
         step = self._tip_steps()
-        terms = {"tip_step": step}
-        if self.lam is not None:
-            terms["multiplier_tie"] = ufl.dot(ufl.grad(self.lam), step)("+")
-            terms["at_tips"] = ufl.conditional(ufl.gt(ufl.dot(step, step), 0.0), 1.0, 0.0)("+")
-        return terms
+        return {
+            "tip_step": step,
+            "multiplier_tie": ufl.dot(ufl.grad(self.lam), step)("+"),
+            "at_tips": ufl.conditional(ufl.gt(ufl.dot(step, step), 0.0), 1.0, 0.0)("+"),
+        }
 
     def _tip_steps(self) -> dolfinx.fem.Function:
         """P1 vector field: at each tip's node, the vector to the nearest other node of the
