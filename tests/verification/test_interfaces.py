@@ -77,14 +77,16 @@ def test_sneddon_opening_converges():
     assert min(rates) > 0.9, (errors, rates)
 
 
-@pytest.mark.parametrize("numerics", CONSISTENT, ids=IDS)
+@pytest.mark.parametrize("numerics", CONSISTENT + [dict(method="al-uzawa", degree=2)],
+                         ids=IDS + ["al-uzawa-P2"])  # fmt: skip
 def test_sneddon_suction_closes_with_uniform_pressure(numerics):
     data = _run(CrackSneddon(CrackSneddon.Params(pressure=-1e6)), **numerics)
     # the faces touch everywhere and carry -p; the body is unstressed: exact on any mesh up to
     # the solver tolerance, for every method (measured 7e-15). The augmented Lagrangian
     # methods carry the neighbour's traction over each tip element (al-ssn's multiplier tie,
     # al-uzawa's InterfaceSurface.tip_extended): with the tip's traction at zero instead the
-    # force was short by the two tip elements, h_tip / a = 2.5e-3 each
+    # force was short by the two tip elements, h_tip / a = 2.5e-3 each (al-uzawa P2 as well:
+    # its multiplier is P1 whatever the displacement's degree)
     assert data.reference["force_rel_error"] < 1e-8
     assert data.max_penetration < 1e-12
 
