@@ -5,14 +5,15 @@ doi:10.1016/0020-7225(88)90038-6), frictionless.
 The interpenetration is a model of the surface asperities being flattened: m = 1 is the linear
 penalty, m > 1 stiffens with the closure. The stiffness is scaled as the penalty's,
 k = kappa0 E / h^m, so that p = kappa0 E ([-g]_+ / h)^m and m = 1 gives
-:class:`contactfx.contact.penalty.Penalty` exactly. The residual adds int p v.n ds; the
-derivative m k [-g]_+^(m-1) vanishes at g = 0 for m > 1 (a smooth law: Newton converges
-quadratically, unlike the semi-smooth penalty).
+:class:`contactfx.contact.penalty.Penalty` exactly (h the same continuous nodal size). The
+residual adds int p v.n ds; the derivative m k [-g]_+^(m-1) vanishes at g = 0 for m > 1 (a
+smooth law: Newton converges quadratically, unlike the semi-smooth penalty).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import ufl
 
@@ -32,6 +33,7 @@ class NormalCompliance(MethodBase):
                           option="penalty")  # fmt: skip
     exponent: float = param(2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m",
                             positive=True)  # fmt: skip
+    nodal_size: ClassVar[bool] = True
     name = "compliance"
     sweep = ("exponent", (1.0, 1.5, 2.0))
     supports = Supports(mixed_up=True, nodal_quadrature=True, interfaces=True,
@@ -41,7 +43,7 @@ class NormalCompliance(MethodBase):
         validate(self)
 
     def pressure(self, s: Surface):
-        return self.kappa0 * s.E * (positive_part(-s.gap()) / s.h) ** self.exponent
+        return self.kappa0 * s.E * (positive_part(-s.gap()) / s.h_continuous) ** self.exponent
 
     def residual(self, s: Surface):
         return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

@@ -78,6 +78,9 @@ class MethodBase:
     #: with friction, whether the method's law needs the tangential traction of the last
     #: converged step (the surface's ``traction_prev``, kept by the driver)
     traction_history: ClassVar[bool] = False
+    #: whether the method's stiffness is scaled by a mesh size that must be continuous along
+    #: the surface (the surface's ``h_nodal``, built by the driver)
+    nodal_size: ClassVar[bool] = False
     supports: ClassVar[Supports] = Supports()
     #: the option that tells the method's variants apart, and the values ``contactfx bench
     #: --method NAME`` runs ("": none)

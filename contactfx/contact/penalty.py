@@ -2,7 +2,10 @@
 
 p = kappa [-g(u)]_+ with kappa = kappa0 E / h; the residual adds int p v.n ds (Kikuchi & Oden
 1988, doi:10.1137/1.9781611970845). The penetration is O(p h / (kappa0 E)): the method is not
-consistent, the error falls as kappa0 grows (and the conditioning worsens).
+consistent, the error falls as kappa0 grows (and the conditioning worsens). h is the surface's
+continuous nodal mesh size (``SurfaceData.h_nodal``): with the facet-wise size the traction
+carries an error of the order of the cell-size jitter that no refinement removes
+(docs/verification.md section 6).
 
 Friction: the stick is a tangential spring of the same stiffness, and the slip its plastic
 part (Wriggers 2006, Computational Contact Mechanics, 2nd ed., chapter 5,
@@ -50,12 +53,13 @@ class Penalty(TrialFriction, MethodBase):
     )  # fmt: skip
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
     traction_history: ClassVar[bool] = True
+    nodal_size: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         validate(self)
 
     def kappa(self, s: Surface):
-        return self.kappa0 * s.E / s.h
+        return self.kappa0 * s.E / s.h_continuous
 
     def pressure(self, s: Surface):
         return self.kappa(s) * positive_part(-s.gap())

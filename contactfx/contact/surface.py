@@ -89,6 +89,14 @@ class SurfaceData:
     multiplier_tie: Expr | None = None
     #: with ``multiplier_tie``: 1 at the tip nodes, 0 at the other nodes
     at_tips: Expr | None = None
+    #: the mesh size as a continuous P1 field along the surface (at each node the
+    #: length-weighted mean of its facets' h), for a method whose traction is a stiffness
+    #: kappa ~ 1 / h times the overlap (``nodal_size``); else None. With the facet-wise h,
+    #: neighbouring facets of different sizes have different stiffnesses: a uniform pressure
+    #: would need an overlap that jumps at the node between them, which a continuous
+    #: displacement cannot give, and the traction error is of the order of the relative
+    #: jitter of the cell sizes at every refinement
+    h_nodal: Expr | None = None
 
     sigma_n = staticmethod(sigma_n)
     sigma_t = staticmethod(sigma_t)
@@ -107,6 +115,11 @@ class SurfaceData:
         if self.multiplier_tie is None:
             return law
         return (1.0 - self.at_tips) * law - self.multiplier_tie
+
+    @property
+    def h_continuous(self):
+        """``h_nodal`` where the driver built it, else the facet-wise h."""
+        return self.h if self.h_nodal is None else self.h_nodal
 
     def tip_extended(self):
         """The surface whose motion and multiplier are continued over each crack tip's

@@ -71,6 +71,8 @@ class Problem:
             self.multiplier = dolfinx.fem.Function(space, name="multiplier")
             self.lam = self.multiplier
         self.surface = self.make_surface()
+        if self.surface is not None and method.nodal_size:
+            self.surface = dataclasses.replace(self.surface, h_nodal=self._nodal_size())
         #: Newton's previous iterate (the friction law's reversal guard), or None
         self.iterate = None
 
@@ -196,8 +198,18 @@ class Problem:
 
     def nodal_rule(self):
         """(the contact measure with the vertex rule, the restriction of its integrands or
-        None): where the traction history is evaluated."""
-        raise NotImplementedError(f"{type(self).__name__} keeps no traction history")
+        None): where the traction history and the nodal mesh size are evaluated."""
+        raise NotImplementedError(f"{type(self).__name__} has no vertex rule on its surface")
+
+    def _nodal_size(self):
+        """The surface's mesh size at its P1 nodes (``SurfaceData.h_nodal``): the lumped
+        projection of the facet-wise h with the vertex rule, the length-weighted mean of the
+        sizes of a node's facets."""
+        measure, restrict = self.nodal_rule()
+        h = dolfinx.fem.Function(_compat.function_space(self.mesh, "Lagrange", 1), name="h")
+        proj = NodalProjection(measure, h.function_space, restrict)
+        proj(proj.form(self.surface.h), h)
+        return h if restrict is None else h(restrict)
 
     def converged(self) -> None:
         """A step converged: it is the history of the next (the state and, for a method that

@@ -111,9 +111,11 @@ def test_penalty_stick_keeps_its_traction(quadrature):
     state does not depend on the steps: 2 steps (one press, one drag) and 10 give the same Q.
     Without the history the traction restarts from the step's own increment: Q differs by
     4.7 % between the two programs (measured with the history update switched off). With it:
-    4e-6 with Gauss points, where a node's history is the average over its facets of laws whose
-    kappa = penalty E / h differs with the cells' diameters (1e-7 with the vertex rule, where
-    only that average remains); asserted to 5e-5."""
+    9e-6 with Gauss points, where the history between the nodes is the P1 interpolant of the
+    nodal tractions, not the Gauss points' own (asserted to 5e-5); 3e-13 with the vertex rule,
+    where the law is exact at the nodes (asserted to 1e-9, the Newton tolerance 1e-10 over
+    the steps). It was 1e-7 there while kappa = penalty E / h took each facet's own h: a
+    node's history averaged facet laws of different stiffnesses (SurfaceData.h_nodal)."""
     params = SlidingBlockParams(shift=1e-4)
     q = []
     for steps in (2, 10):
@@ -122,7 +124,7 @@ def test_penalty_stick_keeps_its_traction(quadrature):
         res = SlidingBlock(params).run(num, verbose=False)
         assert res.friction.slip_fraction == pytest.approx(0.0, abs=1e-12)  # all stick
         q.append(res.friction.tangential_force[0])
-    assert q[1] == pytest.approx(q[0], rel=5e-5)
+    assert q[1] == pytest.approx(q[0], rel=5e-5 if quadrature == "gauss" else 1e-9)
     # the spring is soft (kappa = E / h): the face lags the plane; Q well below mu P
     assert 0.0 < abs(q[0]) < 0.01 * res.friction.bound
 
