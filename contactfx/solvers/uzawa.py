@@ -21,7 +21,15 @@ class Uzawa:
     constraint violation and complementarity residual are then below tol max |lambda| / r.
     On failure (inner divergence or ``max_it`` outer iterations) the multiplier of the last
     converged load step is restored and ``ConvergenceError`` raised, so load cut-back works.
+
+    The Newton solves also stop at a step below ``STEP_TOL`` of the displacement (unless the
+    user sets ``snes_stol``): after the first, each starts from a residual as small as the
+    multiplier's last change, and ``rtol`` of that can lie below the residual's round-off
+    floor, where Newton would stagnate until ``max_it`` (Westergaard in full contact, P2).
     """
+
+    #: the Newton step, relative to the state, below which an inner solve has converged
+    STEP_TOL = 1e-12
 
     def __init__(self, inner: ContactSNES, multiplier, update, mask: np.ndarray, *, tol: float,
                  max_it: int) -> None:  # fmt: skip
@@ -51,6 +59,16 @@ class Uzawa:
         bs = self.multiplier.function_space.dofmap.index_map_bs
         mask = np.repeat(self.mask, bs) if bs > 1 else self.mask.copy()
         mask[imap.size_local * bs :] = False  # owned dofs decide; ghosts follow
+        snes = self.inner.snes
+        stol = snes.getTolerances()[2]
+        if not {"snes_stol", self.inner.prefix + "snes_stol"} & set(self.inner.user_options):
+            snes.setTolerances(stol=max(stol, self.STEP_TOL))
+        try:
+            return self._iterate(lam, saved, mask, total)
+        finally:
+            snes.setTolerances(stol=stol)
+
+    def _iterate(self, lam, saved, mask, total) -> SolveStats:
         for k in range(1, self.max_it + 1):
             try:
                 stats = self.inner.solve()
