@@ -131,6 +131,7 @@ random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, coulomb_nitsche_residual(s, num.theta, num.gamma0, num.mu))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 # -
 
 # Solve: the sliding crack with both methods (the Nitsche run writes its output, with the slip

@@ -128,6 +128,7 @@ random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, crack_nitsche_residual(s, num.theta, num.gamma0))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 # -
 
 # Solve the pressurised crack, writing the ParaView files (`crack-sneddon.pvd`: the crack faces

@@ -116,6 +116,7 @@ random_state(problem.state, scene.p.depth)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, nitsche_residual(s, num.theta, num.gamma0))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 # -
 
 # Solve. `scene.run` returns a `contactfx.results.RunSummary`: named fields for the contact

@@ -126,6 +126,7 @@ random_state(problem.multiplier, 30e6)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, uzawa_residual(s, num.r0, scene.p.Kni, scene.p.Vm))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 # -
 
 # Solve the three load cases with both methods; the output of the last run is in

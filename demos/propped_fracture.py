@@ -133,6 +133,7 @@ random_state(problem.state, 1e-4)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, al_ssn_residual(s, num.r0))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 # -
 
 # Solve above and below $p^*$; each run writes its output (`interface.png` shows the aperture

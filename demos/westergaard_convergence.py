@@ -119,6 +119,7 @@ random_state(problem.state, scene.p.amplitude)
 s = problem.surface
 F_run = method.residual(s)
 mismatch = relative_difference(F_run, nitsche_residual(s, num.theta, num.gamma0))
+assert mismatch < 1e-12, mismatch  # the run assembles exactly this residual
 if MPI.COMM_WORLD.rank == 0:
     print(f"load steps {num.steps}")
     print(f"method.residual vs the formula: relative difference {mismatch:.1e}")

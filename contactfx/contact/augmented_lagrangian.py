@@ -77,15 +77,10 @@ class _AugmentedBase(MethodBase):
     def r(self, s: Surface):
         return self.r0 * s.E / s.h
 
-    def _continued(self, s: Surface) -> Surface:
-        """The surface the augmented tractions are written on (al-uzawa: continued over the
-        crack tips' elements)."""
-        return s
-
     def _augmented(self, s: Surface):
         """(p, T trial, T) from the surface's multiplier; T and its trial are None without
         friction."""
-        s = self._continued(s)
+        s = self.law_surface(s)
         n = s.normal()
         lam_n, lam_t = split_multiplier(s.multiplier, n)
         p = positive_part(lam_n - self.r(s) * s.gap())
@@ -117,6 +112,10 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
     name = "al-uzawa"
     sweep = ("r0", ())
     multiplier = "nodal"
+    #: at a crack tip the gap and the slip vanish identically, so the augmented traction
+    #: there would be the held multiplier alone: the tip's element takes its neighbour's
+    #: augmented traction instead (``tip_extended``), with its derivative in the Jacobian
+    tip_continued = True
     supports = Supports(
         friction=_FRICTION, mixed_up=True, interfaces=True, dim1=False,
         why_not={"nodal_quadrature": "it already collocates the contact law at the nodes",
@@ -132,12 +131,6 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
         update = problem.nodal_update(self.update(problem.surface))
         return Uzawa(solver, problem.multiplier, update, problem.multiplier_mask,
                      tol=self.al_tol, max_it=self.al_max_it)  # fmt: skip
-
-    def _continued(self, s: Surface) -> Surface:
-        """At a crack tip the gap and the slip vanish identically, so the augmented traction
-        there would be the held multiplier alone: the tip's element takes its neighbour's
-        augmented traction instead (``tip_extended``), with its derivative in the Jacobian."""
-        return s.tip_extended()
 
     def pressure(self, s: Surface):
         return self._augmented(s)[0]

@@ -34,6 +34,7 @@ class NormalCompliance(MethodBase):
     exponent: float = param(2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m",
                             positive=True)  # fmt: skip
     nodal_size: ClassVar[bool] = True
+    tip_continued: ClassVar[bool] = True  # as the penalty's
     name = "compliance"
     sweep = ("exponent", (1.0, 1.5, 2.0))
     supports = Supports(mixed_up=True, nodal_quadrature=True, interfaces=True,
@@ -43,6 +44,7 @@ class NormalCompliance(MethodBase):
         validate(self)
 
     def pressure(self, s: Surface):
+        s = self.law_surface(s)
         return self.kappa0 * s.E * (positive_part(-s.gap()) / s.h_continuous) ** self.exponent
 
     def residual(self, s: Surface):

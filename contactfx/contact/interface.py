@@ -175,18 +175,19 @@ class InterfaceSurface(SurfaceData):
         return g
 
     def tip_extended(self):
-        """This surface with the motion w, the previous motion and the multiplier replaced, on
-        each tip's element, by their values at the tip's neighbour, and unchanged elsewhere.
+        """This surface with the motion w, the previous motion, the multiplier and the nodal
+        fields of a law (the traction history, the nodal mesh size) replaced, on each tip's
+        element, by their values at the tip's neighbour, and unchanged elsewhere.
         With d = ``tip_step`` = (x_neighbour - x_tip) phi_tip (phi_tip the tip node's P1 basis
         function), x + d is the neighbour's node at every point x of the tip's facet and x
         elsewhere, so the Taylor expansion f + grad(f) . d + d . grad(grad(f)) . d / 2 is the
         constant f(neighbour) on the tip's element for any field of degree <= 2 in the cell
         (P1 and P2). The jump, and so the gap and the slip, vanish identically at a tip, so a
         law written on them alone (al-uzawa's augmented pressure [lambda - r g]_+ with a
-        multiplier held at the nodes) would otherwise let the traction fall to the tip's value
-        across the element; continued, the tip element carries its neighbour's augmented
-        traction, with its derivative in Newton's Jacobian. This is al-ssn's tie
-        (``collocated``) written into the law instead of a multiplier row."""
+        multiplier held at the nodes, the penalty's kappa [-g]_+) would otherwise let the
+        traction fall to the tip's value across the element; continued, the tip element
+        carries its neighbour's traction, with its derivative in Newton's Jacobian. This is
+        al-ssn's tie (``collocated``) written into the law instead of a multiplier row."""
         if self.tip_step is None:
             return self
         d = self.tip_step
@@ -194,12 +195,15 @@ class InterfaceSurface(SurfaceData):
         def extend(f):
             if f is None:
                 return None
+            if isinstance(f, ufl.classes.Restricted):  # a nodal field seen from one side
+                return extend(f.ufl_operands[0])(f.side())
             return f + ufl.dot(ufl.grad(f), d) + 0.5 * ufl.dot(ufl.dot(ufl.grad(ufl.grad(f)), d), d)
 
         lam = self.multiplier
         if lam is not None and self.multiplier_tie is not None:
             lam = lam + self.multiplier_tie
         return replace(self, w=extend(self.w), u_prev=extend(self.u_prev), multiplier=lam,
+                       traction_prev=extend(self.traction_prev), h_nodal=extend(self.h_nodal),
                        tip_step=None)  # fmt: skip
 
     def slip_increment(self, n):

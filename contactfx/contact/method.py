@@ -81,6 +81,9 @@ class MethodBase:
     #: whether the method's stiffness is scaled by a mesh size that must be continuous along
     #: the surface (the surface's ``h_nodal``, built by the driver)
     nodal_size: ClassVar[bool] = False
+    #: whether the method writes its law on ``s.tip_extended()`` (continued over each crack
+    #: tip's element from its neighbouring node; the driver then builds ``tip_step``)
+    tip_continued: ClassVar[bool] = False
     supports: ClassVar[Supports] = Supports()
     #: the option that tells the method's variants apart, and the values ``contactfx bench
     #: --method NAME`` runs ("": none)
@@ -92,6 +95,11 @@ class MethodBase:
         from contactfx.params import option_name
 
         return cls(**{f.name: getattr(options, option_name(f)) for f in dataclasses.fields(cls)})
+
+    def law_surface(self, s):
+        """The surface the method's law reads: with ``tip_continued``, continued over each
+        crack tip's element from its neighbouring node (``s.tip_extended()``), else ``s``."""
+        return s.tip_extended() if self.tip_continued else s
 
     def contact_indicator(self, s):
         """> 0 exactly where the surfaces are closed (the pressure, unless a multiplier that

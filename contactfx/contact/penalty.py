@@ -54,6 +54,9 @@ class Penalty(TrialFriction, MethodBase):
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
     traction_history: ClassVar[bool] = True
     nodal_size: ClassVar[bool] = True
+    #: the jump, and so the overlap, vanishes identically at a crack tip: the tip's element
+    #: takes its neighbour's traction (``tip_extended``) instead of one falling to zero
+    tip_continued: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         validate(self)
@@ -62,10 +65,12 @@ class Penalty(TrialFriction, MethodBase):
         return self.kappa0 * s.E / s.h_continuous
 
     def pressure(self, s: Surface):
+        s = self.law_surface(s)
         return self.kappa(s) * positive_part(-s.gap())
 
     def _trial_t(self, s: Surface):
         """The trial tangential traction t_prev - kappa du_T."""
+        s = self.law_surface(s)
         n = s.normal()
         return tangential(s.traction_prev, n) - self.kappa(s) * s.slip_increment(n)
 

@@ -133,9 +133,11 @@ class InterfaceProblem(Problem):
         multiplier's tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) -
         lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the P1 multiplier on the
         tip's facet."""
-        if self.lam is None or not self.tips:
+        if not self.tips or self.lam is None and not self.method.tip_continued:
             return {}
         step = self._tip_steps()
+        if self.lam is None:
+            return {"tip_step": step}
         return {
             "tip_step": step,
             "multiplier_tie": ufl.dot(ufl.grad(self.lam), step)("+"),
