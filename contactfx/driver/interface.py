@@ -128,9 +128,10 @@ class InterfaceProblem(Problem):
         )  # fmt: skip
 
     def _tip_terms(self) -> dict:
-        """What the multiplier methods need at the crack tips: ``tip_step`` (the vector from
-        each tip's node to its neighbour's, ``InterfaceSurface.tip_extended``) and the
-        multiplier's tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) -
+        """What the methods need at the crack tips: ``tip_step``, the vector from each tip's
+        node to its neighbour's (``InterfaceSurface.tip_extended``), for the methods continued
+        over the tips' elements (``tip_continued``) and the multiplier methods; for the latter
+        also the multiplier's tie (``SurfaceData.multiplier_tie``, ``at_tips``): lambda(neighbour) -
         lambda(tip) = grad(lambda) . (x_neighbour - x_tip), exact for the P1 multiplier on the
         tip's facet."""
         if not self.tips or self.lam is None and not self.method.tip_continued:
@@ -256,14 +257,12 @@ class InterfaceProblem(Problem):
         self.state.x.scatter_forward()
 
     def _tolerances(self, solver) -> None:
-        user = set(solver.user_options)
-        prefix = solver.prefix
-        if not {"snes_atol", prefix + "snes_atol"} & user:
+        if not solver.user_sets("snes_atol"):
             # absolute tolerance a little above the round-off of the loads: the start (bonded,
             # or the load-step predictor) can already be the solution, e.g. of a uniformly
             # compressed joint, and rtol then cannot be met
             solver.snes.setTolerances(atol=1e-11 * solver.b.norm())
-        if self.method.multiplier != "field" and not {"snes_stol", prefix + "snes_stol"} & user:
+        if self.method.multiplier != "field" and not solver.user_sets("snes_stol"):
             # and a Newton step below 1e-12 of the displacement is converged too (the
             # residual's round-off floor grows with the conditioning, e.g. P2 on graded tips);
             # not for a multiplier field, whose unknown mixes displacements and multipliers

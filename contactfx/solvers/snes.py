@@ -271,6 +271,11 @@ class ContactSNES:
         self.reuse_preconditioner()
 
     # -- options -------------------------------------------------------------------------
+    def user_sets(self, key: str) -> bool:
+        """Whether the user's options give ``key`` (a PETSc option name without the
+        prefix), with or without this solver's prefix."""
+        return bool({key, self.prefix + key} & set(self.user_options))
+
     def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
         opts = PETSc.Options()
         for key, value in defaults.items():

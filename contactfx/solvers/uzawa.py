@@ -61,7 +61,7 @@ class Uzawa:
         mask[imap.size_local * bs :] = False  # owned dofs decide; ghosts follow
         snes = self.inner.snes
         stol = snes.getTolerances()[2]
-        if not {"snes_stol", self.inner.prefix + "snes_stol"} & set(self.inner.user_options):
+        if not self.inner.user_sets("snes_stol"):
             snes.setTolerances(stol=max(stol, self.STEP_TOL))
         try:
             return self._iterate(lam, saved, mask, total)
