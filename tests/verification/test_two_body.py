@@ -410,7 +410,11 @@ def test_coupling_jacobian_is_consistent_3d(num):
     # exact central differences up to round-off away from a switch of the active set or of
     # stick / slip (measured 1e-11 frictionless, 7e-11 with Coulomb, at 1 to 3 ranks): the
     # ball projection's curvature term, O(eps^2 |du|^2 / |z|^2), is far below that
-    assert error(1e-4) < 1e-9
+    # A switch within eps du shows as an O(1) error: 8e-3 once at 2 ranks on Debian 13, where
+    # the 2-rank partition varies from run to run and with it the nodes the seeded noise
+    # moves. A consistent Jacobian then still matches at the smaller eps (measured 3e-11 to
+    # 7e-11 at 2e-5, at 1 and 2 ranks), a wrong one at neither
+    assert min(error(1e-4), error(2e-5)) < 1e-9
     solver.destroy()
 
 
