@@ -265,6 +265,7 @@ class ContactSNES:
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
         self._initial_norm = 0.0
+        self._guard = True  # the reversal guard compares with the remembered iterate
         if iterate is not None:
             self.snes.setMonitor(self._record_initial_norm)
         self.P = None  # the preconditioner's own matrix: see _keep_preconditioner
@@ -366,6 +367,8 @@ class ContactSNES:
             F.set(np.nan)
             return
         self._sync(x)
+        if not self._guard:  # the law's own residual (see _newton)
+            self._remember()
         uvec = _compat.petsc_vec(self.u)  # = x on all dofs
         full = F if self.reduced is None else self.reduced.F
         self._unconstrained_residual(uvec, full, search=True)
@@ -509,9 +512,35 @@ class ContactSNES:
             start.destroy()
 
     def _newton(self, x: PETSc.Vec, before: SolveStats, max_it: int | None = None) -> SolveStats:
-        """One SNES solve from x (at most ``max_it`` iterations when given and below the
+        """SNES solves from x (each at most ``max_it`` iterations when given and below the
         SNES's own limit); the counts added to ``before``. Raises ConvergenceError (with the
-        counts) on divergence, TimeLimitExceeded past the time limit."""
+        counts) on divergence, TimeLimitExceeded past the time limit.
+
+        With the reversal guard, a solve converged on the guarded residual is continued while
+        the law's own residual is not converged (a point that reversed in the last step), up
+        to GUARD_ROUNDS times; a point that keeps flipping between stick and slip across the
+        converged iterates (a 2-cycle of the guard itself) then gets one last solve with the
+        guard off, the law's plain semi-smooth Newton from there."""
+        stats = self._snes_solve(x, before, max_it)
+        if self.iterate is None:
+            return stats
+        for _ in range(self.GUARD_ROUNDS):
+            if self._law_converged(x):
+                return stats
+            stats = self._snes_solve(x, stats, max_it)  # from the law's own residual
+        if self._law_converged(x):
+            return stats
+        self._guard = False
+        try:
+            return self._snes_solve(x, stats, max_it)
+        finally:
+            self._guard = True
+
+    #: continued solves with the reversal guard before one without it (see _newton)
+    GUARD_ROUNDS = 3
+
+    def _snes_solve(self, x: PETSc.Vec, before: SolveStats, max_it: int | None) -> SolveStats:
+        """One SNES solve from x; the counts added to ``before``; raises on failure."""
         limit = self.snes.getTolerances()[3]
         if max_it is not None and max_it < limit:
             self.snes.setTolerances(max_it=max_it)
@@ -533,16 +562,15 @@ class ContactSNES:
                            reason=snes_reason_name(reason))  # fmt: skip
         if reason <= 0:
             raise ConvergenceError(stats.reason, stats=stats)
-        if self.iterate is not None and not self._law_converged(xs):
-            return self._newton(x, stats, max_it)  # from the law's own residual
         return stats
 
-    def _law_converged(self, xs: PETSc.Vec) -> bool:
+    def _law_converged(self, x: PETSc.Vec) -> bool:
         """After a converged solve with the reversal guard: the guard compared the last iterate
         with the one before; with the iterate remembered the residual is the law's own. True
         if it meets the solve's own tolerances (it fails only if a point reversed in the
         last, vanishing step)."""
         self._remember()
+        xs = x if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
         F = self.residual_vec.duplicate()
         try:
             self._residual(self.snes, xs, F)

@@ -6,6 +6,7 @@ import pytest
 
 from contactfx.scenes.hertz import Hertz2D, Hertz2DParams, Hertz3D, Hertz3DParams
 from contactfx.scenes.sliding_block import SlidingBlock, SlidingBlockParams
+from contactfx.solvers.snes import ContactSNES
 
 METHODS = ["nitsche", "penalty", "al-uzawa", "al-ssn"]
 BLOCK = SlidingBlockParams()  # p = 10, L = 1, shift 0.02: gross slip from shift ~ 0.005
@@ -61,6 +62,33 @@ def test_sliding_block_stiff_stick(method, stiff):
     assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
     assert res.scores["slip_traction_error"] < 1e-8
     assert res.friction.excess < 1e-10
+
+
+def test_reversal_guard_gives_way_to_the_plain_law(monkeypatch):
+    """A point flipping between stick and slip across converged iterates (the guard's own
+    2-cycle: each solve converges on the guarded residual, the law's residual check then
+    fails, and so on) must not keep Newton going: after GUARD_ROUNDS continued solves, one
+    solve without the guard. Forced here by a law check that always fails: every solve then
+    takes GUARD_ROUNDS + 1 more, ends on the law's own semi-smooth Newton from a converged
+    state, and the run gives the exact gross slip of the defaults with a stick 10 times
+    stiffer (gamma0 100, where the guard is needed at the drag's first step). Before this
+    bound the continuation recursed without end (a RecursionError at 2 ranks once)."""
+    checks = []
+
+    def never(self, x):
+        checks.append(x)
+        return False
+
+    monkeypatch.setattr(ContactSNES, "_law_converged", never)
+    num = SlidingBlock.default_numerics(method="nitsche", gamma0=100.0)
+    res = SlidingBlock(BLOCK).run(num, verbose=False)
+    # every step taken: GUARD_ROUNDS + 1 checks (a cut-back's failed solve stops before them)
+    assert len(checks) >= (ContactSNES.GUARD_ROUNDS + 1) * len(res.steps)
+    P = BLOCK.pressure * BLOCK.width
+    assert res.force == pytest.approx(P, rel=1e-9)  # equilibrium, Newton tolerance
+    assert abs(res.friction.tangential_force[0]) == pytest.approx(num.mu * P, rel=1e-8)
+    assert res.friction.slip_fraction == pytest.approx(1.0, abs=1e-12)
+    assert res.scores["slip_traction_error"] < 1e-8
 
 
 @pytest.mark.parametrize("method", METHODS)
