@@ -36,6 +36,7 @@ __all__ = [
     "numpy_math",
     "ufl_math",
     "FacetTree",
+    "PointLocator",
     "point_values",
 ]
 
@@ -260,39 +261,60 @@ class FacetTree:
         return other._original[pairs[:, 0]], self._original[pairs[:, 1]]
 
 
-def point_values(f: dolfinx.fem.Function, points: np.ndarray) -> np.ndarray:
-    """Values (n, value size) of ``f`` at the points (n, gdim) on every rank: each point is
-    evaluated by the lowest rank that owns a cell containing it; NaN for a point outside the
-    mesh. Collective."""
-    import dolfinx.geometry as geo
-    from mpi4py import MPI
+class PointLocator:
+    """Where points (n, gdim) lie in a mesh, found once: each point is evaluated by the lowest
+    rank that owns a cell containing it; a point outside the mesh gives NaN. Calling it with
+    a Function on that mesh gives the values (n, value size) on every rank. Collective."""
 
-    mesh = f.function_space.mesh
-    comm, tdim = mesh.comm, mesh.topology.dim
-    n = len(points)
-    pts = np.zeros((n, 3))
-    pts[:, : points.shape[1]] = points
-    owned = mesh.topology.index_map(tdim).size_local
-    cells = np.arange(owned, dtype=np.int32)
-    if _NEW:
-        tree = geo.bb_tree(mesh, tdim, cells)
-        candidates = geo.compute_collisions_points(tree, pts)
-    else:
-        tree = geo.BoundingBoxTree(mesh, tdim, cells)
-        candidates = geo.compute_collisions(tree, pts)
-    colliding = geo.compute_colliding_cells(mesh, candidates, pts)
-    found = np.array([len(colliding.links(i)) > 0 for i in range(n)], dtype=bool)
-    ranks = np.where(found, comm.rank, comm.size).astype(np.int64)
-    first = np.empty_like(ranks)
-    comm.Allreduce(ranks, first, op=MPI.MIN)
-    size = int(np.prod(f.ufl_shape)) if f.ufl_shape else 1
-    local = np.zeros((n, size))
-    mine = np.flatnonzero(first == comm.rank)
-    if len(mine):
-        local[mine] = f.eval(
-            pts[mine], np.array([colliding.links(i)[0] for i in mine], dtype=np.int32)
-        ).reshape(len(mine), size)
-    values = np.zeros_like(local)
-    comm.Allreduce(local, values, op=MPI.SUM)
-    values[first == comm.size] = np.nan
-    return values
+    def __init__(self, mesh, points: np.ndarray, tree=None) -> None:
+        import dolfinx.geometry as geo
+        from mpi4py import MPI
+
+        self.comm = mesh.comm
+        n = len(points)
+        self.points = np.zeros((n, 3))
+        self.points[:, : points.shape[1]] = points
+        tree = self.tree(mesh) if tree is None else tree
+        if _NEW:
+            candidates = geo.compute_collisions_points(tree, self.points)
+        else:
+            candidates = geo.compute_collisions(tree, self.points)
+        colliding = geo.compute_colliding_cells(mesh, candidates, self.points)
+        offsets = np.asarray(colliding.offsets)
+        found = np.diff(offsets) > 0
+        ranks = np.where(found, self.comm.rank, self.comm.size).astype(np.int64)
+        first = np.empty_like(ranks)
+        self.comm.Allreduce(ranks, first, op=MPI.MIN)
+        self.outside = first == self.comm.size
+        self.mine = np.flatnonzero(first == self.comm.rank)
+        self.cells = np.asarray(colliding.array)[offsets[self.mine]].astype(np.int32)
+
+    @staticmethod
+    def tree(mesh):
+        """The bounding-box tree of the mesh's owned cells (to share between locators)."""
+        import dolfinx.geometry as geo
+
+        tdim = mesh.topology.dim
+        cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
+        if _NEW:
+            return geo.bb_tree(mesh, tdim, cells)
+        return geo.BoundingBoxTree(mesh, tdim, cells)
+
+    def __call__(self, f: dolfinx.fem.Function) -> np.ndarray:
+        from mpi4py import MPI
+
+        size = int(np.prod(f.ufl_shape)) if f.ufl_shape else 1
+        local = np.zeros((len(self.points), size))
+        if len(self.mine):
+            values = f.eval(self.points[self.mine], self.cells)
+            local[self.mine] = values.reshape(len(self.mine), size)
+        values = np.zeros_like(local)
+        self.comm.Allreduce(local, values, op=MPI.SUM)
+        values[self.outside] = np.nan
+        return values
+
+
+def point_values(f: dolfinx.fem.Function, points: np.ndarray) -> np.ndarray:
+    """Values (n, value size) of ``f`` at the points (n, gdim) on every rank (NaN outside the
+    mesh): one :class:`PointLocator`, called once. Collective."""
+    return PointLocator(f.function_space.mesh, points)(f)

@@ -24,7 +24,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
+from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded, owned_bc_dofs
 
 __all__ = ["NestedSolver", "Transfer", "transfer", "nested_levels", "MIN_DOFS"]
 
@@ -58,33 +58,47 @@ def _leaves(f: dolfinx.fem.Function, split: bool) -> list[tuple[object, np.ndarr
 class Transfer:
     """fine = the interpolant of ``coarse`` (another mesh of the same domain) at fine's owned
     dofs, each call; what depends on the meshes only (the fields' sub-spaces, the fine dof
-    coordinates gathered on every rank) is found once. A dof outside the coarse mesh keeps
-    its value. Collective."""
+    coordinates gathered on every rank, the coarse cell that holds each of them) is found
+    once, the cells at the first call (so that a run's solve time counts it). A dof outside
+    the coarse mesh keeps its value, and so do the ``fixed`` dofs (indices into
+    ``fine.x.array``: a field confined to a surface is zero elsewhere, and only its surface
+    nodes are interpolated). Collective."""
 
     def __init__(self, coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function,
-                 split: bool) -> None:  # fmt: skip
+                 split: bool, fixed: np.ndarray | None = None) -> None:  # fmt: skip
         self.coarse, self.fine = coarse, fine
         comm = fine.function_space.mesh.comm
         gdim = fine.function_space.mesh.geometry.dim
+        free = np.ones(len(fine.x.array), dtype=bool)
+        if fixed is not None:
+            free[fixed] = False
         self.parts = []
         for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split),
                                       strict=True):  # fmt: skip
             n_owned = Vf.dofmap.index_map.size_local
-            points = _compat.dof_coordinates(Vf)[:n_owned, :gdim]
-            start = sum(comm.allgather(n_owned)[: comm.rank])
-            everywhere = np.concatenate(comm.allgather(points))
             bs = Vf.dofmap.index_map_bs
-            owned = slice(start, start + n_owned)
-            self.parts.append((dolfinx.fem.Function(Vc), dc, df[: n_owned * bs], everywhere,
-                               owned, bs))  # fmt: skip
+            nodes = df[: n_owned * bs].reshape(n_owned, bs)
+            moved = free[nodes].any(axis=1)  # a node with a free component
+            points = _compat.dof_coordinates(Vf)[:n_owned, :gdim][moved]
+            start = sum(comm.allgather(len(points))[: comm.rank])
+            everywhere = np.concatenate(comm.allgather(points))
+            owned = slice(start, start + len(points))
+            self.parts.append((dolfinx.fem.Function(Vc), dc, nodes[moved].reshape(-1),
+                               everywhere, owned, bs))  # fmt: skip
+        self.locators: list[_compat.PointLocator] | None = None
 
     def __call__(self) -> int:
         """Interpolate; returns the number of fine nodes outside the coarse mesh (all
         ranks)."""
+        if self.locators is None:
+            mesh = self.coarse.function_space.mesh
+            tree = _compat.PointLocator.tree(mesh)
+            self.locators = [_compat.PointLocator(mesh, everywhere, tree)
+                             for _, _, _, everywhere, _, _ in self.parts]  # fmt: skip
         kept = 0
-        for fc, dc, df, everywhere, owned, bs in self.parts:
+        for (fc, dc, df, _, owned, bs), locate in zip(self.parts, self.locators, strict=True):
             fc.x.array[:] = self.coarse.x.array[dc]
-            mine = _compat.point_values(fc, everywhere)[owned].reshape(-1)
+            mine = locate(fc)[owned].reshape(-1)
             found = np.isfinite(mine)
             self.fine.x.array[df[found]] = mine[found]
             kept += int(np.count_nonzero(~found)) // bs
@@ -119,7 +133,8 @@ class NestedSolver:
         self._saved = [f.x.array.copy() for f in self.fields]
         # the state is mixed when the problem is split; a nodal multiplier never is
         pairs = zip(self.fields, problem.nested_fields(), strict=True)
-        self.transfers = [Transfer(c, f, problem.split and i == 0)
+        fixed = owned_bc_dofs(problem.confined, len(problem.state.x.array))
+        self.transfers = [Transfer(c, f, problem.split and i == 0, fixed if i == 0 else None)
                           for i, (c, f) in enumerate(pairs)]  # fmt: skip
         #: Newton iterations of the coarse chain in the last solve
         self.coarse_newton = 0

@@ -300,7 +300,9 @@ class ContactSNES:
         ksp = self.snes.getKSP()
         if ksp.getPC().getType() != "lu" or ksp.getType() != "preonly":
             return
-        ksp.setType("gmres")
+        # flexible GMRES (preconditioned on the right) keeps the preconditioned directions, so
+        # k iterations cost k back-substitutions (left-preconditioned GMRES takes one more)
+        ksp.setType("fgmres")
         ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=self.REUSE_MAX_IT)
         # a Krylov solve stopped at REUSE_MAX_IT is still a descent step: take it, refactorise
         self.snes.setMaxLinearSolveFailures(10**6)
