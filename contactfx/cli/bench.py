@@ -37,6 +37,13 @@ def _parser() -> Parser:
         "obstacle scenes)",
     )
     p.add_argument(
+        "--repeat",
+        type=int,
+        default=1,
+        help="run every case this many times and keep the shortest time (times on a busy "
+        "machine vary by tens of %%)",
+    )
+    p.add_argument(
         "--speedup",
         action="store_true",
         help="under mpirun, also run every case on rank 0 alone (parallel speed-up)",
@@ -58,10 +65,13 @@ def cmd_bench(argv: list[str], petsc_options: dict, comm) -> int:
     degrees = int_list(ns.degree)
     if not degrees or any(d not in (1, 2) for d in degrees):
         raise ValueError(f"--degree must list 1 and/or 2, got '{ns.degree}'")
+    if ns.repeat < 1:
+        raise ValueError(f"--repeat must be >= 1, got {ns.repeat}")
     variants = expand_methods(ns.method)
     started = time.perf_counter()
     rows = run_bench(cases, variants, degrees, ns.levels, comm, petsc_options,
-                     solver=ns.solver, linear=ns.linear, speedup=ns.speedup)  # fmt: skip
+                     solver=ns.solver, linear=ns.linear, speedup=ns.speedup,
+                     repeat=ns.repeat)  # fmt: skip
     finish_table(rows, comm, started, f"bench: {len(rows)} runs in {{total:.0f}} s on "
                  f"{comm.size} rank(s)", ns.out, write_bench)  # fmt: skip
     return 0

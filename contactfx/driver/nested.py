@@ -83,8 +83,9 @@ class Transfer:
             start = sum(comm.allgather(len(points))[: comm.rank])
             everywhere = np.concatenate(comm.allgather(points))
             owned = slice(start, start + len(points))
-            self.parts.append((dolfinx.fem.Function(Vc), dc, nodes[moved].reshape(-1),
-                               everywhere, owned, bs))  # fmt: skip
+            dofs = nodes[moved].reshape(-1)
+            self.parts.append((dolfinx.fem.Function(Vc), dc, dofs, free[dofs], everywhere,
+                               owned, bs))  # fmt: skip
         self.locators: list[_compat.PointLocator] | None = None
 
     def __call__(self) -> int:
@@ -93,14 +94,14 @@ class Transfer:
         if self.locators is None:
             mesh = self.coarse.function_space.mesh
             tree = _compat.PointLocator.tree(mesh)
-            self.locators = [_compat.PointLocator(mesh, everywhere, tree)
-                             for _, _, _, everywhere, _, _ in self.parts]  # fmt: skip
+            self.locators = [_compat.PointLocator(mesh, part[4], tree) for part in self.parts]
         kept = 0
-        for (fc, dc, df, _, owned, bs), locate in zip(self.parts, self.locators, strict=True):
+        for (fc, dc, df, free, _, owned, bs), locate in zip(self.parts, self.locators,
+                                                            strict=True):  # fmt: skip
             fc.x.array[:] = self.coarse.x.array[dc]
             mine = locate(fc)[owned].reshape(-1)
             found = np.isfinite(mine)
-            self.fine.x.array[df[found]] = mine[found]
+            self.fine.x.array[df[found & free]] = mine[found & free]
             kept += int(np.count_nonzero(~found)) // bs
         self.fine.x.scatter_forward()
         return self.fine.function_space.mesh.comm.allreduce(kept, op=MPI.SUM)

@@ -8,7 +8,7 @@ import pytest
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.driver.nested import nested_levels, transfer
+from contactfx.driver.nested import Transfer, nested_levels, transfer
 from contactfx.scenes.hertz import Hertz2D, Hertz2DParams
 from contactfx.scenes.two_body import PatchTest, PatchTestParams
 
@@ -96,6 +96,37 @@ def test_transfer_reproduces_polynomials(degree):
     assert np.max(np.abs(uf.x.array[:n] - exact.x.array[:n]), initial=0.0) < 1e-12
     # ghosts follow the owners
     assert np.max(np.abs(uf.x.array - exact.x.array)) < 1e-12
+
+
+def test_transfer_keeps_fixed_dofs_and_repeats():
+    """The ``fixed`` dofs (a field confined to a surface) keep their value, the others are
+    interpolated exactly (P1 field, round-off 1e-12); a second call, with the coarse cells
+    found at the first, interpolates the changed coarse field exactly too."""
+    comm = MPI.COMM_WORLD
+    corners = [np.array([0.0, 0.0]), np.array([1.0, 1.0])]
+    coarse_mesh = dolfinx.mesh.create_rectangle(comm, corners, [4, 3])
+    fine_mesh = dolfinx.mesh.create_rectangle(comm, corners, [7, 9])
+    Vc = _compat.function_space(coarse_mesh, "Lagrange", 1, (2,))
+    Vf = _compat.function_space(fine_mesh, "Lagrange", 1, (2,))
+    uc, uf, exact = (dolfinx.fem.Function(V) for V in (Vc, Vf, Vf))
+    # fixed: both components of the nodes with x < 0.5, the y component of those with y < 0.3
+    x = _compat.dof_coordinates(Vf)
+    both = np.repeat(x[:, 0] < 0.5, 2)
+    y_only = np.repeat(x[:, 1] < 0.3, 2) & (np.arange(len(both)) % 2 == 1)
+    fixed = np.flatnonzero(both | y_only)
+    free = np.setdiff1d(np.arange(len(uf.x.array)), fixed)
+    moving = Transfer(uc, uf, split=False, fixed=fixed)
+    for k in (1.0, -3.0):
+
+        def field(x, k=k):
+            return np.vstack([k + 2.0 * x[0] - x[1], 3.0 * k * x[0] + x[1]])
+
+        uc.interpolate(field)
+        exact.interpolate(field)
+        uf.x.array[fixed] = 7.0
+        assert moving() == 0
+        assert np.all(uf.x.array[fixed] == 7.0)
+        assert np.max(np.abs(uf.x.array[free] - exact.x.array[free]), initial=0.0) < 1e-12
 
 
 def test_nested_refused_where_not_offered():
