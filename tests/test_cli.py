@@ -71,6 +71,7 @@ BAD = [
     (["bench", "--method", "magic"], "unknown method 'magic'"),
     (["bench", "--method", "penalty@x"], "'x' is not a number"),
     (["bench", "--levels", "0"], "--levels must be >= 1"),
+    (["bench", "--repeat", "0"], "--repeat must be >= 1"),
     (["bench", "--degree", "3"], "--degree must list 1 and/or 2"),
     (["stress", "--axis", "nosuch"], "unknown axis 'nosuch'"),
     (["stress", "--time-limit", "-1"], "--time-limit must be > 0"),
@@ -183,11 +184,13 @@ def test_module_entry_point_westergaard():
 
 
 def test_bench_command_line(tmp_path):
-    """The bench entry point end to end (positional case, method list, CSV written)."""
+    """The bench entry point end to end (positional case, method list, the linear yardstick
+    with repeated runs, CSV written)."""
     res = run_cli("bench", "hertz2d", "--method", "nitsche@-1,penalty@100", "--levels", "1",
-                  "--out", str(tmp_path), timeout=300)  # fmt: skip
+                  "--linear", "--repeat", "2", "--out", str(tmp_path), timeout=300)  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert "nitsche(-1)" in res.stdout and "penalty(100)" in res.stdout
+    assert res.stdout.count("contact/linear") == 2
     rows = (tmp_path / "bench.csv").read_text().splitlines()
     assert rows[0].startswith("case,method,degree,level,h") and len(rows) == 3
 
