@@ -229,11 +229,7 @@ class FacetTree:
         mesh = dolfinx.mesh.create_mesh(MPI.COMM_SELF, cells, x, domain)
         self._original = np.asarray(mesh.topology.original_cell_index, dtype=np.int64)
         tdim = d - 1
-        entities = np.arange(m, dtype=np.int32)
-        if _NEW:
-            self.tree = geo.bb_tree(mesh, tdim, entities, padding=padding)
-        else:
-            self.tree = geo.BoundingBoxTree(mesh, tdim, entities, padding=padding)
+        self.tree = _bb_tree(mesh, tdim, np.arange(m, dtype=np.int32), padding)
         self._geo = geo
 
     def collide_points(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -259,6 +255,15 @@ class FacetTree:
             pairs = self._geo.compute_collisions(other.tree, self.tree)
         pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
         return other._original[pairs[:, 0]], self._original[pairs[:, 1]]
+
+
+def _bb_tree(mesh, tdim: int, entities: np.ndarray, padding: float = 0.0):
+    """The bounding-box tree of the mesh's entities of dimension ``tdim``."""
+    import dolfinx.geometry as geo
+
+    if _NEW:
+        return geo.bb_tree(mesh, tdim, entities, padding=padding)
+    return geo.BoundingBoxTree(mesh, tdim, entities, padding=padding)
 
 
 class PointLocator:
@@ -292,13 +297,9 @@ class PointLocator:
     @staticmethod
     def tree(mesh):
         """The bounding-box tree of the mesh's owned cells (to share between locators)."""
-        import dolfinx.geometry as geo
-
         tdim = mesh.topology.dim
         cells = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-        if _NEW:
-            return geo.bb_tree(mesh, tdim, cells)
-        return geo.BoundingBoxTree(mesh, tdim, cells)
+        return _bb_tree(mesh, tdim, cells)
 
     def __call__(self, f: dolfinx.fem.Function) -> np.ndarray:
         from mpi4py import MPI

@@ -18,13 +18,20 @@ coarse chain keeps its own friction history, advanced with the fine steps.
 from __future__ import annotations
 
 import time
+from typing import NamedTuple
 
 import dolfinx
 import numpy as np
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded, owned_bc_dofs
+from contactfx.solvers.snes import (
+    ConvergenceError,
+    SolveStats,
+    TimeLimitExceeded,
+    owned_bc_dofs,
+    owned_size,
+)
 
 __all__ = ["NestedSolver", "Transfer", "transfer", "nested_levels", "MIN_DOFS"]
 
@@ -53,6 +60,20 @@ def _leaves(f: dolfinx.fem.Function, split: bool) -> list[tuple[object, np.ndarr
         V, dofs = W.sub(i).collapse()
         out.append((V, np.asarray(dofs)))
     return out
+
+
+class _Part(NamedTuple):
+    """One field of a transfer: the coarse field (collapsed) and its dofs in the coarse
+    Function, the fine dofs written (those of the moved nodes) and which of them are free,
+    the moved nodes' points of all ranks and this rank's slice of them, the block size."""
+
+    coarse: dolfinx.fem.Function
+    coarse_dofs: np.ndarray
+    dofs: np.ndarray
+    free: np.ndarray
+    points: np.ndarray
+    mine: slice
+    bs: int
 
 
 class Transfer:
@@ -84,8 +105,8 @@ class Transfer:
             everywhere = np.concatenate(comm.allgather(points))
             owned = slice(start, start + len(points))
             dofs = nodes[moved].reshape(-1)
-            self.parts.append((dolfinx.fem.Function(Vc), dc, dofs, free[dofs], everywhere,
-                               owned, bs))  # fmt: skip
+            self.parts.append(_Part(dolfinx.fem.Function(Vc), dc, dofs, free[dofs], everywhere,
+                                    owned, bs))  # fmt: skip
         self.locators: list[_compat.PointLocator] | None = None
 
     def __call__(self) -> int:
@@ -94,15 +115,16 @@ class Transfer:
         if self.locators is None:
             mesh = self.coarse.function_space.mesh
             tree = _compat.PointLocator.tree(mesh)
-            self.locators = [_compat.PointLocator(mesh, part[4], tree) for part in self.parts]
+            self.locators = [_compat.PointLocator(mesh, part.points, tree)
+                             for part in self.parts]  # fmt: skip
         kept = 0
-        for (fc, dc, df, free, _, owned, bs), locate in zip(self.parts, self.locators,
-                                                            strict=True):  # fmt: skip
-            fc.x.array[:] = self.coarse.x.array[dc]
-            mine = locate(fc)[owned].reshape(-1)
+        for part, locate in zip(self.parts, self.locators, strict=True):
+            part.coarse.x.array[:] = self.coarse.x.array[part.coarse_dofs]
+            mine = locate(part.coarse)[part.mine].reshape(-1)
             found = np.isfinite(mine)
-            self.fine.x.array[df[found & free]] = mine[found & free]
-            kept += int(np.count_nonzero(~found)) // bs
+            write = found & part.free
+            self.fine.x.array[part.dofs[write]] = mine[write]
+            kept += int(np.count_nonzero(~found)) // part.bs
         self.fine.x.scatter_forward()
         return self.fine.function_space.mesh.comm.allreduce(kept, op=MPI.SUM)
 
@@ -134,7 +156,7 @@ class NestedSolver:
         self._saved = [f.x.array.copy() for f in self.fields]
         # the state is mixed when the problem is split; a nodal multiplier never is
         pairs = zip(self.fields, problem.nested_fields(), strict=True)
-        fixed = owned_bc_dofs(problem.confined, len(problem.state.x.array))
+        fixed = owned_bc_dofs(problem.confined, owned_size(problem.state.function_space))
         self.transfers = [Transfer(c, f, problem.split and i == 0, fixed if i == 0 else None)
                           for i, (c, f) in enumerate(pairs)]  # fmt: skip
         #: Newton iterations of the coarse chain in the last solve
