@@ -85,6 +85,8 @@ __all__ = [
     "crack_perturbation_stress",
     "opening",
     "stress_intensity",
+    "penny_opening",
+    "penny_stress_intensity",
     "crack_plane_tractions",
     "driving_shear",
     "inclined_crack_KII",
@@ -171,6 +173,19 @@ def opening(s, a, load, E, nu, m: Any = numpy_math):
 def stress_intensity(load, a):
     """K = load sqrt(pi a): K_I for the face pressure, K_II for the (driving) face shear."""
     return load * (np.pi * a) ** 0.5
+
+
+def penny_opening(r, a, p, E, nu, m: Any = numpy_math):
+    """Opening of a penny-shaped crack of radius a under the face pressure p in an infinite
+    body, 8 p (1 - nu^2) / (pi E) sqrt(a^2 - r^2) at r <= a, 0 beyond (Sneddon 1946,
+    doi:10.1098/rspa.1946.0077)."""
+    return 8.0 * p * (1.0 - nu**2) / (np.pi * E) * m.sqrt(m.maximum(a**2 - r**2, 0.0))
+
+
+def penny_stress_intensity(p, a):
+    """K_I = 2 p sqrt(a / pi) along the front of a penny-shaped crack under the face pressure p
+    (Sneddon 1946)."""
+    return 2.0 * p * (a / np.pi) ** 0.5
 
 
 def crack_plane_tractions(sigma, beta_deg, m: Any = numpy_math):

@@ -21,7 +21,7 @@ Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.t
 bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
 :func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`.
 
-Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,joint-column,
+Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,penny-block,joint-column,
 stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block} ...
 --out mesh.msh``.
 """
@@ -42,6 +42,7 @@ from contactfx.meshes.box import BoxCells, BoxFacets, box
 from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
 from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
+from contactfx.meshes.penny_block import PennyBlockCells, PennyBlockFacets, penny_block
 from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
 from contactfx.meshes.two_body import (
     CylindersCells,
@@ -72,6 +73,7 @@ BUILDERS = {
     "box": (box, 3),
     "crack-plate": (crack_plate, 2),
     "joint-column": (joint_column, 2),
+    "penny-block": (penny_block, 3),
     "stacked-blocks": (stacked_blocks, 2),
     "stacked-boxes": (stacked_boxes, 3),
     "cylinders": (cylinders, 2),
@@ -96,6 +98,8 @@ __all__ = [
     "JointColumnFacets",
     "MeshData",
     "MshInfo",
+    "PennyBlockCells",
+    "PennyBlockFacets",
     "PunchFoundationCells",
     "PunchFoundationFacets",
     "RectangleCells",
@@ -118,6 +122,7 @@ __all__ = [
     "interval",
     "cylinders",
     "joint_column",
+    "penny_block",
     "punch_foundation",
     "rectangle",
     "rounded_on_block",

@@ -8,6 +8,8 @@ Examples::
         --refine-center 0 0 --refine-radius 0.15 --h-contact 0.02 --h-far 0.2 --out quarter.msh
     python3 -m contactfx.meshes crack-plate --half-width 1 --crack-half-length 0.2 --angle 30 \
         --h-crack 0.005 --h-far 0.1 --split-at -0.1 0.1 --out crack.msh
+    python3 -m contactfx.meshes penny-block --half-width 8 --crack-radius 1 --h-front 0.05 \\
+        --h-crack 0.1 --h-far 2 --out penny.msh
     python3 -m contactfx.meshes joint-column --width 1 --block-height 1 --h 0.05 --out joint.msh
     python3 -m contactfx.meshes stacked-blocks --width 1 --h-lower 0.5 --h-upper 0.5 --h1 0.05 \\
         --ratio 0.7 --offset 0.3 --out blocks.msh
@@ -34,6 +36,7 @@ from contactfx.meshes._build import write_msh
 from contactfx.meshes.box import box
 from contactfx.meshes.crack_plate import crack_plate
 from contactfx.meshes.joint_column import joint_column
+from contactfx.meshes.penny_block import penny_block
 from contactfx.meshes.rectangle import rectangle
 from contactfx.meshes.two_body import (
     cylinders,
@@ -139,6 +142,17 @@ def _parser() -> argparse.ArgumentParser:
     )
     _add_output(crack)
 
+    penny = geometries.add_parser(
+        "penny-block", help="3D quarter block with a penny-shaped crack, refined at its front"
+    )
+    penny.add_argument("--half-width", type=float, required=True, metavar="L")
+    penny.add_argument("--crack-radius", type=float, required=True, metavar="A")
+    penny.add_argument("--h-front", type=float, required=True, metavar="H")
+    penny.add_argument("--h-crack", type=float, required=True, metavar="H")
+    penny.add_argument("--h-far", type=float, required=True, metavar="H")
+    _add_grading(penny)
+    _add_output(penny)
+
     joint = geometries.add_parser(
         "joint-column", help="2D column of two blocks with a horizontal joint, uniform mesh"
     )
@@ -210,6 +224,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             half_width=args.half_width, crack_half_length=args.crack_half_length,
             angle=args.angle, h_crack=args.h_crack, h_far=args.h_far, grading=args.grading,
             split_at=tuple(args.split_at),
+        )  # fmt: skip
+    elif args.geometry == "penny-block":
+        gdim, cells = 3, "tetrahedra"
+        builder = partial(
+            penny_block,
+            half_width=args.half_width, crack_radius=args.crack_radius, h_front=args.h_front,
+            h_crack=args.h_crack, h_far=args.h_far, grading=args.grading,
         )  # fmt: skip
     elif args.geometry == "joint-column":
         builder = partial(joint_column, width=args.width, block_height=args.block_height, h=args.h)

@@ -118,7 +118,7 @@ def _interface_rows(res: RunSummary) -> list[tuple[str, str]]:
     i = res.interface
     rows = [
         ("interface normal / tangential force", f"{res.force:.6g} / {i.tangential_force:.6g}"),
-        ("closed length / max penetration",
+        ("closed length (area in 3D) / max penetration",
          f"{res.contact_size:.6g} / {res.max_penetration:.3e}"),
     ]  # fmt: skip
     if i.proppant_force is not None:

@@ -58,9 +58,16 @@ def oriented_jump(w, H):
     return 0.5 * (H("+") - H("-")) * (w("+") - w("-"))
 
 
-def tangent(n):
-    """The interface direction in 2D: the normal n_I rotated by -90 degrees."""
-    return ufl.as_vector([n[1], -n[0]])
+def tangent(n, axis=None):
+    """The interface direction: in 2D the normal n_I rotated by -90 degrees; in 3D the unit
+    projection of ``axis`` (a vector not normal to the interface) on the interface's plane."""
+    if ufl.shape(n)[0] == 2:
+        return ufl.as_vector([n[1], -n[0]])
+    if axis is None:
+        raise ValueError("a 3D interface's tangent needs an axis (InterfaceScene.slip_axis)")
+    a = ufl.as_vector([float(c) for c in axis])
+    t = a - ufl.dot(a, n) * n
+    return t / ufl.sqrt(ufl.dot(t, t))
 
 
 def interface_normal(H, n):

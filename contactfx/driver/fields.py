@@ -11,8 +11,9 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["vertex_rule", "surface_mask", "at_points", "at_nodes", "confine", "assemble_array",
-           "NodalProjection", "nodal_contact", "global_sum", "zero_pattern"]  # fmt: skip
+__all__ = ["vertex_rule", "surface_mask", "near_points", "at_points", "at_nodes", "confine",
+           "assemble_array", "NodalProjection", "nodal_contact", "global_sum",
+           "zero_pattern"]  # fmt: skip
 
 
 def vertex_rule(fdim: int) -> dict:
@@ -32,9 +33,10 @@ def vertex_rule(fdim: int) -> dict:
     }
 
 
-def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=()) -> np.ndarray:
+def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=None) -> np.ndarray:
     """Bool per local (owned + ghost) dof block of the collapsed space Q: on one of the facets
-    on any rank, and not at one of the ``excluded`` (point, tolerance) pairs (crack tips)."""
+    on any rank, and not where ``excluded`` (a predicate of the points (3, n), e.g. on a crack
+    tip or front) holds."""
     marker = dolfinx.fem.Function(Q)
     dofs = _compat.locate_dofs_topological(Q, fdim, facets)
     bs = Q.dofmap.index_map_bs
@@ -43,13 +45,14 @@ def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=()) -> np.ndarray:
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
     on = marker.x.array.reshape(-1, bs)[:, 0] > 0.0
-    on[at_points(Q, excluded)] = False
+    if excluded is not None:
+        on[dolfinx.fem.locate_dofs_geometrical(Q, excluded)] = False
     return on
 
 
-def at_points(Q, points) -> np.ndarray:
-    """Local dof blocks of the collapsed space Q within the tolerance of one of the
-    (point, tolerance) pairs."""
+def near_points(points):
+    """The predicate of points x (3, n): within the tolerance of one of the (point, tolerance)
+    pairs."""
 
     def at(x):
         hit = np.zeros(x.shape[1], dtype=bool)
@@ -57,7 +60,13 @@ def at_points(Q, points) -> np.ndarray:
             hit |= np.linalg.norm(x[: len(point)].T - point, axis=1) < tol
         return hit
 
-    return dolfinx.fem.locate_dofs_geometrical(Q, at)
+    return at
+
+
+def at_points(Q, points) -> np.ndarray:
+    """Local dof blocks of the collapsed space Q within the tolerance of one of the
+    (point, tolerance) pairs."""
+    return dolfinx.fem.locate_dofs_geometrical(Q, near_points(points))
 
 
 def at_nodes(Q, points: np.ndarray) -> np.ndarray:

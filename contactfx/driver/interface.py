@@ -24,8 +24,8 @@ import numpy as np
 import ufl
 
 from contactfx import _compat
-from contactfx.contact.interface import InterfaceSurface, oriented_jump, tangent
-from contactfx.contact.laws import positive_part
+from contactfx.contact.interface import InterfaceSurface, oriented_jump
+from contactfx.contact.laws import positive_part, tangential
 from contactfx.driver.fields import (
     NodalProjection,
     at_points,
@@ -60,11 +60,15 @@ class InterfaceProblem(Problem):
             raise ValueError("fitted interfaces use --formulation displacement")
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
-        if mesh.geometry.dim != 2:
-            raise ValueError("fitted interfaces are implemented in 2D (plane strain)")
+        if mesh.geometry.dim == 3 and (method.tip_continued or method.multiplier != "none"):
+            raise ValueError(
+                f"method {method.name} is not implemented on a 3D crack front (its tip "
+                "continuation is written for 2D tips); use nitsche"
+            )
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.interface_tag]
         self.tol = 1e-9 * scene.length_scale()  # of point location
         self.tips = [(np.asarray(t, dtype=float), self.tol) for t in scene.tips()]
+        self.on_front = functools.partial(scene.on_front, tol=self.tol)
         # the side sign H: +1 / -1 from the cell midpoints
         self.H = dolfinx.fem.Function(_compat.function_space(mesh, "DG", 0), name="side")
         self.H.interpolate(lambda x: np.where(scene.side(x) >= 0.0, 1.0, -1.0))
@@ -98,8 +102,8 @@ class InterfaceProblem(Problem):
         return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_tip_terms)
 
     def free_mask(self, Q) -> np.ndarray:
-        """On the interface and not at a tip."""
-        return surface_mask(Q, self.fdim, self.contact_facets, self.tips)
+        """On the interface and not on a tip or front."""
+        return surface_mask(Q, self.fdim, self.contact_facets, self.on_front)
 
     def make_surface(self) -> InterfaceSurface:
         mesh, scene, tag = self.mesh, self.scene, self.scene.interface_tag
@@ -109,9 +113,7 @@ class InterfaceProblem(Problem):
         self.dS_fine = self.dS(tag, metadata={"quadrature_degree": 12})
         self.dS_nodal = self.dS(tag, metadata=vertex_rule(self.fdim))
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
-        x = ufl.SpatialCoordinate(mesh)
-        origin, direction = (np.asarray(v, dtype=float) for v in scene.frame())
-        self.s_coord = (x[0] - origin[0]) * direction[0] + (x[1] - origin[1]) * direction[1]
+        self.s_coord = scene.coordinate(ufl.SpatialCoordinate(mesh))
         self.fluid_value = scene.fluid_pressure()
         self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
         sigma = self.material.sigma
@@ -222,12 +224,11 @@ class InterfaceProblem(Problem):
         spring = None
         if joint is not None:
             n_I = s.interface_normal()
-            t_I = tangent(n_I)
             jd = oriented_jump(self.dw, self.H)
             k_t = self.scene.contact_modulus() / s.h
             spring = dolfinx.fem.form(
                 (joint.Kni * ufl.dot(jd, n_I) * ufl.dot(s.v, n_I)
-                 + k_t * ufl.dot(jd, t_I) * ufl.dot(s.v, t_I)) * self.dSc
+                 + k_t * ufl.dot(tangential(jd, n_I), s.v)) * self.dSc
             )  # fmt: skip
         n_owned = owned_size(self.state.function_space)
         free = np.zeros(n_owned, dtype=bool)

@@ -17,7 +17,7 @@ from contactfx.contact.laws import active
 from contactfx.driver.fields import NodalProjection, global_sum, nodal_contact
 from contactfx.results import InterfaceQuantities, Quantities
 
-__all__ = ["InterfacePost", "Profile", "STATUS", "plot_profile", "pyplot"]
+__all__ = ["InterfacePost", "Profile", "STATUS", "plot_front", "plot_profile", "pyplot"]
 
 #: interface status codes of the ``interface_status`` field
 STATUS = {"open": 0, "stick": 1, "slip": 2, "propped": 3}
@@ -26,7 +26,7 @@ STATUS = {"open": 0, "stick": 1, "slip": 2, "propped": 3}
 @dataclasses.dataclass
 class Profile:
     """Nodal values along the interface (rank 0 holds all, sorted by s; other ranks empty):
-    coordinate s, position x (n, 2), opening (normal jump), slip (tangential jump, along the
+    coordinate s, position x (n, gdim), opening (normal jump), slip (tangential jump, along the
     interface direction), normal contact pressure p, tangential traction t (on the +side,
     along the direction), status codes, and the proppant floor."""
 
@@ -39,13 +39,14 @@ class Profile:
     status: np.ndarray
     floor: np.ndarray
 
-    COLUMNS = "s,x,y,opening,slip,normal_traction,tangential_traction,status,proppant"
+    FIELDS = "opening,slip,normal_traction,tangential_traction,status,proppant"
 
     def write_csv(self, path: Path) -> None:
         """One row per interface node, sorted by s."""
         cols = np.column_stack([self.s, self.x, self.opening, self.slip, self.p, self.t,
                                 self.status, self.floor])  # fmt: skip
-        np.savetxt(path, cols, delimiter=",", comments="", header=self.COLUMNS)
+        position = ",".join("xyz"[: self.x.shape[1]])
+        np.savetxt(path, cols, delimiter=",", comments="", header=f"s,{position},{self.FIELDS}")
 
 
 class InterfacePost:
@@ -56,7 +57,7 @@ class InterfacePost:
         mesh, s, method = pb.mesh, pb.surface, pb.method
         self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
         self.nodal = NodalProjection(pb.dS_nodal, self.Q1, "+")
-        t_I = tangent(s.interface_normal())
+        t_I = tangent(s.interface_normal(), self.scene.slip_axis())
         p = method.pressure(s)
         closed = method.contact_indicator(s)
         joint = s.joint
@@ -161,9 +162,9 @@ class InterfacePost:
         owned = np.zeros(n, dtype=bool)
         owned[: self.Q1.dofmap.index_map.size_local] = True
         sel = owned & on
-        origin, direction = (np.asarray(v, dtype=float) for v in self.scene.frame())
-        xs = _compat.dof_coordinates(self.Q1)[:n][sel][:, :2]
-        s = (xs - origin) @ direction
+        d = self.pb.gdim
+        xs = _compat.dof_coordinates(self.Q1)[:n][sel][:, :d]
+        s = self.scene.coordinate(xs.T)
 
         def col(name):
             f = self.fields_nodal.get(name)
@@ -175,11 +176,12 @@ class InterfacePost:
         ])  # fmt: skip
         parts = self.comm.gather(local, root=0)
         if self.comm.rank != 0:
-            return Profile(*(np.zeros(0) for _ in range(8)))
+            return Profile(np.zeros(0), np.zeros((0, d)), *(np.zeros(0) for _ in range(6)))
         a = np.vstack(parts)
-        a = a[np.argsort(a[:, 0])]
-        return Profile(a[:, 0], a[:, 1:3], a[:, 3] - self.w0, a[:, 4], a[:, 5], a[:, 6],
-                       a[:, 7], a[:, 8])  # fmt: skip
+        a = a[np.argsort(a[:, 0], kind="stable")]
+        f = a[:, d + 1 :]
+        return Profile(a[:, 0], a[:, 1 : d + 1], f[:, 0] - self.w0, f[:, 1], f[:, 2], f[:, 3],
+                       f[:, 4], f[:, 5])  # fmt: skip
 
     def finish(self, q: Quantities, out: Path | None) -> dict:
         """Closed-form comparisons from the gathered profile, field errors, the CSV and the
@@ -195,6 +197,11 @@ class InterfacePost:
             if self.comm.rank == 0:
                 plot_profile(prof, self.scene, plot)
                 prof.write_csv(out / "interface.csv")
+                front = self.scene.front_profile(prof)
+                if front is not None:
+                    plot_front(front, self.scene, out / "front.png")
+                    np.savetxt(out / "front.csv", np.column_stack(list(front.values())),
+                               delimiter=",", comments="", header=",".join(front))  # fmt: skip
         errors = {}
         for name, (err, norm) in self.err_forms.items():
             e, nrm = np.sqrt(global_sum(err, self.comm)), np.sqrt(global_sum(norm, self.comm))
@@ -221,8 +228,10 @@ def plot_profile(prof: Profile, scene, path: Path) -> None:
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 8.0), sharex=True)
     s = prof.s
     ref = scene.reference_profile(s)
+    # a 3D interface's nodes at one s lie at different places on it: points, not a line
+    line = "-" if prof.x.shape[1] == 2 else ""
     for ax, name, computed in ((axes[0], "opening", prof.opening), (axes[1], "slip", prof.slip)):
-        ax.plot(s, computed, "o-", ms=2, label=f"{name} (computed)")
+        ax.plot(s, computed, "o" + line, ms=2, label=f"{name} (computed)")
         if name == "opening" and np.any(prof.floor > 0.0):
             ax.plot(s, prof.floor, "k--", lw=1, label="proppant thickness")
         if name in ref:
@@ -230,17 +239,32 @@ def plot_profile(prof: Profile, scene, path: Path) -> None:
         ax.set_ylabel(name)
         ax.legend(fontsize=8)
     ax = axes[2]
-    ax.plot(s, prof.p, "o-", ms=2, label="contact pressure")
-    ax.plot(s, prof.t, "s-", ms=2, label="tangential traction")
+    ax.plot(s, prof.p, "o" + line, ms=2, label="contact pressure")
+    ax.plot(s, prof.t, "s" + line, ms=2, label="tangential traction")
     for name, code in STATUS.items():
         sel = prof.status == code
         if np.any(sel) and code > 0:
             label = "closed / stick" if name == "stick" else name
             ax.plot(s[sel], np.zeros(sel.sum()), "|", ms=8, label=label)
     ax.set_ylabel("traction")
-    ax.set_xlabel("s (along the interface)")
+    ax.set_xlabel("s (along the interface)" if line else "s (interface coordinate)")
     ax.legend(fontsize=8)
     fig.suptitle(scene.name)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_front(front: dict[str, np.ndarray], scene, path: Path) -> None:
+    """K along a 3D crack front against the front angle, with the closed form."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(7.0, 4.0))
+    ax.plot(front["angle"], front["K"], "o-", ms=3, label="K (displacement extrapolation)")
+    ax.plot(front["angle"], front["K_exact"], "-", lw=1, label="K (closed form)")
+    ax.set_xlabel("front angle (degrees)")
+    ax.set_ylabel("stress intensity")
+    ax.legend(fontsize=8)
+    fig.suptitle(f"{scene.name}: stress intensity along the crack front")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -41,7 +41,13 @@ from contactfx.scenes import export
 from contactfx.scenes.base import elastic
 from contactfx.scenes.interface_base import InterfaceScene
 
-__all__ = ["CrackSneddon", "CrackInclined", "ProppedFracture", "stress_intensity_from_jump"]
+__all__ = [
+    "CrackSneddon",
+    "CrackInclined",
+    "ProppedFracture",
+    "stress_intensity_from_jump",
+    "extrapolated_K",
+]
 
 _OUTER = (CrackPlateFacets.BOTTOM, CrackPlateFacets.RIGHT, CrackPlateFacets.TOP,
           CrackPlateFacets.LEFT)  # fmt: skip
@@ -51,17 +57,27 @@ def stress_intensity_from_jump(s, jump, a: float, E: float, nu: float,
                                window: tuple[float, float] = (0.05, 0.5)):  # fmt: skip
     """K from the crack-face displacement jump near both tips (see the module docstring);
     nan when a tip has fewer than 3 nodes at window[0] a <= r <= window[1] a."""
-    Ep = E / (1.0 - nu**2)
     values = []
     for sign in (1.0, -1.0):
         r = a - sign * np.asarray(s)
-        sel = (r >= window[0] * a) & (r <= window[1] * a) & (sign * np.asarray(s) > 0)
-        if sel.sum() < 3:
-            return float("nan")
-        K = Ep / 8.0 * np.sqrt(2.0 * np.pi / r[sel]) * np.abs(np.asarray(jump)[sel])
-        K1, K0 = np.polyfit(r[sel], K, 1)
-        values.append(K0)
+        values.append(extrapolated_K(r, jump, E, nu, a, window, sign * np.asarray(s) > 0))
     return float(np.mean(values))
+
+
+def extrapolated_K(r, jump, E: float, nu: float, a: float,
+                   window: tuple[float, float] = (0.05, 0.5), near=True) -> float:  # fmt: skip
+    """K at one tip (or one stretch of a 3D front) from the jump at the distances r to it:
+    the near-tip plane-strain field [[u]] = 8 K / E' sqrt(r / (2 pi)) read at the nodes with
+    window[0] a <= r <= window[1] a (and ``near``), fitted by K0 + K1 r, K0; nan with fewer
+    than 3 such nodes."""
+    r = np.asarray(r)
+    sel = (r >= window[0] * a) & (r <= window[1] * a) & near
+    if sel.sum() < 3:
+        return float("nan")
+    Ep = E / (1.0 - nu**2)
+    K = Ep / 8.0 * np.sqrt(2.0 * np.pi / r[sel]) * np.abs(np.asarray(jump)[sel])
+    K1, K0 = np.polyfit(r[sel], K, 1)
+    return float(K0)
 
 
 #: the part of the crack, |s| <= INTERIOR a, where the pressure is measured away from the tips

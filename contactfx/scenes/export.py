@@ -42,7 +42,10 @@ def write_problem(scene, numerics: Numerics, out: Path, command: str,
                   comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[Path, Path]:  # fmt: skip
     """Write ``out/<scene>.msh`` and ``out/<scene>.toml``; returns their paths. Collective:
     rank 0 writes, an error there is raised on every rank."""
-    tables = scene.problem_data(numerics)  # refuses what a problem file cannot say, first
+    try:
+        tables = scene.problem_data(numerics)  # refuses what a problem file cannot say, first
+    except NotImplementedError as exc:
+        raise ValueError(str(exc)) from None
     builder, gdim = scene.mesh_builder()
     out = Path(out)
     msh, toml = out / f"{scene.name}.msh", out / f"{scene.name}.toml"

@@ -40,9 +40,32 @@ class InterfaceScene(Scene):
         """Crack tips (points where the jump vanishes); [] for an interface across the body."""
         return []
 
+    def on_front(self, x: np.ndarray, tol: float) -> np.ndarray:
+        """Bool per point of x (3, n): on the crack's tip or front, where the jump vanishes
+        (within ``tol``). By default: at one of :meth:`tips` (2D); a 3D crack gives its front
+        curve."""
+        hit = np.zeros(x.shape[1], dtype=bool)
+        for tip in self.tips():
+            tip = np.asarray(tip, dtype=float)
+            hit |= np.linalg.norm(x[: len(tip)].T - tip, axis=1) < tol
+        return hit
+
     def frame(self) -> tuple[np.ndarray, np.ndarray]:
         """(origin, unit direction) of the interface coordinate s = (x - origin) . direction."""
         raise NotImplementedError
+
+    def coordinate(self, x):
+        """The interface coordinate s of the points x (UFL ``SpatialCoordinate``, or numpy
+        (gdim, n)) along which the profile, the closed forms and the proppant floor are
+        written: by default the distance along :meth:`frame`'s direction; a penny-shaped
+        crack's radius."""
+        origin, direction = (np.asarray(v, dtype=float) for v in self.frame())
+        return sum((x[i] - origin[i]) * direction[i] for i in range(len(origin)))
+
+    def slip_axis(self) -> np.ndarray | None:
+        """3D: the direction whose projection on the interface's plane is the reported slip and
+        tangential traction direction; None in 2D (the interface direction)."""
+        return None
 
     def length_scale(self) -> float:
         """A typical length of the body (tolerances of point location)."""
@@ -84,6 +107,12 @@ class InterfaceScene(Scene):
     def reference_profile(self, s: np.ndarray) -> dict[str, np.ndarray]:
         """Closed-form 'opening' / 'slip' at the coordinates s (numpy) for the plots."""
         return {}
+
+    def front_profile(self, prof) -> dict[str, np.ndarray] | None:
+        """3D: the stress intensity along the crack front from the gathered profile ``prof``,
+        {"angle": front angle (degrees), "K": computed, "K_exact": closed form} (written as
+        ``front.csv`` and plotted as ``front.png``); None for a 2D interface."""
+        return None
 
     def interface_reference(self, prof, q, friction) -> dict[str, float]:
         """Closed-form comparisons from the gathered profile ``prof``

@@ -28,6 +28,8 @@ from contactfx.references import (
     inclined_crack_KII,
     joint_column,
     opening,
+    penny_opening,
+    penny_stress_intensity,
     propping_pressure,
     rigid_punch_2d,
     stress_intensity,
@@ -209,6 +211,28 @@ def test_width_correction():
     """Feddersen: sqrt(sec(pi a / W)) = 1.0062 at W / a = 20 (docs/verification.md section 6)."""
     assert width_correction(1.0, 20.0) == pytest.approx(1.0062, abs=1e-4)
     assert width_correction(A, 20.0 * A) == pytest.approx(width_correction(1.0, 20.0), rel=1e-14)
+
+
+def test_penny_opening_volume_and_front():
+    """Sneddon's penny crack (docs/verification.md section 13): the opening integrates to the
+    crack opening volume 16 (1 - nu^2) p a^3 / (3 E) (Simpson's rule in t = sqrt(1 - r^2 / a^2),
+    where the integrand is a polynomial), and near the front it is the plane-strain field
+    8 K_I / E' sqrt(rho / (2 pi)) of K_I = 2 p sqrt(a / pi), to O(rho / a)."""
+    a, p, E, nu = 1.7, 3e6, 20e9, 0.3
+    # r dr = -a^2 t dt: V = 2 pi a^2 int_0^1 w(r(t)) t dt
+    t = np.linspace(0.0, 1.0, 201)
+    w = penny_opening(a * np.sqrt(1.0 - t**2), a, p, E, nu)
+    f = w * t
+    V = 2.0 * np.pi * a**2 * (t[1] - t[0]) / 3.0 * (f[0] + 4 * f[1:-1:2].sum() + 2 * f[2:-1:2].sum()
+                                                    + f[-1])  # fmt: skip
+    assert V == pytest.approx(16.0 * (1.0 - nu**2) * p * a**3 / (3.0 * E), rel=1e-12)
+    K = penny_stress_intensity(p, a)
+    Ep = E / (1.0 - nu**2)
+    for rho in (1e-4 * a, 1e-6 * a):
+        near = 8.0 * K / Ep * np.sqrt(rho / (2.0 * np.pi))
+        # w = near sqrt(1 - rho / (2 a)): relative difference rho / (4 a)
+        assert penny_opening(a - rho, a, p, E, nu) == pytest.approx(near, rel=0.3 * rho / a)
+    assert penny_opening(1.01 * a, a, p, E, nu) == 0.0
 
 
 # docs/verification.md section 7, SI units: E = 10 GPa, nu = 0.25 (M = 12 GPa), H = 1 m, w0 = 1 mm,

@@ -66,6 +66,7 @@ def test_serial_and_parallel_agree_al_and_friction(scene, num):
 def _interface_cases():
     from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
     from contactfx.scenes.joint import JointColumn
+    from contactfx.scenes.penny import PennyCrack
 
     inclined = CrackInclined(CrackInclined.Params(beta=45.0))
     propped = ProppedFracture(ProppedFracture.Params())
@@ -77,6 +78,16 @@ def _interface_cases():
         ("propped-al-ssn", propped, {"method": "al-ssn"}),
         ("propped-nitsche", propped, {"method": "nitsche", "theta": -1}),
         ("joint-al-ssn", JointColumn(JointColumn.Params()), {"method": "al-ssn"}),
+        (
+            "penny-nitsche",
+            PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
+            {"method": "nitsche", "degree": 2},
+        ),
+        (
+            "penny-suction-nitsche",
+            PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, pressure=-1e6)),
+            {"method": "nitsche", "theta": 0},
+        ),
     ]
 
 
