@@ -41,6 +41,16 @@ from contactfx.solvers.snes import owned_size
 __all__ = ["InterfaceProblem"]
 
 
+def _check_front(dim: int, method) -> None:
+    """Methods continued over the tips' elements (the penalties, the augmented Lagrangian
+    ones: ``_tip_terms``) are written for the point tips of 2D cracks."""
+    if dim == 3 and (method.tip_continued or method.multiplier != "none"):
+        raise ValueError(
+            f"method {method.name} is not implemented on a 3D crack front (its tip "
+            "continuation is written for 2D tips); use nitsche"
+        )
+
+
 class InterfaceProblem(Problem):
     """A body with a fitted interface (see the module docstring)."""
 
@@ -58,13 +68,10 @@ class InterfaceProblem(Problem):
             )
         if numerics.formulation != "displacement":
             raise ValueError("fitted interfaces use --formulation displacement")
+        _check_front(scene.dimension(), method)
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
-        if mesh.geometry.dim == 3 and (method.tip_continued or method.multiplier != "none"):
-            raise ValueError(
-                f"method {method.name} is not implemented on a 3D crack front (its tip "
-                "continuation is written for 2D tips); use nitsche"
-            )
+        _check_front(mesh.geometry.dim, method)  # the mesh's, whatever the scene says
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.interface_tag]
         self.tol = 1e-9 * scene.length_scale()  # of point location
         self.tips = [(np.asarray(t, dtype=float), self.tol) for t in scene.tips()]

@@ -21,6 +21,10 @@ class InterfaceScene(Scene):
     problem = InterfaceProblem
     interface_tag: ClassVar[int]
 
+    def dimension(self) -> int:
+        """The space dimension of the scene's mesh (2: plane strain)."""
+        return 2
+
     def supports(self) -> list[tuple[int, int]]:
         """Component supports: (facet tag, component) pairs with zero displacement; they hold
         for the total displacement, so for u and a alike."""

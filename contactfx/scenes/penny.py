@@ -85,6 +85,9 @@ class PennyCrack(InterfaceScene):
             h_front=p.h_front, h_crack=p.h_crack, h_far=p.h_far, grading=p.grading,
         ), 3  # fmt: skip
 
+    def dimension(self) -> int:
+        return 3
+
     def length_scale(self) -> float:
         return self.p.block_width
 

@@ -99,6 +99,10 @@ CASES: dict[str, BenchCase] = {
         2.0,
         "propped fracture, open branch p_net > p* (Sneddon)",
     ),  # fmt: skip
+    # level 2 is the scene's default mesh (68012 dofs with P2)
+    "penny-crack": BenchCase(
+        "penny-crack", {}, 4.0, "pressurised penny-shaped crack in 3D, Sneddon", p2_levels=3
+    ),
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
     "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
     "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),
