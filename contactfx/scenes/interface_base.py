@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from contactfx.contact.interface import BartonBandis
+from contactfx.driver.fields import near_points
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.scenes.base import Scene
 
@@ -48,11 +49,7 @@ class InterfaceScene(Scene):
         """Bool per point of x (3, n): on the crack's tip or front, where the jump vanishes
         (within ``tol``). By default: at one of :meth:`tips` (2D); a 3D crack gives its front
         curve."""
-        hit = np.zeros(x.shape[1], dtype=bool)
-        for tip in self.tips():
-            tip = np.asarray(tip, dtype=float)
-            hit |= np.linalg.norm(x[: len(tip)].T - tip, axis=1) < tol
-        return hit
+        return near_points([(np.asarray(tip, dtype=float), tol) for tip in self.tips()])(x)
 
     def frame(self) -> tuple[np.ndarray, np.ndarray]:
         """(origin, unit direction) of the interface coordinate s = (x - origin) . direction."""
