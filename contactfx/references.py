@@ -87,6 +87,7 @@ __all__ = [
     "stress_intensity",
     "penny_opening",
     "penny_stress_intensity",
+    "penny_shear_slip",
     "crack_plane_tractions",
     "driving_shear",
     "inclined_crack_KII",
@@ -186,6 +187,18 @@ def penny_stress_intensity(p, a):
     """K_I = 2 p sqrt(a / pi) along the front of a penny-shaped crack under the face pressure p
     (Sneddon 1946)."""
     return 2.0 * p * (a / np.pi) ** 0.5
+
+
+def penny_shear_slip(r, a, tau, E, nu, m: Any = numpy_math):
+    """Slip of a penny-shaped crack of radius a under the uniform face shear tau in an infinite
+    body, parallel to the shear: 16 (1 - nu^2) tau / (pi (2 - nu) E) sqrt(a^2 - r^2) at r <= a
+    (Kassir & Sih 1966, doi:10.1115/1.3625086; Tada, Paris & Irwin 2000, The Stress Analysis of
+    Cracks Handbook, doi:10.1115/1.801535). Near the front it is the plane-strain mode II jump
+    of K_II = 4 tau sqrt(a / pi) cos(phi) / (2 - nu) where the front normal is along the shear
+    (phi = 0), and the mode III jump of K_III = 4 (1 - nu) tau sqrt(a / pi) sin(phi) / (2 - nu)
+    where it is across (phi = 90 degrees)."""
+    return 16.0 * tau * (1.0 - nu**2) / (np.pi * (2.0 - nu) * E) * m.sqrt(m.maximum(a**2 - r**2,
+                                                                                  0.0))  # fmt: skip
 
 
 def crack_plane_tractions(sigma, beta_deg, m: Any = numpy_math):

@@ -151,6 +151,8 @@ def _parser() -> argparse.ArgumentParser:
     penny.add_argument("--h-crack", type=float, required=True, metavar="H")
     penny.add_argument("--h-far", type=float, required=True, metavar="H")
     _add_grading(penny)
+    penny.add_argument("--half", action="store_true", help="the half block y >= 0 (one "
+                       "symmetry plane) instead of the quarter")  # fmt: skip
     _add_output(penny)
 
     joint = geometries.add_parser(
@@ -230,7 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         builder = partial(
             penny_block,
             half_width=args.half_width, crack_radius=args.crack_radius, h_front=args.h_front,
-            h_crack=args.h_crack, h_far=args.h_far, grading=args.grading,
+            h_crack=args.h_crack, h_far=args.h_far, grading=args.grading, half=args.half,
         )  # fmt: skip
     elif args.geometry == "joint-column":
         builder = partial(joint_column, width=args.width, block_height=args.block_height, h=args.h)

@@ -3,7 +3,10 @@ tetrahedra graded towards the crack and refined further at the crack front.
 
 The block is [0, half_width]^2 x [-half_width, half_width]; the crack is the quarter disk
 x^2 + y^2 <= a^2, z = 0 (``a = crack_radius``), so the planes x = 0 and y = 0 are planes of
-symmetry of the whole cracked block (the caller supports them). The crack is a set of mesh
+symmetry of the whole cracked block (the caller supports them). With ``half``, the block is
+[-half_width, half_width] x [0, half_width] x [-half_width, half_width] and the crack the half
+disk y >= 0 (y = 0 the one plane of symmetry: a load with no y component, e.g. a shear along
+x). The crack is a set of mesh
 triangles inside the volume (OpenCASCADE boolean fragment of the box with the quarter disk): the
 mesh is conforming and the crack triangles are interior facets; no node is duplicated, the
 displacement jump is left to the solver. The crack front, the arc r = a, is a chain of mesh
@@ -48,8 +51,8 @@ class PennyBlockCells(IntEnum):
 
 
 class PennyBlockFacets(IntEnum):
-    """Facet tags of :func:`penny_block`: the symmetry planes x = 0 and y = 0, the outer faces
-    and the crack (interior facets)."""
+    """Facet tags of :func:`penny_block`: the symmetry planes x = 0 (quarter) and y = 0, the
+    outer faces (x = -half_width: half only) and the crack (interior facets)."""
 
     XSYM = 1
     YSYM = 2
@@ -58,6 +61,7 @@ class PennyBlockFacets(IntEnum):
     BOTTOM = 5
     TOP = 6
     CRACK = 7
+    XMIN = 8
 
 
 def penny_block(
@@ -69,8 +73,9 @@ def penny_block(
     h_crack: float,
     h_far: float,
     grading: float = 0.3,
+    half: bool = False,
 ) -> None:
-    """Build and mesh the quarter block with its quarter penny crack in ``model``.
+    """Build and mesh the quarter (or half) block with its penny crack in ``model``.
 
     Args:
         model: The ``gmsh.model`` namespace of an open gmsh session.
@@ -81,6 +86,7 @@ def penny_block(
         h_crack: Element size on and near the crack, <= h_far (length).
         h_far: Element size far from the crack (length).
         grading: Size increase per unit distance (dimensionless).
+        half: The half block y >= 0 instead of the quarter x, y >= 0.
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -94,29 +100,27 @@ def penny_block(
     check_less_equal("h_crack", h_crack, "h_far", h_far)
 
     w, a = half_width, crack_radius
+    x0 = -w if half else 0.0
     occ = model.occ
-    block = occ.addBox(0.0, 0.0, -w, w, w, 2.0 * w)
+    block = occ.addBox(x0, 0.0, -w, w - x0, w, 2.0 * w)
     disk = occ.addDisk(0.0, 0.0, 0.0, a, a)
-    square = occ.addRectangle(0.0, 0.0, 0.0, a, a)
-    quarter, _ = occ.intersect([(2, disk)], [(2, square)])
-    # The block comes out as one volume with the quarter disk embedded in it (it touches the
-    # symmetry planes but does not cut the volume in two); children[1] is the disk's image.
-    _, children = occ.fragment([(3, block)], quarter)
+    cut = occ.addRectangle(-a if half else 0.0, 0.0, 0.0, 2.0 * a if half else a, a)
+    part, _ = occ.intersect([(2, disk)], [(2, cut)])
+    # The block comes out as one volume with the part of the disk embedded in it (it touches
+    # the symmetry planes but does not cut the volume in two); children[1] is its image.
+    _, children = occ.fragment([(3, block)], part)
     occ.synchronize()
     crack = [tag for _, tag in children[1]]
-    add_physical_groups(
-        model,
-        PennyBlockCells.DOMAIN,
-        {
-            PennyBlockFacets.XSYM: (0, 0.0),
-            PennyBlockFacets.YSYM: (1, 0.0),
-            PennyBlockFacets.XMAX: (0, w),
-            PennyBlockFacets.YMAX: (1, w),
-            PennyBlockFacets.BOTTOM: (2, -w),
-            PennyBlockFacets.TOP: (2, w),
-        },
-        interior={PennyBlockFacets.CRACK: crack},
-    )
+    sides = {
+        PennyBlockFacets.XMIN if half else PennyBlockFacets.XSYM: (0, x0),
+        PennyBlockFacets.YSYM: (1, 0.0),
+        PennyBlockFacets.XMAX: (0, w),
+        PennyBlockFacets.YMAX: (1, w),
+        PennyBlockFacets.BOTTOM: (2, -w),
+        PennyBlockFacets.TOP: (2, w),
+    }
+    add_physical_groups(model, PennyBlockCells.DOMAIN, sides,
+                        interior={PennyBlockFacets.CRACK: crack})  # fmt: skip
 
     # Distances: to the crack disk, sqrt(max(r - a, 0)^2 + z^2) = sqrt(((|r - a| + r - a) / 2)^2
     # + z^2), and to the front circle, sqrt((r - a)^2 + z^2), with r = sqrt(x^2 + y^2).

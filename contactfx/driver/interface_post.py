@@ -256,11 +256,15 @@ def plot_profile(prof: Profile, scene, path: Path) -> None:
 
 
 def plot_front(front: dict[str, np.ndarray], scene, path: Path) -> None:
-    """K along a 3D crack front against the front angle, with the closed form."""
+    """The stress intensities along a 3D crack front (every key K... of ``front`` with its
+    K..._exact) against the front angle."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.0))
-    ax.plot(front["angle"], front["K"], "o-", ms=3, label="K (displacement extrapolation)")
-    ax.plot(front["angle"], front["K_exact"], "-", lw=1, label="K (closed form)")
+    for name in (k for k in front if k != "angle" and not k.endswith("_exact")):
+        (line,) = ax.plot(front["angle"], front[name], "o-", ms=3,
+                          label=f"{name} (displacement extrapolation)")  # fmt: skip
+        ax.plot(front["angle"], front[f"{name}_exact"], "-", lw=1, color=line.get_color(),
+                label=f"{name} (closed form)")  # fmt: skip
     ax.set_xlabel("front angle (degrees)")
     ax.set_ylabel("stress intensity")
     ax.legend(fontsize=8)

@@ -9,7 +9,7 @@ from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
-from contactfx.scenes.penny import PennyCrack
+from contactfx.scenes.penny import PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
@@ -31,6 +31,7 @@ SCENES: dict[str, type[Scene]] = {
         CrackInclined,
         ProppedFracture,
         PennyCrack,
+        PennyShear,
         JointColumn,
         PatchTest,
         HertzCylinders,

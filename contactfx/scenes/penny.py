@@ -1,4 +1,5 @@
-"""A penny-shaped (circular) crack in a 3D block: the fitted interface in 3D.
+"""A penny-shaped (circular) crack in a 3D block: the fitted interface in 3D (``penny-crack``,
+pressurised; ``penny-shear``, closed and sliding under remote compression with friction).
 
 Geometry: the crack is the disk r = sqrt(x^2 + y^2) <= a in the plane z = 0 (interface normal
 n_I = e_z) at the centre of the cube [-W/2, W/2]^3; the planes x = 0 and y = 0 are planes of
@@ -22,36 +23,50 @@ by the front angle phi = atan2(y, x) (``--front-bins`` bins of the quarter), and
 the displacement extrapolation of the 2D crack scenes
 (:func:`contactfx.scenes.crack.extrapolated_K`) at the distance a - r from the front: the
 near-front field is the plane-strain one.
+
+``penny-shear``: the crack under the remote uniaxial compression sigma along the direction
+(sin beta, 0, cos beta), at beta to the crack's normal: on the crack plane the normal stress
+sigma_n = sigma cos^2 beta and the shear tau = -sigma sin beta cos beta along x, so y = 0 is the
+one plane of symmetry and the half block y >= 0 is meshed (``half``), u_y = 0 on y = 0, three
+conditions at two bottom corners removing the other rigid motions. The block's faces carry the
+remote traction (the crack's perturbation decays as (a / r)^3). The crack stays closed under
+sigma_n; with Coulomb friction (or Tresca) it slides where |tau| exceeds the bound, and then
+under the uniform driving shear q = sign(tau) (|tau| - mu sigma_n) the slip is parallel to x
+and elliptical, 16 (1 - nu^2) q / (pi (2 - nu) E) sqrt(a^2 - r^2) (Kassir & Sih 1966,
+doi:10.1115/1.3625086), with K_II = 4 q sqrt(a / pi) cos(phi) / (2 - nu) and K_III =
+4 (1 - nu) q sqrt(a / pi) sin(phi) / (2 - nu) along the front (Tada, Paris & Irwin 2000,
+doi:10.1115/1.801535); the faces carry sigma_n and the shear mu sigma_n.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import ufl
 
 from contactfx import references as cf
 from contactfx._compat import numpy_math, ufl_math
+from contactfx.driver.interface_post import STATUS
 from contactfx.meshes import PennyBlockFacets, penny_block
 from contactfx.params import param
 from contactfx.scenes.base import elastic
 from contactfx.scenes.crack import extrapolated_K
 from contactfx.scenes.interface_base import InterfaceScene
 
-__all__ = ["PennyCrack"]
+__all__ = ["PennyCrack", "PennyShear"]
 
 
 @dataclass(frozen=True)
-class PennyCrackParams(elastic(10e9, 0.25)):
+class _PennyParams(elastic(10e9, 0.25)):
     crack_radius: float = param(1.0, "crack radius a", positive=True)
     block_width: float = param(16.0, "block width W (the cube [-W/2, W/2]^3)", positive=True)
     h_front: float = param(0.05, "element size at the crack front (<= h-crack)", positive=True)
     h_crack: float = param(0.1, "element size on the crack", positive=True)
     h_far: float = param(2.0, "element size far from the crack", positive=True)
     grading: float = param(0.3, "element size increase per unit distance", positive=True)
-    pressure: float = param(1e6, "fluid pressure p on the crack faces (< 0: suction closes it)")
     front_bins: int = param(6, "bins of the front angle for K along the front", positive=True)
 
     def __post_init__(self) -> None:
@@ -68,21 +83,21 @@ class PennyCrackParams(elastic(10e9, 0.25)):
             )
 
 
-class PennyCrack(InterfaceScene):
-    name = "penny-crack"
-    summary = "pressurised penny-shaped crack in 3D (Sneddon opening, K_I along the front)"
-    Params = PennyCrackParams
+class _PennyBlock(InterfaceScene):
+    """Shared geometry of the penny-crack scenes: the quarter (or ``half``) block."""
+
+    interface_tag = PennyBlockFacets.CRACK
     #: P2: P1 tetrahedra on the default mesh give K 24 % and the opening 10 % low
     #: (docs/verification.md section 13)
-    numerics_defaults = {"steps": 1, "degree": 2}
-    interface_tag = PennyBlockFacets.CRACK
+    numerics_defaults: ClassVar[dict] = {"steps": 1, "degree": 2}
+    half: ClassVar[bool] = False
 
-    # -- geometry ---------------------------------------------------------------------------
     def mesh_builder(self):
         p = self.p
         return functools.partial(
             penny_block, half_width=0.5 * p.block_width, crack_radius=p.crack_radius,
             h_front=p.h_front, h_crack=p.h_crack, h_far=p.h_far, grading=p.grading,
+            half=self.half,
         ), 3  # fmt: skip
 
     def dimension(self) -> int:
@@ -94,12 +109,11 @@ class PennyCrack(InterfaceScene):
     def h_contact(self) -> float:
         return self.p.h_crack
 
-    def supports(self):
-        return [(PennyBlockFacets.XSYM, 0), (PennyBlockFacets.YSYM, 1)]
-
-    def pinned(self):
-        half = 0.5 * self.p.block_width
-        return [(np.array([half, half, -half]), 2)]
+    def problem_data(self, numerics):
+        raise ValueError(
+            f"scene '{self.name}' cannot be written as a problem file: problem files carry 2D "
+            "interfaces only"
+        )
 
     def side(self, x):
         return x[2]
@@ -116,13 +130,38 @@ class PennyCrack(InterfaceScene):
     def slip_axis(self):
         return np.array([1.0, 0.0, 0.0])
 
-    def problem_data(self, numerics):
-        raise ValueError(
-            f"scene '{self.name}' cannot be written as a problem file: problem files carry 2D "
-            "interfaces only"
-        )
+    def _front_K(self, prof, jump, E: float, nu: float) -> tuple[np.ndarray, np.ndarray]:
+        """(bin centres, K per bin) of the front angle phi = atan2(y, x) over the model's part
+        of the front, from the ``jump`` at the crack's vertices (:func:`extrapolated_K` with
+        the modulus E / (1 - nu^2) of the mode)."""
+        p = self.p
+        a, n = p.crack_radius, p.front_bins
+        phi = np.degrees(np.arctan2(prof.x[:, 1], prof.x[:, 0]))
+        edges = np.linspace(0.0, 180.0 if self.half else 90.0, n + 1)
+        K = np.array([
+            extrapolated_K(a - prof.s, jump, E, nu, a, near=(phi >= lo) & (phi <= hi))
+            for lo, hi in zip(edges[:-1], edges[1:], strict=True)
+        ])  # fmt: skip
+        return 0.5 * (edges[:-1] + edges[1:]), K
 
-    # -- loads ------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class PennyCrackParams(_PennyParams):
+    pressure: float = param(1e6, "fluid pressure p on the crack faces (< 0: suction closes it)")
+
+
+class PennyCrack(_PennyBlock):
+    name = "penny-crack"
+    summary = "pressurised penny-shaped crack in 3D (Sneddon opening, K_I along the front)"
+    Params = PennyCrackParams
+
+    def supports(self):
+        return [(PennyBlockFacets.XSYM, 0), (PennyBlockFacets.YSYM, 1)]
+
+    def pinned(self):
+        half = 0.5 * self.p.block_width
+        return [(np.array([half, half, -half]), 2)]
+
     def fluid_pressure(self):
         return self.p.pressure
 
@@ -145,17 +184,9 @@ class PennyCrack(InterfaceScene):
 
     def front_profile(self, prof):
         p = self.p
-        a, n = p.crack_radius, p.front_bins
-        phi = np.degrees(np.arctan2(prof.x[:, 1], prof.x[:, 0]))
-        edges = np.linspace(0.0, 90.0, n + 1)
-        K = np.array([
-            extrapolated_K(a - prof.s, prof.opening, p.E, p.nu, a,
-                           near=(phi >= lo) & (phi <= hi))
-            for lo, hi in zip(edges[:-1], edges[1:], strict=True)
-        ])  # fmt: skip
-        K_exact = cf.penny_stress_intensity(max(p.pressure, 0.0), a)
-        return {"angle": 0.5 * (edges[:-1] + edges[1:]), "K": K,
-                "K_exact": np.full(n, K_exact)}  # fmt: skip
+        angle, K = self._front_K(prof, prof.opening, p.E, p.nu)
+        K_exact = cf.penny_stress_intensity(max(p.pressure, 0.0), p.crack_radius)
+        return {"angle": angle, "K": K, "K_exact": np.full(len(K), K_exact)}
 
     def interface_reference(self, prof, q, friction):
         p, a = self.p.pressure, self.p.crack_radius
@@ -174,4 +205,114 @@ class PennyCrack(InterfaceScene):
             out["force_rel_error"] = (
                 abs(q.force - out["contact_force_exact"]) / out["contact_force_exact"]
             )
+        return out
+
+
+@dataclass(frozen=True)
+class PennyShearParams(_PennyParams):
+    sigma: float = param(10e6, "remote uniaxial compression", positive=True)
+    beta: float = param(45.0, "angle of the compression to the crack's normal, degrees")
+
+
+class PennyShear(_PennyBlock):
+    name = "penny-shear"
+    summary = "closed penny-shaped crack sliding under inclined compression, Coulomb (3D)"
+    Params = PennyShearParams
+    numerics_defaults: ClassVar[dict] = {"steps": 1, "degree": 2, "friction": "coulomb",
+                                         "mu": 0.3}  # fmt: skip
+    half = True
+
+    def __init__(self, params) -> None:
+        super().__init__(params)
+        self.friction = None  # the friction law of the run (set by configure)
+
+    def configure(self, numerics) -> None:
+        self.friction = numerics.friction_law()
+
+    def supports(self):
+        return [(PennyBlockFacets.YSYM, 1)]
+
+    def pinned(self):
+        w = 0.5 * self.p.block_width
+        return [(np.array([-w, 0.0, -w]), 0), (np.array([-w, 0.0, -w]), 2),
+                (np.array([w, 0.0, -w]), 2)]  # fmt: skip
+
+    def remote_stress(self) -> np.ndarray:
+        b = np.radians(self.p.beta)
+        d = np.array([np.sin(b), 0.0, np.cos(b)])
+        return -self.p.sigma * np.outer(d, d)
+
+    def load(self, v, ds, t):
+        n = ufl.FacetNormal(ds.ufl_domain())
+        sigma = ufl.as_matrix(self.remote_stress().tolist())
+        outer = (PennyBlockFacets.XMIN, PennyBlockFacets.XMAX, PennyBlockFacets.YMAX,
+                 PennyBlockFacets.BOTTOM, PennyBlockFacets.TOP)  # fmt: skip
+        return t * ufl.dot(ufl.dot(sigma, n), v) * ds(outer)
+
+    # -- closed forms -----------------------------------------------------------------------
+    def _plane(self) -> tuple[float, float]:
+        """(sigma_n, tau): the compression across the crack and the shear along x on it."""
+        S = self.remote_stress()
+        return float(-S[2, 2]), float(S[0, 2])
+
+    def _bound(self, p):
+        """Friction bound of the law at the contact pressure p (numbers)."""
+        f = self.friction
+        if f is None:
+            return 0.0 * p
+        if f.name == "coulomb":
+            return f.mu * p
+        return f.threshold + 0.0 * p
+
+    def _q(self) -> float:
+        """Driving shear: tau minus the friction resistance when it is exceeded, else 0."""
+        sigma_n, tau = self._plane()
+        return float(cf.driving_shear(tau, self._bound(sigma_n), 1.0))
+
+    def _slip(self, r):
+        m = numpy_math if isinstance(r, np.ndarray) else ufl_math
+        p = self.p
+        return cf.penny_shear_slip(r, p.crack_radius, self._q(), p.E, p.nu, m)
+
+    def exact_slip(self, s):
+        return self._slip(s)
+
+    def exact_pressure_interface(self, s):
+        return self._plane()[0] + 0.0 * s
+
+    def reference_profile(self, s):
+        return {"slip": self._slip(np.asarray(s))}
+
+    def _K0(self) -> float:
+        """K_II at phi = 0: 4 |q| sqrt(a / pi) / (2 - nu)."""
+        return 4.0 * abs(self._q()) * np.sqrt(self.p.crack_radius / np.pi) / (2.0 - self.p.nu)
+
+    def front_profile(self, prof):
+        """The amplitude K_II0 = K_II / cos(phi) = K_III / ((1 - nu) sin(phi)) per bin: the
+        slip is parallel to x, so near the front its normal part slip cos(phi) is the mode II
+        jump and its part along the front slip sin(phi) the mode III one, both of the
+        plane-strain fit of the slip itself."""
+        p = self.p
+        angle, K = self._front_K(prof, prof.slip, p.E, p.nu)
+        return {"angle": angle, "K_II0": K, "K_II0_exact": np.full(len(K), self._K0())}
+
+    def interface_reference(self, prof, q, friction):
+        sigma_n, tau = self._plane()
+        a, q_d, K0 = self.p.crack_radius, self._q(), self._K0()
+        out = {"sigma_n": sigma_n, "tau": tau, "driving_shear": q_d, "K_II0_exact": K0}
+        if q_d == 0.0:
+            out["max_slip"] = float(np.max(np.abs(prof.slip), initial=0.0))  # stick
+            return out
+        front = self.front_profile(prof)
+        err = np.abs(front["K_II0"] - K0) / K0
+        out["K_II0"] = float(np.mean(front["K_II0"]))
+        out["K_rel_error"] = abs(out["K_II0"] - K0) / K0
+        out["K_rel_error_max"] = float(np.max(err))
+        # sliding: the face shear equals the bound at sigma_n away from the front
+        inner = prof.s < a - 2.0 * self.p.h_crack
+        shear = np.abs(prof.t[inner])
+        out["face_shear_error"] = float(
+            np.max(np.abs(shear - self._bound(sigma_n)), initial=0.0) / sigma_n
+        )
+        out["slipping_fraction"] = float(np.mean(prof.status[inner] == STATUS["slip"]))
         return out

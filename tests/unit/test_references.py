@@ -29,6 +29,7 @@ from contactfx.references import (
     joint_column,
     opening,
     penny_opening,
+    penny_shear_slip,
     penny_stress_intensity,
     propping_pressure,
     rigid_punch_2d,
@@ -233,6 +234,26 @@ def test_penny_opening_volume_and_front():
         # w = near sqrt(1 - rho / (2 a)): relative difference rho / (4 a)
         assert penny_opening(a - rho, a, p, E, nu) == pytest.approx(near, rel=0.3 * rho / a)
     assert penny_opening(1.01 * a, a, p, E, nu) == 0.0
+
+
+def test_penny_shear_slip_and_front():
+    """The circular shear crack (docs/verification.md section 13): near the front its slip is
+    the plane-strain mode II jump 8 K_II / E' sqrt(rho / (2 pi)) of the handbook's
+    K_II = 4 q sqrt(a / pi) / (2 - nu) where the front's normal is along the slip, and the
+    mode III jump 8 (1 + nu) K_III / E sqrt(rho / (2 pi)) of K_III = (1 - nu) K_II where it is
+    across: the same slip, two independent formulas, to O(rho / a)."""
+    a, q, E, nu = 1.3, -2e6, 30e9, 0.2
+    K_II = 4.0 * abs(q) * np.sqrt(a / np.pi) / (2.0 - nu)
+    K_III = (1.0 - nu) * K_II
+    for rho in (1e-4 * a, 1e-6 * a):
+        slip = abs(penny_shear_slip(a - rho, a, q, E, nu))
+        mode_II = 8.0 * K_II * (1.0 - nu**2) / E * np.sqrt(rho / (2.0 * np.pi))
+        mode_III = 8.0 * K_III * (1.0 + nu) / E * np.sqrt(rho / (2.0 * np.pi))
+        assert slip == pytest.approx(mode_II, rel=0.3 * rho / a)
+        assert slip == pytest.approx(mode_III, rel=0.3 * rho / a)
+    # the sign of the shear, and nothing beyond the front
+    assert penny_shear_slip(0.0, a, q, E, nu) < 0.0 < penny_shear_slip(0.0, a, -q, E, nu)
+    assert penny_shear_slip(1.01 * a, a, q, E, nu) == 0.0
 
 
 # docs/verification.md section 7, SI units: E = 10 GPa, nu = 0.25 (M = 12 GPa), H = 1 m, w0 = 1 mm,

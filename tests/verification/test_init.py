@@ -123,7 +123,10 @@ def test_init_round_trip(tmp_path, name, params, numerics):
 
 
 #: scenes a problem file cannot say yet (a 3D interface), refused with one line
-NO_PROBLEM_FILE = {"penny-crack": "problem files carry 2D interfaces only"}
+NO_PROBLEM_FILE = {
+    "penny-crack": "problem files carry 2D interfaces only",
+    "penny-shear": "problem files carry 2D interfaces only",
+}
 
 
 def test_every_scene_has_a_round_trip_case():

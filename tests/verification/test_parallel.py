@@ -66,7 +66,7 @@ def test_serial_and_parallel_agree_al_and_friction(scene, num):
 def _interface_cases():
     from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
     from contactfx.scenes.joint import JointColumn
-    from contactfx.scenes.penny import PennyCrack
+    from contactfx.scenes.penny import PennyCrack, PennyShear
 
     inclined = CrackInclined(CrackInclined.Params(beta=45.0))
     propped = ProppedFracture(ProppedFracture.Params())
@@ -82,6 +82,11 @@ def _interface_cases():
             "penny-nitsche",
             PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
             {"method": "nitsche", "degree": 2},
+        ),
+        (
+            "penny-shear-nitsche",
+            PennyShear(PennyShear.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
+            {"method": "nitsche"},
         ),
         (
             "penny-suction-nitsche",
