@@ -47,6 +47,7 @@ __all__ = [
     "ProppedFracture",
     "stress_intensity_from_jump",
     "extrapolated_K",
+    "SlidingCrack",
 ]
 
 _OUTER = (CrackPlateFacets.BOTTOM, CrackPlateFacets.RIGHT, CrackPlateFacets.TOP,
@@ -306,11 +307,10 @@ class CrackInclinedParams(_PlateParams):
     sigma: float = param(10e6, "uniaxial compression along y", positive=True)
 
 
-class CrackInclined(_CrackPlate):
-    name = "crack-inclined"
-    summary = "inclined closed crack under uniaxial compression, Coulomb / Tresca friction (K_II)"
-    Params = CrackInclinedParams
-    numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 1}
+class SlidingCrack:
+    """Mixin of the closed crack scenes that slide under a remote stress: the run's friction
+    law, its bound and the driving shear from the scene's ``_plane()`` = (sigma_n, tau) on
+    the crack plane."""
 
     def __init__(self, params) -> None:
         super().__init__(params)
@@ -318,19 +318,6 @@ class CrackInclined(_CrackPlate):
 
     def configure(self, numerics) -> None:
         self.friction = numerics.friction_law()
-
-    def angle(self):
-        return self.p.beta
-
-    def remote_stress(self):
-        return np.array([[0.0, 0.0], [0.0, -self.p.sigma]])
-
-    def _plane(self):
-        d, n = self._axes()
-        S = self.remote_stress()
-        sigma_n = -n @ S @ n
-        tau = d @ S @ n
-        return sigma_n, tau
 
     def _bound(self, p):
         """Friction bound of the law at the contact pressure p (numbers)."""
@@ -345,6 +332,26 @@ class CrackInclined(_CrackPlate):
         """Driving shear: tau minus the friction resistance when it is exceeded, else 0."""
         sigma_n, tau = self._plane()
         return float(cf.driving_shear(tau, self._bound(sigma_n), 1.0))
+
+
+class CrackInclined(SlidingCrack, _CrackPlate):
+    name = "crack-inclined"
+    summary = "inclined closed crack under uniaxial compression, Coulomb / Tresca friction (K_II)"
+    Params = CrackInclinedParams
+    numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 1}
+
+    def angle(self):
+        return self.p.beta
+
+    def remote_stress(self):
+        return np.array([[0.0, 0.0], [0.0, -self.p.sigma]])
+
+    def _plane(self):
+        d, n = self._axes()
+        S = self.remote_stress()
+        sigma_n = -n @ S @ n
+        tau = d @ S @ n
+        return sigma_n, tau
 
     def face_loads(self):
         return 0.0, self._q()

@@ -53,7 +53,7 @@ from contactfx.driver.interface_post import STATUS
 from contactfx.meshes import PennyBlockFacets, penny_block
 from contactfx.params import param
 from contactfx.scenes.base import elastic
-from contactfx.scenes.crack import extrapolated_K
+from contactfx.scenes.crack import SlidingCrack, extrapolated_K
 from contactfx.scenes.interface_base import InterfaceScene
 
 __all__ = ["PennyCrack", "PennyShear"]
@@ -214,20 +214,13 @@ class PennyShearParams(_PennyParams):
     beta: float = param(45.0, "angle of the compression to the crack's normal, degrees")
 
 
-class PennyShear(_PennyBlock):
+class PennyShear(SlidingCrack, _PennyBlock):
     name = "penny-shear"
     summary = "closed penny-shaped crack sliding under inclined compression, Coulomb (3D)"
     Params = PennyShearParams
     numerics_defaults: ClassVar[dict] = {"steps": 1, "degree": 2, "friction": "coulomb",
                                          "mu": 0.3}  # fmt: skip
     half = True
-
-    def __init__(self, params) -> None:
-        super().__init__(params)
-        self.friction = None  # the friction law of the run (set by configure)
-
-    def configure(self, numerics) -> None:
-        self.friction = numerics.friction_law()
 
     def supports(self):
         return [(PennyBlockFacets.YSYM, 1)]
@@ -254,20 +247,6 @@ class PennyShear(_PennyBlock):
         """(sigma_n, tau): the compression across the crack and the shear along x on it."""
         S = self.remote_stress()
         return float(-S[2, 2]), float(S[0, 2])
-
-    def _bound(self, p):
-        """Friction bound of the law at the contact pressure p (numbers)."""
-        f = self.friction
-        if f is None:
-            return 0.0 * p
-        if f.name == "coulomb":
-            return f.mu * p
-        return f.threshold + 0.0 * p
-
-    def _q(self) -> float:
-        """Driving shear: tau minus the friction resistance when it is exceeded, else 0."""
-        sigma_n, tau = self._plane()
-        return float(cf.driving_shear(tau, self._bound(sigma_n), 1.0))
 
     def _slip(self, r):
         m = numpy_math if isinstance(r, np.ndarray) else ufl_math
