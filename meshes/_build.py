@@ -66,6 +66,7 @@ __all__ = [
     "check_less_equal",
     "check_positive",
     "matheval_number",
+    "refine_near",
     "model_to_mesh",
     "set_graded_size",
     "write_msh",
@@ -340,6 +341,27 @@ def set_graded_size(
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     return size
+
+
+def refine_near(model: type[gmsh.model], size: int, distance: str, *, size_min: float,
+                size_max: float, grading: float) -> int:  # fmt: skip
+    """Combine the size field ``size`` with a finer zone: the size ``size_min`` at distance 0
+    of it (``distance``, a MathEval expression) growing by ``grading`` per unit distance up to
+    ``size_max``; the smaller of the two holds (a gmsh Min field, the background mesh).
+    Returns the Min field's tag."""
+    field = model.mesh.field
+    zone_distance = field.add("MathEval")
+    field.setString(zone_distance, "F", distance)
+    zone = field.add("Threshold")
+    field.setNumber(zone, "InField", zone_distance)
+    field.setNumber(zone, "SizeMin", size_min)
+    field.setNumber(zone, "SizeMax", size_max)
+    field.setNumber(zone, "DistMin", 0.0)
+    field.setNumber(zone, "DistMax", (size_max - size_min) / grading)
+    both = field.add("Min")
+    field.setNumbers(both, "FieldsList", [size, zone])
+    field.setAsBackgroundMesh(both)
+    return both
 
 
 def matheval_number(value: float) -> str:

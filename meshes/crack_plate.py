@@ -33,6 +33,7 @@ from contactfx.meshes._build import (
     check_less_equal,
     check_positive,
     matheval_number,
+    refine_near,
     set_graded_size,
 )
 
@@ -152,21 +153,10 @@ def crack_plate(
         dist_min=min(0.5 * crack_half_length, gap),
         grading=grading,
     )
-    import gmsh
-
     if h_tip < h_crack:  # the smaller of that size and h_tip + grading * (distance to a tip)
-        field = model.mesh.field
-        tip_distance = field.add("MathEval")
-        field.setString(tip_distance, "F", f"Sqrt((Fabs({along})-{a})^2+{across}^2)")
-        tip = field.add("Threshold")
-        field.setNumber(tip, "InField", tip_distance)
-        field.setNumber(tip, "SizeMin", h_tip)
-        field.setNumber(tip, "SizeMax", h_far)
-        field.setNumber(tip, "DistMin", 0.0)
-        field.setNumber(tip, "DistMax", (h_far - h_tip) / grading)
-        both = field.add("Min")
-        field.setNumbers(both, "FieldsList", [size, tip])
-        field.setAsBackgroundMesh(both)
+        refine_near(model, size, f"Sqrt((Fabs({along})-{a})^2+{across}^2)", size_min=h_tip,
+                    size_max=h_far, grading=grading)  # fmt: skip
+    import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
     model.mesh.generate(2)

@@ -35,6 +35,7 @@ from contactfx.meshes._build import (
     check_less_equal,
     check_positive,
     matheval_number,
+    refine_near,
     set_graded_size,
 )
 
@@ -129,21 +130,10 @@ def penny_block(
     beyond = f"((Fabs({r}-{am})+{r}-{am})/2)"
     size = set_graded_size(model, f"Sqrt({beyond}^2+z^2)", size_min=h_crack, size_max=h_far,
                            dist_min=0.5 * a, grading=grading)  # fmt: skip
-    import gmsh
-
     if h_front < h_crack:  # the smaller of that size and h_front + grading * (distance to front)
-        field = model.mesh.field
-        front_distance = field.add("MathEval")
-        field.setString(front_distance, "F", f"Sqrt(({r}-{am})^2+z^2)")
-        front = field.add("Threshold")
-        field.setNumber(front, "InField", front_distance)
-        field.setNumber(front, "SizeMin", h_front)
-        field.setNumber(front, "SizeMax", h_far)
-        field.setNumber(front, "DistMin", 0.0)
-        field.setNumber(front, "DistMax", (h_far - h_front) / grading)
-        both = field.add("Min")
-        field.setNumbers(both, "FieldsList", [size, front])
-        field.setAsBackgroundMesh(both)
+        refine_near(model, size, f"Sqrt(({r}-{am})^2+z^2)", size_min=h_front, size_max=h_far,
+                    grading=grading)  # fmt: skip
+    import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
     gmsh.option.setNumber("Mesh.Algorithm3D", 1)
