@@ -33,6 +33,10 @@ __all__ = [
     "dirichletbc",
     "cell_diameter",
     "mixed_space",
+    "quadrature_space",
+    "quadrature_rule",
+    "eval_expression",
+    "cell_coordinates",
     "numpy_math",
     "ufl_math",
     "FacetTree",
@@ -175,6 +179,45 @@ def mixed_space(mesh, degree: int, gdim: int, multiplier_shape: tuple[int, ...])
     else:
         Qe = ufl.FiniteElement("Lagrange", cell, 1)
     return dolfinx.fem.FunctionSpace(mesh, ufl.MixedElement([Ve, Qe]))
+
+
+def quadrature_rule(mesh, degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """(points (n, tdim), weights (n,)) of the reference cell's default rule of ``degree``:
+    the rule of a form with ``{"quadrature_degree": degree, "quadrature_rule": "default"}``
+    and the points of :func:`quadrature_space`."""
+    import basix
+
+    cell = mesh.basix_cell() if _NEW else getattr(basix.CellType, mesh.topology.cell_name())
+    points, weights = basix.make_quadrature(cell, degree)
+    return np.asarray(points), np.asarray(weights)
+
+
+def quadrature_space(mesh, degree: int):
+    """A scalar space of values at the points of :func:`quadrature_rule` (one dof per cell and
+    point, in the rule's order)."""
+    if _NEW:
+        import basix.ufl
+
+        element = basix.ufl.quadrature_element(mesh.basix_cell(), scheme="default", degree=degree)
+        return dolfinx.fem.functionspace(mesh, element)
+    element = ufl.FiniteElement("Quadrature", mesh.ufl_cell(), degree, quad_scheme="default")
+    return dolfinx.fem.FunctionSpace(mesh, element)
+
+
+def eval_expression(expr: dolfinx.fem.Expression, mesh, cells: np.ndarray) -> np.ndarray:
+    """Values (len(cells), points * value size) of a compiled expression on local cells."""
+    cells = np.asarray(cells, dtype=np.int32)
+    return expr.eval(mesh, cells) if _NEW else expr.eval(cells)
+
+
+def cell_coordinates(mesh) -> np.ndarray:
+    """(cells incl. ghosts, nodes per cell, gdim): the coordinates of every local cell's
+    geometry nodes (its vertices for an affine mesh)."""
+    dofmap = mesh.geometry.dofmap
+    if not isinstance(dofmap, np.ndarray):
+        n = dofmap.links(0).size if dofmap.num_nodes else 0
+        dofmap = dofmap.array.reshape(-1, n)
+    return mesh.geometry.x[dofmap][:, :, : mesh.geometry.dim]
 
 
 # Math namespaces (sqrt, atan2, cos, sin) for closed forms written once for numpy arrays and UFL

@@ -70,6 +70,7 @@ def crack_plate(
     grading: float = 0.3,
     split_at: tuple[float, ...] = (),
     h_tip: float | None = None,
+    embed: bool = True,
 ) -> None:
     """Build and mesh the cracked square [-half_width, half_width]^2 in ``model`` (a gmsh builder).
 
@@ -86,6 +87,9 @@ def crack_plate(
             centre) that must be mesh nodes, e.g. the ends of a proppant layer (length).
         h_tip: Element size at the crack tips, <= h_crack (default h_crack): the size grows
             from h_tip at the tips by ``grading`` per unit distance up to h_crack (length).
+        embed: Whether the crack is a chain of mesh edges; False: the plate's mesh ignores
+            the crack (a background mesh for an unfitted crack, graded towards the crack as
+            the fitted one; no ``CRACK`` group, ``split_at`` unused).
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -118,14 +122,17 @@ def crack_plate(
     gap = half_width - crack_half_length * max(abs(cos), abs(sin))
     w = half_width
     surface = model.occ.addRectangle(-w, -w, 0.0, 2.0 * w, 2.0 * w)
-    stations = sorted((-crack_half_length, *split_at, crack_half_length))
-    points = [model.occ.addPoint(s * cos, s * sin, 0.0) for s in stations]
-    lines = [(1, model.occ.addLine(p, q)) for p, q in zip(points[:-1], points[1:], strict=True)]
-    # The square comes out as one surface with the crack lines embedded in it (they do not cut
-    # it in two); children[1:] are the crack lines' images.
-    _, children = model.occ.fragment([(2, surface)], lines)
+    interior = {}
+    if embed:
+        stations = sorted((-crack_half_length, *split_at, crack_half_length))
+        points = [model.occ.addPoint(s * cos, s * sin, 0.0) for s in stations]
+        lines = [(1, model.occ.addLine(p, q))
+                 for p, q in zip(points[:-1], points[1:], strict=True)]  # fmt: skip
+        # The square comes out as one surface with the crack lines embedded in it (they do
+        # not cut it in two); children[1:] are the crack lines' images.
+        _, children = model.occ.fragment([(2, surface)], lines)
+        interior = {CrackPlateFacets.CRACK: [tag for images in children[1:] for _, tag in images]}
     model.occ.synchronize()
-    crack = [tag for images in children[1:] for _, tag in images]
     add_physical_groups(
         model,
         CrackPlateCells.DOMAIN,
@@ -135,7 +142,7 @@ def crack_plate(
             CrackPlateFacets.TOP: (1, w),
             CrackPlateFacets.LEFT: (0, -w),
         },
-        interior={CrackPlateFacets.CRACK: crack},
+        interior=interior,
     )
 
     # Distance to the crack segment in the crack's frame: s = x cos + y sin along the crack,

@@ -158,7 +158,8 @@ def print_outputs(res: RunSummary) -> None:
     """The files a run wrote (rank 0)."""
     if res.paraview:
         print(f"  ParaView: {res.paraview}")
-        print(f"  surface:  {res.paraview_surface}")
+        if res.paraview_surface:
+            print(f"  surface:  {res.paraview_surface}")
         print(f"  summary:  {Path(res.paraview).parent / 'run.json'}")
 
 

@@ -221,7 +221,11 @@ class _Run:
             timings=dict(self.timings),
             quantities=steps[-1].quantities,
             paraview=self._output(".pvd"),
-            paraview_surface=self._output("_surface.pvd"),
+            paraview_surface=(
+                self._output("_surface.pvd")
+                if getattr(problem, "contact_facets", None) is not None
+                else None
+            ),
             memory_mib=peak_memory_mib(self.comm),
             **extra,
         )

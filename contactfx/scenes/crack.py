@@ -34,7 +34,10 @@ import ufl
 
 from contactfx import references as cf
 from contactfx._compat import numpy_math, ufl_math
+from contactfx.contact.cut import CrackSegment
+from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, Profile
+from contactfx.driver.unfitted import UnfittedProblem
 from contactfx.meshes import CrackPlateFacets, crack_plate
 from contactfx.params import param
 from contactfx.scenes import export
@@ -96,6 +99,11 @@ class _PlateParams(elastic(10e9, 0.25)):
     boundary: str = param("infinite", "plate boundary traction: infinite (closed-form "
                           "infinite-plate field) or remote (uniform remote stress)",
                           choices=("infinite", "remote"))  # fmt: skip
+    crack: str = param(
+        "fitted",
+        "fitted (a chain of mesh edges) or unfitted (level sets on a mesh that ignores the crack)",
+        choices=("fitted", "unfitted"),
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -131,6 +139,16 @@ class _CrackPlate(InterfaceScene):
     def split_points(self) -> tuple[float, ...]:
         return ()
 
+    @property
+    def problem(self):
+        """The fitted-interface kind, or with ``--crack unfitted`` the unfitted crack's."""
+        return UnfittedProblem if self.p.crack == "unfitted" else InterfaceProblem
+
+    def crack_segments(self) -> list[CrackSegment]:
+        """The crack as a segment (tip to tip), for ``--crack unfitted``."""
+        t0, t1 = self.tips()
+        return [CrackSegment(t1, t0)]
+
     # -- geometry -------------------------------------------------------------------------
     def _axes(self):
         beta = np.radians(self.angle())
@@ -143,7 +161,8 @@ class _CrackPlate(InterfaceScene):
         return functools.partial(
             crack_plate, half_width=0.5 * p.plate_width,
             crack_half_length=p.crack_half_length, angle=self.angle(), h_crack=p.h_crack,
-            h_far=p.h_far, grading=p.grading, split_at=self.split_points(), h_tip=p.h_tip,
+            h_far=p.h_far, grading=p.grading, h_tip=p.h_tip, embed=p.crack == "fitted",
+            split_at=self.split_points() if p.crack == "fitted" else (),
         ), 2  # fmt: skip
 
     def length_scale(self) -> float:
@@ -224,6 +243,11 @@ class _CrackPlate(InterfaceScene):
     def problem_data(self, numerics) -> dict:
         """The plate with its boundary stress on the four edges (traction sigma n, the same
         degree-8 rule), the pinned corners, and the crack with the scene's frame and h."""
+        if self.p.crack == "unfitted":
+            raise ValueError(
+                f"scene '{self.name}' with --crack unfitted cannot be written as a "
+                "problem file: problem files carry fitted interfaces only"
+            )
         stress = self._boundary_stress_text()
         boundary = []
         if any(v != 0.0 for row in stress for v in row):

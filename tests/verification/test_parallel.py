@@ -79,6 +79,21 @@ def _interface_cases():
         ("propped-nitsche", propped, {"method": "nitsche", "theta": -1}),
         ("joint-al-ssn", JointColumn(JointColumn.Params()), {"method": "al-ssn"}),
         (
+            "sneddon-unfitted",
+            CrackSneddon(CrackSneddon.Params(crack="unfitted")),
+            {"method": "nitsche"},
+        ),
+        (
+            "inclined-unfitted",
+            CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted")),
+            {"method": "nitsche", "mu": 0.3},
+        ),
+        (
+            "propped-unfitted",
+            ProppedFracture(ProppedFracture.Params(crack="unfitted")),
+            {"method": "nitsche", "theta": 0},
+        ),
+        (
             "penny-nitsche",
             PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
             {"method": "nitsche", "degree": 2},

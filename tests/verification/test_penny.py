@@ -1,5 +1,5 @@
 """The fitted interface in 3D: a penny-shaped crack in a block (docs/verification.md section
-15), against Sneddon's infinite-body solution.
+13), against Sneddon's infinite-body solution.
 
 Run serially and with ``mpirun -n 2 python -m mpi4py -m pytest``; the serial / parallel
 comparison is in test_parallel.py (``penny-nitsche``).

@@ -1,0 +1,95 @@
+"""Unfitted cracks (docs/verification.md section 14): the crack scenes with ``--crack unfitted``
+on a plate mesh that ignores the crack, against the closed forms of the fitted scenes.
+
+Run serially and with ``mpirun -n 2 python -m mpi4py -m pytest``; the serial / parallel
+comparison is in test_parallel.py (``*-unfitted``).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from contactfx.scenes.crack import CrackInclined, CrackSneddon
+
+#: K_II / (sigma sqrt(pi a)) at beta = 30 / 45 / 60 (docs/verification.md section 6)
+KII_TABLE = {0.0: (0.43301, 0.5, 0.43301), 0.3: (0.20801, 0.35, 0.35801)}
+
+
+def _run(scene, **numerics):
+    return scene.run(scene.default_numerics(**numerics), verbose=False)
+
+
+def test_unfitted_sneddon_opening_and_K_converge():
+    coarse = CrackSneddon(CrackSneddon.Params(crack="unfitted", h_crack=0.05, h_tip=0.005,
+                                              h_far=1.0))  # fmt: skip
+    fine = CrackSneddon(CrackSneddon.Params(crack="unfitted"))
+    runs = [_run(s, method="nitsche") for s in (coarse, fine)]
+    for data in runs:
+        assert data.force == 0.0  # the pressurised crack is open everywhere: no contact
+    errors = [d.errors["opening_L2_rel"] for d in runs]
+    # opening in L2 along the crack: measured 1.9e-2 (h_crack = a / 20) and 9.6e-3 (a / 40,
+    # the default; the fitted crack 5.8e-3): first order, as the fitted P1 crack's
+    assert errors[1] < 0.0125 and errors[0] > 1.6 * errors[1], errors
+    # K_I by displacement extrapolation over r in [a / 20, a / 2]: measured 2.2 % low on the
+    # default mesh (the fitted crack 1.0 %). The jump vanishes on the tip cells (module
+    # docstring of contactfx.contact.cut), which shortens the crack by up to two tip cells
+    # (h_tip = a / 400): the jump at r = a / 20 is then up to 5 % low, which the fit carries
+    # to K
+    assert runs[1].reference["K_rel_error"] < 0.03, runs[1].reference
+
+
+@pytest.mark.parametrize("mu", sorted(KII_TABLE))
+@pytest.mark.parametrize("column, beta", [(0, 30.0), (1, 45.0), (2, 60.0)])
+def test_unfitted_inclined_crack_KII_table(mu, column, beta):
+    """The crack at 30, 45 and 60 degrees to a mesh that does not follow it."""
+    scene = CrackInclined(CrackInclined.Params(beta=beta, crack="unfitted"))
+    data = _run(scene, method="nitsche", mu=mu)
+    ref = data.reference
+    expected = KII_TABLE[mu][column]
+    assert ref["K_II_normalised_exact"] == pytest.approx(expected, abs=5e-6)
+    # displacement extrapolation of the slip: measured 1.8-2.3 % low over the table (the
+    # tip cells as in the Sneddon test above); the slip in L2 0.75-0.94 %
+    assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.03)
+    assert data.errors["slip_L2_rel"] < 0.0125
+    # the whole crack slides, the Coulomb law holds at every Gauss point to round-off
+    assert ref["slipping_fraction"] == 1.0
+    assert ref["friction_law_error"] < 1e-9
+    # the contact pressure a fixed distance from the tips (|s| <= 0.8 a): measured
+    # 0.56-4.2 % over the table with gamma0 = 10 (the fitted crack 0.3 %): Nitsche's
+    # pressure on the cut cells oscillates from cell to cell (section 14)
+    assert data.errors["pressure_interior_L2_rel"] < 0.06
+
+
+def test_unfitted_stick_has_no_slip():
+    # beta 30, mu 0.6: tan(30) < 0.6, the crack sticks; the body carries the remote stress
+    # alone, which the discrete space holds exactly
+    scene = CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted"))
+    data = _run(scene, method="nitsche", mu=0.6)
+    assert data.reference["max_slip"] < 1e-12
+    assert data.errors["pressure_interior_L2_rel"] < 1e-10
+
+
+@pytest.mark.parametrize("theta", [1, 0, -1])
+def test_unfitted_suction_closes_with_uniform_pressure(theta):
+    # the faces carry -p and the body is unstressed: u = a = 0 is the discrete solution for
+    # every theta (as for the fitted crack, section 6); the force is p times the crack's
+    # length in the cut cells (the tip cells carry none: less than 2 h_tip = a / 200)
+    scene = CrackSneddon(CrackSneddon.Params(crack="unfitted", pressure=-1e6))
+    data = _run(scene, method="nitsche", theta=theta)
+    assert data.force == pytest.approx(1e6 * data.contact_size, rel=1e-8)
+    assert data.max_penetration < 1e-12
+    assert 0.0 < data.reference["force_rel_error"] < 0.005
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        ({"degree": 2}, "unfitted cracks are P1"),
+        ({"method": "al-ssn"}, "not implemented on unfitted cracks"),
+        ({"method": "penalty"}, "not implemented on unfitted cracks"),
+    ],
+)
+def test_unfitted_refuses_what_it_does_not_implement(overrides, message):
+    scene = CrackSneddon(CrackSneddon.Params(crack="unfitted"))
+    with pytest.raises(ValueError, match=message):
+        _run(scene, **{"method": "nitsche", **overrides})
