@@ -4,7 +4,11 @@
 The unknown is U = (u, a) as for a fitted interface (:mod:`contactfx.driver.interface`), the
 enrichment a confined to the enriched nodes; the bulk form weighs each cut cell's two sides by
 their area fractions, the crack's terms are the methods' residuals on a
-:class:`contactfx.contact.cut.CutSurface`. P1 only (the area-fraction integration is exact for
+:class:`contactfx.contact.cut.CutSurface`. Nitsche's stress on the crack is the sides' mean
+weighted by their area fractions and its parameter scales with the piece's length over the
+cell's area (Annavarapu, Hautefeuille & Dolbow 2012, doi:10.1002/nme.4343): with the cell
+diameter instead the pressure oscillates from cut cell to cut cell, more with a larger gamma0
+(docs/verification.md section 14). P1 only (the area-fraction integration is exact for
 constant strains); the methods whose law needs the vertex rule or a tip continuation (the
 penalties, the augmented Lagrangian ones) are not offered.
 
@@ -44,6 +48,11 @@ __all__ = ["UnfittedProblem"]
 #: the degree of the cell rule that carries the crack's Gauss points (6 points per piece)
 QUADRATURE_DEGREE = 4
 _CUT = 1  # the cut cells' tag
+#: Nitsche's length h_K = 5 |K| / |Gamma_K| on a cut cell K (area |K|, crack piece |Gamma_K|):
+#: gamma = gamma0 E / h_K is then, at the default gamma0 = 10, the stabilisation
+#: 2 E |Gamma_K| / |K| of Annavarapu, Hautefeuille & Dolbow 2012 (doi:10.1002/nme.4343) for the
+#: area-weighted mean stress
+NITSCHE_LENGTH = 5.0
 
 
 def _accumulate(Q, values_per_cell: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
@@ -116,6 +125,11 @@ class UnfittedProblem(InterfaceProblem):
             Yi.x.array[qd] = quad.points[:, :, i]
         self.weight = dolfinx.fem.Function(Qs)
         self.weight.x.array[qd] = quad.ratio
+        # Nitsche's length on a cut cell: NITSCHE_LENGTH |K| / |Gamma_K| (module docstring)
+        self.h_cut = dolfinx.fem.Function(DG0, name="h_cut")
+        length = np.where(cells.cut, np.linalg.norm(cells.pieces[:, 1] - cells.pieces[:, 0],
+                                                    axis=1), 1.0)  # fmt: skip
+        self.h_cut.x.array[c0] = NITSCHE_LENGTH * self.area / length
         cut = np.flatnonzero(cells.cut).astype(np.int32)
         self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, np.full(len(cut), _CUT, np.int32))
         self.cut_owned = cut[cut < self.n_owned_cells]
@@ -166,7 +180,7 @@ class UnfittedProblem(InterfaceProblem):
 
         return CutSurface(
             self.U, self.V_test, ufl.as_vector([float(v) for v in self.crack.normal]), self.dSc,
-            mean_stress(self.U), mean_stress(self.V_test), scene.contact_modulus(), self.h,
+            mean_stress(self.U), mean_stress(self.V_test), scene.contact_modulus(), self.h_cut,
             floor=scene.floor(self.s_coord), fluid=self.fluid, friction=self.friction,
             u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
         )  # fmt: skip

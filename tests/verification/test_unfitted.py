@@ -27,10 +27,10 @@ def test_unfitted_sneddon_opening_and_K_converge():
     for data in runs:
         assert data.force == 0.0  # the pressurised crack is open everywhere: no contact
     errors = [d.errors["opening_L2_rel"] for d in runs]
-    # opening in L2 along the crack: measured 1.9e-2 (h_crack = a / 20) and 9.6e-3 (a / 40,
+    # opening in L2 along the crack: measured 1.8e-2 (h_crack = a / 20) and 9.1e-3 (a / 40,
     # the default; the fitted crack 5.8e-3): first order, as the fitted P1 crack's
     assert errors[1] < 0.0125 and errors[0] > 1.6 * errors[1], errors
-    # K_I by displacement extrapolation over r in [a / 20, a / 2]: measured 2.2 % low on the
+    # K_I by displacement extrapolation over r in [a / 20, a / 2]: measured 2.1 % low on the
     # default mesh (the fitted crack 1.0 %). The jump vanishes on the tip cells (module
     # docstring of contactfx.contact.cut), which shortens the crack by up to two tip cells
     # (h_tip = a / 400): the jump at r = a / 20 is then up to 5 % low, which the fit carries
@@ -48,16 +48,17 @@ def test_unfitted_inclined_crack_KII_table(mu, column, beta):
     expected = KII_TABLE[mu][column]
     assert ref["K_II_normalised_exact"] == pytest.approx(expected, abs=5e-6)
     # displacement extrapolation of the slip: measured 1.8-2.3 % low over the table (the
-    # tip cells as in the Sneddon test above); the slip in L2 0.75-0.94 %
+    # tip cells as in the Sneddon test above; Debian 13's gmsh mesh: 2.3 % at beta 45); the
+    # slip in L2 0.74-0.93 %
     assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.03)
     assert data.errors["slip_L2_rel"] < 0.0125
     # the whole crack slides, the Coulomb law holds at every Gauss point to round-off
     assert ref["slipping_fraction"] == 1.0
     assert ref["friction_law_error"] < 1e-9
     # the contact pressure a fixed distance from the tips (|s| <= 0.8 a): measured
-    # 0.56-4.2 % over the table with gamma0 = 10 (the fitted crack 0.3 %): Nitsche's
-    # pressure on the cut cells oscillates from cell to cell (section 14)
-    assert data.errors["pressure_interior_L2_rel"] < 0.06
+    # 0.23-1.3 % over the table (the fitted crack 0.2-0.4 %); with the cell diameter as
+    # Nitsche's length it was 0.56-4.2 %, oscillating from cut cell to cut cell (section 14)
+    assert data.errors["pressure_interior_L2_rel"] < 0.02
 
 
 def test_unfitted_stick_has_no_slip():
