@@ -39,7 +39,12 @@ from contactfx.meshes._build import (
     write_msh,
 )
 from contactfx.meshes.box import BoxCells, BoxFacets, box
-from contactfx.meshes.crack_plate import CrackPlateCells, CrackPlateFacets, crack_plate
+from contactfx.meshes.crack_plate import (
+    CrackPlateCells,
+    CrackPlateFacets,
+    crack_plate,
+    structured_plate,
+)
 from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.penny_block import PennyBlockCells, PennyBlockFacets, penny_block
@@ -119,6 +124,7 @@ __all__ = [
     "builder_groups",
     "file_groups",
     "crack_plate",
+    "structured_plate",
     "interval",
     "cylinders",
     "joint_column",

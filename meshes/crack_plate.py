@@ -40,7 +40,7 @@ from contactfx.meshes._build import (
 if TYPE_CHECKING:
     import gmsh
 
-__all__ = ["CrackPlateCells", "CrackPlateFacets", "crack_plate"]
+__all__ = ["CrackPlateCells", "CrackPlateFacets", "crack_plate", "structured_plate"]
 
 
 class CrackPlateCells(IntEnum):
@@ -166,4 +166,88 @@ def crack_plate(
     import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
+    model.mesh.generate(2)
+
+
+def _outer_cells(width: float, h: float, growth: float) -> tuple[int, float]:
+    """(cells, ratio) of a geometric progression over ``width`` whose first cell is h and whose
+    ratio is at most ``growth``."""
+    n = max(1, math.ceil(math.log(1.0 + width * (growth - 1.0) / h) / math.log(growth)))
+    lo, hi = 1.0, growth  # h (r^n - 1) / (r - 1) = width for r in [1, growth]
+    for _ in range(200):
+        r = 0.5 * (lo + hi)
+        if h * (r**n - 1.0) / (r - 1.0) < width:
+            lo = r
+        else:
+            hi = r
+    return n, 0.5 * (lo + hi)
+
+
+def structured_plate(
+    model: type[gmsh.model],
+    *,
+    half_width: float,
+    inner_half_width: float,
+    h: float,
+    growth: float = 1.1,
+) -> None:
+    """Mesh the square [-half_width, half_width]^2 as a structured triangle grid: uniform
+    spacing ``h`` in the inner square [-inner_half_width, inner_half_width]^2 (node lines at
+    x, y = k h, k = 0, +-1, ...; the inner half-width is rounded to a whole number of cells)
+    and cells growing geometrically by at most ``growth`` per cell outside it. A background
+    for unfitted cracks whose position against the nodes is known (through nodes, along
+    edges). Facet tags as :func:`crack_plate` (no ``CRACK`` group); the triangles are the
+    grid's squares split along their (1, 1) diagonals.
+
+    Raises:
+        ValueError: Before any gmsh call, if a parameter is invalid.
+    """
+    check_finite(half_width=half_width, inner_half_width=inner_half_width, h=h, growth=growth)
+    check_positive(half_width=half_width, inner_half_width=inner_half_width, h=h)
+    check_less("inner_half_width", inner_half_width, "half_width", half_width)
+    check_less("1", 1.0, "growth", growth)
+    k = max(1, round(inner_half_width / h))
+    b = k * h
+    check_less("inner_half_width", b, "half_width", half_width)
+    n_out, ratio = _outer_cells(half_width - b, h, growth)
+    w = half_width
+    geo = model.geo
+    xs = (-w, -b, b, w)
+    pt = {(i, j): geo.addPoint(xs[i], xs[j], 0.0) for i in range(4) for j in range(4)}
+    counts = (n_out, 2 * k, n_out)
+
+    def line(p, q, piece):
+        tag = geo.addLine(p, q)
+        return tag, piece
+
+    # lines along x (j fixed) and along y (i fixed); piece 0 / 2: outer (cells grow outwards)
+    hl = {(i, j): line(pt[i, j], pt[i + 1, j], i) for i in range(3) for j in range(4)}
+    vl = {(i, j): line(pt[i, j], pt[i, j + 1], j) for i in range(4) for j in range(3)}
+    geo.synchronize()
+    surfaces = []
+    for i in range(3):
+        for j in range(3):
+            loop = geo.addCurveLoop([hl[i, j][0], vl[i + 1, j][0], -hl[i, j + 1][0], -vl[i, j][0]])
+            surfaces.append((geo.addPlaneSurface([loop]), loop))
+    geo.synchronize()
+    for tag, piece in list(hl.values()) + list(vl.values()):
+        # outer pieces: from the plate's edge (piece 0, the line runs inwards: cells shrink)
+        # or towards it (piece 2: they grow)
+        if piece == 1:
+            model.mesh.setTransfiniteCurve(tag, counts[1] + 1)
+        else:
+            r = 1.0 / ratio if piece == 0 else ratio
+            model.mesh.setTransfiniteCurve(tag, counts[piece] + 1, "Progression", r)
+    for tag, _ in surfaces:
+        model.mesh.setTransfiniteSurface(tag, "Right")
+    add_physical_groups(
+        model,
+        CrackPlateCells.DOMAIN,
+        {
+            CrackPlateFacets.BOTTOM: (1, -w),
+            CrackPlateFacets.RIGHT: (0, w),
+            CrackPlateFacets.TOP: (1, w),
+            CrackPlateFacets.LEFT: (0, -w),
+        },
+    )
     model.mesh.generate(2)

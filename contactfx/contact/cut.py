@@ -12,18 +12,22 @@ is one case. Per cell (:class:`CutCells`):
 
 * a *cut* cell: the zero line of phi_h crosses it along a piece of positive length with both
   ends inside the crack (|psi| <= a); a piece along an edge belongs to the cell on the +side;
-* a *tip* cell: its closed triangle contains a tip, or its piece ends beyond a tip;
+* a *tip* cell: its closed triangle contains a tip and its zero line (if any) does not lie
+  on the crack, or its piece ends beyond a tip;
 * the +side's area fraction f of the cell (exact for the piecewise linear phi_h); 1 or 0 in a
   cell that phi_h does not cross.
 
 Kinematics (Heaviside enrichment; Moes, Dolbow & Belytschko 1999,
 doi:10.1002/(SICI)1097-0207(19990910)46:1<131::AID-NME726>3.0.CO;2-J). The displacement is
 w = u + H a with H = +1 / -1 on the two sides of phi_h = 0 inside the cells, u and a P1. a is
-nonzero only at the *enriched* nodes: those of a cut cell that belong to no tip cell and whose
-support has area on both sides of the crack. Across the crack [[w]] = 2 a; elsewhere w is
-continuous. At the tips: the nodes of a tip cell are not enriched, so the jump vanishes on the
-tip cell and falls linearly to zero over the cut cell before it, as at the tip node of a fitted
-crack; the crack's effective tip is the tip cell's boundary, within one cell of the true tip
+nonzero only at the *enriched* nodes: those of a cut cell whose support the crack crosses
+completely (area on both sides, no tip inside the support). Across the crack [[w]] = 2 a;
+elsewhere w is continuous. At the tips: a tip inside a cell is first moved along the crack to
+the nearer of the two points where the crack's line crosses that cell's boundary
+(:func:`snapped_tips`, by at most half the cell), so that every tip lies on a node or an edge.
+The node at the tip, or the two nodes of the tip's edge, are not enriched (``tip_nodes``): the
+jump falls linearly to zero over the last cut cell and vanishes at the tip, as at the tip node
+of a fitted crack
 (docs/verification.md section 14 measures the effect on the opening and on K).
 
 Integrals. For P1 the strain is constant on each side of a cut cell, so the bulk energy is
@@ -55,6 +59,7 @@ __all__ = [
     "CutSurface",
     "WeightedMeasure",
     "cut_cells",
+    "snapped_tips",
     "cell_sizes",
     "near_cells",
 ]
@@ -109,13 +114,16 @@ class CutCells:
     """What a crack does to the local cells (owned and ghosts) of a triangle mesh (module
     docstring): ``phi`` (cells, 3) the snapped level set at each cell's vertices; ``fraction``
     (cells,) the +side's area fraction; ``cut`` (cells,) bool, and ``pieces`` (cells, 2, 2) the
-    crack's piece in each cut cell (NaN elsewhere); ``tip`` (cells,) bool."""
+    crack's piece in each cut cell (NaN elsewhere); ``tip`` (cells,) bool; ``tip_nodes``
+    (cells, 3) bool: the vertices whose support holds a tip inside (a tip's barycentric
+    coordinate > 0 in a cell containing it)."""
 
     phi: np.ndarray
     fraction: np.ndarray
     cut: np.ndarray
     pieces: np.ndarray
     tip: np.ndarray
+    tip_nodes: np.ndarray
 
 
 def cell_sizes(X: np.ndarray) -> np.ndarray:
@@ -185,12 +193,16 @@ def _positive_fraction(X: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return frac
 
 
-def _contains(X: np.ndarray, point: np.ndarray, tol: float) -> np.ndarray:
-    """Whether each closed triangle of X contains the point (barycentric, within tol)."""
+def _barycentric(X: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """(cells, 3): the point's barycentric coordinates in each triangle of X."""
     A = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=2)  # (m, 2, 2)
     lam = np.linalg.solve(A, (point - X[:, 0])[:, :, None])[:, :, 0]
-    bary = np.column_stack([1.0 - lam.sum(axis=1), lam])
-    return np.all(bary >= -tol, axis=1)
+    return np.column_stack([1.0 - lam.sum(axis=1), lam])
+
+
+def _contains(X: np.ndarray, point: np.ndarray, tol: float) -> np.ndarray:
+    """Whether each closed triangle of X contains the point (barycentric, within tol)."""
+    return np.all(_barycentric(X, point) >= -tol, axis=1)
 
 
 def cut_cells(X: np.ndarray, crack: CrackSegment, snap: float) -> CutCells:
@@ -212,11 +224,38 @@ def cut_cells(X: np.ndarray, crack: CrackSegment, snap: float) -> CutCells:
     plus_side = phi.sum(axis=1) > 0.0
     cut = has & inside & (~on_edge | plus_side)
     tip = touches & ~inside
+    tip_nodes = np.zeros((len(X), 3), dtype=bool)
     for t in crack.tips():
-        tip |= _contains(X, t, 1e-10)
+        bary = _barycentric(X, np.asarray(t, float))
+        holds = np.all(bary >= -1e-10, axis=1)
+        # (a cell along the crack, cut or the -side's twin of an edge piece, is not a tip cell)
+        tip |= holds & ~(has & inside)
+        tip_nodes |= holds[:, None] & (bary > 1e-10)
     cut &= ~tip
     pieces = np.where(cut[:, None, None], line, np.nan)
-    return CutCells(phi, _positive_fraction(X, phi), cut, pieces, tip)
+    return CutCells(phi, _positive_fraction(X, phi), cut, pieces, tip, tip_nodes)
+
+
+def snapped_tips(X: np.ndarray, crack: CrackSegment, snap: float) -> list[float]:
+    """The coordinate psi of each tip (-a, +a) moved to the nearer end of the crack line's
+    piece in the cell that holds the tip strictly inside (where the line enters the cell or
+    leaves it): NaN for a tip that no cell of X holds so (outside X, or on an edge or node)."""
+    phi = crack.phi(X)
+    phi = np.where(np.abs(phi) < snap, 0.0, phi)
+    line = _zero_line(X, phi)
+    has = ~np.isnan(line[:, 0, 0])
+    a = crack.half_length
+    out = []
+    for sign, t in ((-1.0, crack.p0), (1.0, crack.p1)):
+        ends = np.sort(crack.psi(line[has]) * sign, axis=1)  # along the crack, towards the tip
+        strict = (ends[:, 0] < a - 1e-12 * a) & (ends[:, 1] > a + 1e-12 * a)
+        hold = np.flatnonzero(strict & _contains(X[has], np.asarray(t, float), 1e-10))
+        if len(hold) == 0:
+            out.append(float("nan"))
+            continue
+        entry, exit_ = ends[hold[0]]
+        out.append(sign * (exit_ if exit_ - a < a - entry else entry))
+    return out
 
 
 class CrackQuadrature:

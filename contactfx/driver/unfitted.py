@@ -29,11 +29,13 @@ from contactfx import _compat
 from contactfx.contact.cut import (
     SNAP,
     CrackQuadrature,
+    CrackSegment,
     CutSurface,
     WeightedMeasure,
     cell_sizes,
     cut_cells,
     near_cells,
+    snapped_tips,
 )
 from contactfx.contact.interface import tangent
 from contactfx.contact.laws import active
@@ -55,11 +57,13 @@ _CUT = 1  # the cut cells' tag
 NITSCHE_LENGTH = 5.0
 
 
-def _accumulate(Q, values_per_cell: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
-    """Sum over every rank's owned cells of ``values_per_cell`` at each cell's dofs of the
-    scalar space Q, on the local dofs (owned and ghosts)."""
+def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
+    """Sum over every rank's owned cells of ``values`` (per cell, or per cell and vertex) at
+    each cell's dofs of the scalar P1 space Q, on the local dofs (owned and ghosts)."""
     f = dolfinx.fem.Function(Q)
-    np.add.at(f.x.array, dofs[:n_owned].ravel(), np.repeat(values_per_cell[:n_owned], 3))
+    per_vertex = np.broadcast_to(np.asarray(values, float).reshape(len(values), -1),
+                                 dofs.shape)  # fmt: skip
+    np.add.at(f.x.array, dofs[:n_owned].ravel(), per_vertex[:n_owned].ravel())
     vec = _compat.petsc_vec(f)
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
@@ -100,7 +104,16 @@ class UnfittedProblem(InterfaceProblem):
         h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
         if not np.isfinite(h):
             raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
-        self.cells = cells = cut_cells(X, crack, SNAP * h)
+        # every tip moved onto the boundary of the cell holding it (the same on every rank:
+        # from the ranks that hold that cell)
+        psi = np.array(comm.allgather(snapped_tips(X, crack, SNAP * h)))
+        d = crack.direction
+        ends = []
+        for k, tip in enumerate(crack.tips()):
+            found = psi[:, k][~np.isnan(psi[:, k])]
+            ends.append(crack.centre + found[0] * d if len(found) else tip)
+        self.effective = CrackSegment(*ends)
+        self.cells = cells = cut_cells(X, self.effective, SNAP * h)
         for tip in crack.tips():
             inside = _compat.PointLocator(mesh, np.asarray([tip]))
             if inside.outside[0]:
@@ -139,15 +152,15 @@ class UnfittedProblem(InterfaceProblem):
         return None
 
     def free_mask(self, Q) -> np.ndarray:
-        """The enriched nodes: of a cut cell, of no tip cell, with area on both sides of the
-        crack in their support (summed over every rank's cells)."""
+        """The enriched nodes: of a cut cell, with area on both sides of the crack in their
+        support and no tip inside it (summed over every rank's cells)."""
         dofs = _compat.cell_dofs(Q)
         c = self.cells
         n = self.n_owned_cells
         plus = _accumulate(Q, c.fraction * self.area, dofs, n)
         minus = _accumulate(Q, (1.0 - c.fraction) * self.area, dofs, n)
         cut = _accumulate(Q, c.cut.astype(float), dofs, n)
-        tip = _accumulate(Q, c.tip.astype(float), dofs, n)
+        tip = _accumulate(Q, c.tip_nodes, dofs, n)
         both = np.minimum(plus, minus) > 1e-12 * (plus + minus)
         return (cut > 0.0) & (tip == 0.0) & both
 

@@ -38,7 +38,7 @@ from contactfx.contact.cut import CrackSegment
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, Profile
 from contactfx.driver.unfitted import UnfittedProblem
-from contactfx.meshes import CrackPlateFacets, crack_plate
+from contactfx.meshes import CrackPlateFacets, crack_plate, structured_plate
 from contactfx.params import param
 from contactfx.scenes import export
 from contactfx.scenes.base import elastic
@@ -104,9 +104,16 @@ class _PlateParams(elastic(10e9, 0.25)):
         "fitted (a chain of mesh edges) or unfitted (level sets on a mesh that ignores the crack)",
         choices=("fitted", "unfitted"),
     )
+    crack_offset: float = param(0.0, "shift of the crack along its normal (unfitted: its "
+                                "position against the mesh's nodes)")  # fmt: skip
+    background: str = param("graded", "the unfitted crack's mesh: graded (the fitted crack's "
+                            "size field) or structured (a grid of spacing h-crack around it)",
+                            choices=("graded", "structured"))  # fmt: skip
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.crack == "fitted" and (self.crack_offset != 0.0 or self.background != "graded"):
+            raise ValueError("--crack-offset and --background structured need --crack unfitted")
         if not self.crack_half_length < 0.5 * self.plate_width:
             raise ValueError(
                 f"--crack-half-length ({self.crack_half_length}) must be < plate-width / 2 "
@@ -158,6 +165,15 @@ class _CrackPlate(InterfaceScene):
 
     def mesh_builder(self):
         p = self.p
+        if p.background == "structured":
+            d, _ = self._axes()
+            reach = p.crack_half_length * np.abs(d).max() + abs(p.crack_offset)
+            return functools.partial(
+                structured_plate, half_width=0.5 * p.plate_width,
+                inner_half_width=min(reach + 0.25 * p.crack_half_length,
+                                     0.5 * (reach + 0.5 * p.plate_width)),
+                h=p.h_crack,
+            ), 2  # fmt: skip
         return functools.partial(
             crack_plate, half_width=0.5 * p.plate_width,
             crack_half_length=p.crack_half_length, angle=self.angle(), h_crack=p.h_crack,
@@ -171,18 +187,22 @@ class _CrackPlate(InterfaceScene):
     def h_contact(self) -> float:
         return self.p.h_crack
 
+    def _centre(self) -> np.ndarray:
+        _, n = self._axes()
+        return self.p.crack_offset * n
+
     def side(self, x):
         _, n = self._axes()
-        return n[0] * x[0] + n[1] * x[1]
+        return n[0] * x[0] + n[1] * x[1] - self.p.crack_offset
 
     def tips(self):
         d, _ = self._axes()
         a = self.p.crack_half_length
-        return [a * d, -a * d]
+        return [self._centre() + a * d, self._centre() - a * d]
 
     def frame(self):
         d, _ = self._axes()
-        return np.zeros(2), d
+        return self._centre(), d
 
     def away_from_tips(self, s):
         """|s| <= 0.8 a (docs/verification.md section 6, "Tractions at the tips"): next to a
@@ -203,7 +223,7 @@ class _CrackPlate(InterfaceScene):
         if self.p.boundary == "infinite" and (p != 0.0 or q != 0.0):
             d, n = self._axes()
             xl = d[0] * x[0] + d[1] * x[1]
-            yl = n[0] * x[0] + n[1] * x[1]
+            yl = n[0] * x[0] + n[1] * x[1] - self.p.crack_offset
             sxx, syy, sxy = cf.crack_perturbation_stress(
                 xl, yl, self.p.crack_half_length, p, q, ufl_math
             )

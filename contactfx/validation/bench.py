@@ -99,6 +99,17 @@ CASES: dict[str, BenchCase] = {
         2.0,
         "propped fracture, open branch p_net > p* (Sneddon)",
     ),  # fmt: skip
+    # the same cracks on a mesh that ignores them (P1 and nitsche only; the rest: n/a), beside
+    # the fitted rows above
+    "crack-sneddon-unfitted": BenchCase(
+        "crack-sneddon", {"crack": "unfitted"}, 2.0, "pressurised crack, unfitted, Sneddon"
+    ),
+    "crack-inclined-unfitted": BenchCase(
+        "crack-inclined",
+        {"beta": 45.0, "crack": "unfitted"},
+        2.0,
+        "inclined crack, unfitted, compression, Coulomb mu 0.3",
+    ),
     # level 2 is the scene's default mesh (68012 dofs with P2)
     "penny-crack": BenchCase(
         "penny-crack", {}, 4.0, "pressurised penny-shaped crack in 3D, Sneddon", p2_levels=3

@@ -154,6 +154,24 @@ def _interface_cases() -> list[StressCase]:
                                   "propped-fracture", {**crack, "net_pressure": p_net},
                                   {"method": method},
                                   quick=p_net == -1e6 and method == "nitsche"))  # fmt: skip
+    # an unfitted crack's position against the nodes of the structured plate (h = a / 20
+    # around the crack): along the edges, 1e-6 h off them, between them, through the nodes
+    # diagonally; and the unfitted crack on the graded mesh at a shallow angle
+    grid = {"crack": "unfitted", "background": "structured", "h_crack": 0.05, "h_tip": 0.05}
+    for name, scene, params in (
+        ("along edges", "crack-sneddon", {}),
+        ("1e-6 h off the nodes", "crack-sneddon", {"crack_offset": 5e-8}),
+        ("0.4 h off the nodes", "crack-sneddon", {"crack_offset": 0.02}),
+        ("through nodes, beta=-45 mu=0", "crack-inclined", {"beta": -45.0}),
+        ("along diagonal edges, beta=45 mu=0", "crack-inclined", {"beta": 45.0}),
+    ):
+        numerics = {"method": "nitsche", **({"mu": 0.0} if scene == "crack-inclined" else {})}
+        out.append(StressCase(f"unfitted crack {name}", "unfitted crack position", scene,
+                              {**grid, **params}, numerics,
+                              quick=name == "1e-6 h off the nodes"))  # fmt: skip
+    out.append(StressCase("unfitted crack beta=10 mu=0.3 (graded)", "unfitted crack position",
+                          "crack-inclined", {**crack, "beta": 10.0, "crack": "unfitted"},
+                          {"method": "nitsche"}))  # fmt: skip
     for s_c, p in ((30e6, 10e6), (3e9, 0.0), (30e6, 29.9e6), (30e6, 40e6)):
         # the last: fluid pressure above the load, no equilibrium (refused)
         out.append(StressCase(f"joint s_c={s_c:g} p={p:g}", "joint closure", "joint-column",
