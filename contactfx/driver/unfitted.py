@@ -162,7 +162,19 @@ class UnfittedProblem(InterfaceProblem):
         cut = _accumulate(Q, c.cut.astype(float), dofs, n)
         tip = _accumulate(Q, c.tip_nodes, dofs, n)
         both = np.minimum(plus, minus) > 1e-12 * (plus + minus)
-        return (cut > 0.0) & (tip == 0.0) & both
+        enriched = (cut > 0.0) & (tip == 0.0) & both
+        mesh = self.mesh
+        fdim = mesh.topology.dim - 1
+        mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+        outer = _compat.locate_dofs_topological(
+            Q, fdim, dolfinx.mesh.exterior_facet_indices(mesh.topology)
+        )
+        if mesh.comm.allreduce(bool(np.any(enriched[outer])), op=MPI.LOR):
+            raise ValueError(
+                "the crack is closer to the boundary than a cell (a cut cell's "
+                "node lies on the boundary); move it inwards or refine"
+            )
+        return enriched
 
     def make_surface(self) -> CutSurface:
         mesh, scene, d = self.mesh, self.scene, self.gdim

@@ -83,16 +83,20 @@ def test_unfitted_suction_closes_with_uniform_pressure(theta):
 
 
 @pytest.mark.parametrize(
-    "overrides, message",
+    "params, overrides, message",
     [
-        ({"degree": 2}, "unfitted cracks are P1"),
-        ({"method": "al-ssn"}, "not implemented on unfitted cracks"),
-        ({"method": "penalty"}, "not implemented on unfitted cracks"),
+        ({}, {"degree": 2}, "unfitted cracks are P1"),
+        ({}, {"method": "al-ssn"}, "not implemented on unfitted cracks"),
+        ({}, {"method": "penalty"}, "not implemented on unfitted cracks"),
+        # the plate is [-10, 10]^2, its cells near the top edge about 0.8 wide
+        ({"crack_offset": 9.99}, {}, "closer to the boundary than a cell"),
+        ({"crack_offset": 12.0}, {}, "lies outside the mesh"),
+        ({"crack_offset": 0.1, "crack": "fitted"}, {}, "need --crack unfitted"),
     ],
 )
-def test_unfitted_refuses_what_it_does_not_implement(overrides, message):
-    scene = CrackSneddon(CrackSneddon.Params(crack="unfitted"))
+def test_unfitted_refuses_what_it_does_not_implement(params, overrides, message):
     with pytest.raises(ValueError, match=message):
+        scene = CrackSneddon(CrackSneddon.Params(**{"crack": "unfitted", **params}))
         _run(scene, **{"method": "nitsche", **overrides})
 
 
