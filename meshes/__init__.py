@@ -43,6 +43,7 @@ from contactfx.meshes.crack_plate import (
     CrackPlateCells,
     CrackPlateFacets,
     crack_plate,
+    crack_set_plate,
     structured_plate,
 )
 from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
@@ -124,6 +125,7 @@ __all__ = [
     "builder_groups",
     "file_groups",
     "crack_plate",
+    "crack_set_plate",
     "structured_plate",
     "interval",
     "cylinders",

@@ -40,7 +40,13 @@ from contactfx.meshes._build import (
 if TYPE_CHECKING:
     import gmsh
 
-__all__ = ["CrackPlateCells", "CrackPlateFacets", "crack_plate", "structured_plate"]
+__all__ = [
+    "CrackPlateCells",
+    "CrackPlateFacets",
+    "crack_plate",
+    "crack_set_plate",
+    "structured_plate",
+]
 
 
 class CrackPlateCells(IntEnum):
@@ -250,4 +256,71 @@ def structured_plate(
             CrackPlateFacets.LEFT: (0, -w),
         },
     )
+    model.mesh.generate(2)
+
+
+def crack_set_plate(
+    model: type[gmsh.model],
+    *,
+    half_width: float,
+    cracks: tuple[tuple[float, float, float], ...],
+    crack_half_length: float,
+    h_crack: float,
+    h_tip: float,
+    h_far: float,
+    grading: float = 0.3,
+) -> None:
+    """Mesh the square [-half_width, half_width]^2 graded towards several straight cracks that
+    it does not follow (a background for unfitted cracks): ``cracks`` are (x, y, angle in
+    degrees) of each crack's centre and direction, all of half-length ``crack_half_length``.
+    The size is ``h_crack`` within a / 2 of each crack and ``h_tip`` at its tips, growing by
+    ``grading`` per unit distance up to ``h_far`` (the smallest over the cracks holds).
+    Facet tags as :func:`crack_plate` (no ``CRACK`` group).
+
+    Raises:
+        ValueError: Before any gmsh call, if a parameter is invalid.
+    """
+    check_finite(half_width=half_width, crack_half_length=crack_half_length, h_crack=h_crack,
+                 h_tip=h_tip, h_far=h_far, grading=grading)  # fmt: skip
+    check_positive(half_width=half_width, crack_half_length=crack_half_length, h_crack=h_crack,
+                   h_tip=h_tip, h_far=h_far, grading=grading)  # fmt: skip
+    check_less_equal("h_tip", h_tip, "h_crack", h_crack)
+    check_less_equal("h_crack", h_crack, "h_far", h_far)
+    if not cracks:
+        raise ValueError("crack_set_plate needs at least one crack")
+    w = half_width
+    model.occ.addRectangle(-w, -w, 0.0, 2.0 * w, 2.0 * w)
+    model.occ.synchronize()
+    add_physical_groups(
+        model,
+        CrackPlateCells.DOMAIN,
+        {
+            CrackPlateFacets.BOTTOM: (1, -w),
+            CrackPlateFacets.RIGHT: (0, w),
+            CrackPlateFacets.TOP: (1, w),
+            CrackPlateFacets.LEFT: (0, -w),
+        },
+    )
+    size = None
+    a = matheval_number(crack_half_length)
+    for x0, y0, angle in cracks:
+        theta = math.radians(angle)
+        c, n = matheval_number(math.cos(theta)), matheval_number(math.sin(theta))
+        x, y = f"(x-{matheval_number(x0)})", f"(y-{matheval_number(y0)})"
+        along, across = f"({x}*{c}+{y}*{n})", f"({y}*{c}-{x}*{n})"
+        beyond_tips = f"(Fabs({along}-{a})+Fabs({along}+{a})-2*{a})/2"
+        distance = f"Sqrt(({beyond_tips})^2+{across}^2)"
+        if size is None:
+            size = set_graded_size(model, distance, size_min=h_crack, size_max=h_far,
+                                   dist_min=0.5 * crack_half_length, grading=grading)  # fmt: skip
+        else:
+            zone = f"({distance}-{matheval_number(0.5 * crack_half_length)})"
+            size = refine_near(model, size, zone, size_min=h_crack, size_max=h_far,
+                               grading=grading)  # fmt: skip
+        if h_tip < h_crack:
+            size = refine_near(model, size, f"Sqrt((Fabs({along})-{a})^2+{across}^2)",
+                               size_min=h_tip, size_max=h_far, grading=grading)  # fmt: skip
+    import gmsh
+
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
     model.mesh.generate(2)

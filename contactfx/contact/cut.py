@@ -300,16 +300,18 @@ class WeightedMeasure(ufl.Measure):
 @dataclass(frozen=True)
 class CutSurface(InterfaceSurface):
     """:class:`contactfx.contact.interface.InterfaceSurface` on an unfitted crack (module
-    docstring): ``w`` / ``v_total`` are the unknown U = (u, a) and its test function; ``ds``
+    docstring): ``w`` / ``v_total`` are the unknown U = (u, a_1, ...) and its test function
+    (the crack's enrichment from component ``first``); ``ds``
     a :class:`WeightedMeasure` on the cut cells; ``stress_cell`` / ``stress_test_cell`` the
-    stress of u (the two sides' mean for P1); ``H`` the crack's normal n_I; ``at_crack``
+    sides' stress weighted by their area fractions; ``H`` the crack's normal n_I; ``at_crack``
     maps a P1 field to its value at the crack's Gauss points."""
 
     at_crack: object = None
+    #: the first component of this crack's enrichment in U = (u, a_1, ..., a_K)
+    first: int = 2
 
     def _jump(self, X):
-        d = ufl.shape(X)[0] // 2
-        return 2.0 * self.at_crack(ufl.as_vector([X[d + i] for i in range(d)]))
+        return 2.0 * self.at_crack(ufl.as_vector([X[self.first + i] for i in range(2)]))
 
     @property
     def u(self):

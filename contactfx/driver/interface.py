@@ -94,9 +94,10 @@ class InterfaceProblem(Problem):
     def boundary_conditions(self) -> list:
         V, d, fdim, tags = self.V, self.gdim, self.fdim, self.facet_tags
         bcs = []
+        enrichments = self.enrichments()
         for tag, comp in self.scene.supports():  # they hold for the total displacement
             facets = tags.indices[tags.values == tag]
-            for c in (comp, d + comp):
+            for c in (comp, *(first + comp for first, _ in enrichments)):
                 dofs = _compat.locate_dofs_topological(V.sub(c), fdim, facets)
                 bcs.append(_compat.dirichletbc(np.float64(0.0), dofs, V.sub(c)))
         for point, comp in self.scene.pinned():  # removing the rigid motions
@@ -104,9 +105,15 @@ class InterfaceProblem(Problem):
             dofs = at_points(Q, [(np.asarray(point, dtype=float), self.tol)])
             parent = np.asarray(q_to_w)[dofs].astype(np.int32)
             bcs.append(_compat.dirichletbc(np.float64(0.0), parent, V.sub(comp)))
-        for i in range(d):
-            bcs += self.confine(V.sub(d + i), self.free_mask)
+        for first, mask in enrichments:
+            for i in range(d):
+                bcs += self.confine(V.sub(first + i), mask)
         return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_tip_terms)
+
+    def enrichments(self) -> list:
+        """(first component, mask of the free dofs) of each enrichment field of the unknown:
+        the one a, free on the interface."""
+        return [(self.gdim, self.free_mask)]
 
     def free_mask(self, Q) -> np.ndarray:
         """On the interface and not on a tip or front."""

@@ -38,15 +38,18 @@ class Profile:
     t: np.ndarray
     status: np.ndarray
     floor: np.ndarray
+    #: with several (unfitted) cracks: the crack of each point, from 1; s is its coordinate
+    crack: np.ndarray | None = None
 
     FIELDS = "opening,slip,normal_traction,tangential_traction,status,proppant"
 
     def write_csv(self, path: Path) -> None:
-        """One row per interface node, sorted by s."""
-        cols = np.column_stack([self.s, self.x, self.opening, self.slip, self.p, self.t,
-                                self.status, self.floor])  # fmt: skip
-        position = ",".join("xyz"[: self.x.shape[1]])
-        np.savetxt(path, cols, delimiter=",", comments="", header=f"s,{position},{self.FIELDS}")
+        """One row per interface node (or Gauss point), sorted by s (and crack)."""
+        cols = [self.s, self.x, self.opening, self.slip, self.p, self.t, self.status, self.floor]
+        header = f"s,{','.join('xyz'[: self.x.shape[1]])},{self.FIELDS}"
+        if self.crack is not None:
+            cols, header = cols + [self.crack], header + ",crack"
+        np.savetxt(path, np.column_stack(cols), delimiter=",", comments="", header=header)
 
 
 class InterfacePost:

@@ -163,23 +163,29 @@ class Problem:
             )
         L = self.extra_load(L)
         # two bodies: no UFL surface, the contact terms are the solver's coupling
-        F = None if self.surface is None else self.method.residual(self.newton_surface())
+        F = None if self.surface is None else self.contact_residual()
         compiled = [dolfinx.fem.form(a), dolfinx.fem.form(L)]
         if F is None:
             return (*compiled, None, None)
         J = ufl.derivative(F, self.state, self.trial)
         return (*compiled, dolfinx.fem.form(F), dolfinx.fem.form(J))
 
-    def newton_surface(self):
-        """The surface of Newton's residual: with friction, a point whose trial tangential
-        traction reversed since Newton's previous iterate (``iterate``, kept by the solver)
-        takes the stick branch (:func:`contactfx.contact.laws.reversal`); at a converged
-        iterate this is the surface itself."""
-        s = self.surface
+    def contact_residual(self):
+        """The method's contact residual on the kind's surface (Newton's: ``newton_surface``)."""
+        return self.method.residual(self.newton_surface())
+
+    def newton_surface(self, s=None):
+        """The surface of Newton's residual (``s``, by default the kind's): with friction, a
+        point whose trial tangential traction reversed since Newton's previous iterate
+        (``iterate``, kept by the solver) takes the stick branch
+        (:func:`contactfx.contact.laws.reversal`); at a converged iterate this is the surface
+        itself."""
+        s = self.surface if s is None else s
         trial = getattr(self.method, "trial_traction", None)
         if s.friction is None or trial is None:
             return s
-        self.iterate = dolfinx.fem.Function(self.state.function_space, name="iterate")
+        if self.iterate is None:
+            self.iterate = dolfinx.fem.Function(self.state.function_space, name="iterate")
         x, bound = trial(s)
         x_last = ufl.replace(x, {self.state: self.iterate})
         return dataclasses.replace(s, stick=reversal(x, x_last, bound))

@@ -19,6 +19,8 @@ fraction and the von Mises stress of u + H a (H the side of the larger part of e
 
 from __future__ import annotations
 
+import functools
+
 import dolfinx
 import numpy as np
 import ufl
@@ -70,8 +72,69 @@ def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.nda
     return f.x.array.copy()
 
 
+class _Crack:
+    """One unfitted crack on the mesh: its tips moved onto cell boundaries (``segment``), its
+    cut cells, the side fractions and signs (DG0), its Gauss points and weights (quadrature
+    functions), Nitsche's length, and the first component of its enrichment in U."""
+
+    def __init__(self, mesh, X, crack: CrackSegment, first: int, rule, n_owned: int) -> None:
+        comm = mesh.comm
+        self.true, self.first = crack, first
+        near = near_cells(X, crack)
+        h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
+        if not np.isfinite(h):
+            raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
+        for tip in crack.tips():
+            if _compat.PointLocator(mesh, np.asarray([tip])).outside[0]:
+                raise ValueError(f"the crack tip {tip} lies outside the mesh")
+        # every tip moved onto the boundary of the cell holding it (the same on every rank:
+        # from the ranks that hold that cell)
+        psi = np.array(comm.allgather(snapped_tips(X, crack, SNAP * h)))
+        ends = []
+        for k, tip in enumerate(crack.tips()):
+            found = psi[:, k][~np.isnan(psi[:, k])]
+            ends.append(crack.centre + found[0] * crack.direction if len(found) else tip)
+        self.segment = CrackSegment(*ends)
+        self.cells = cells = cut_cells(X, self.segment, SNAP * h)
+        if comm.allreduce(int(cells.cut[:n_owned].sum()), op=MPI.SUM) == 0:
+            raise ValueError("the crack cuts no cell completely (shorter than the cells "
+                             "around it)")  # fmt: skip
+        quad = CrackQuadrature(X, cells, rule)
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        c0 = _compat.cell_dofs(DG0)[:, 0]
+        self.fraction = dolfinx.fem.Function(DG0, name="side_fraction")
+        self.fraction.x.array[c0] = cells.fraction
+        self.H = dolfinx.fem.Function(DG0, name="side")
+        self.H.x.array[c0] = np.where(cells.fraction >= 0.5, 1.0, -1.0)
+        Qs = _compat.quadrature_space(mesh, QUADRATURE_DEGREE)
+        qd = _compat.cell_dofs(Qs)
+        self.Y = [dolfinx.fem.Function(Qs) for _ in range(2)]
+        for i, Yi in enumerate(self.Y):
+            Yi.x.array[qd] = quad.points[:, :, i]
+        self.weight = dolfinx.fem.Function(Qs)
+        self.weight.x.array[qd] = quad.ratio
+        # Nitsche's length on a cut cell: NITSCHE_LENGTH |K| / |Gamma_K| (module docstring)
+        e1, e2 = X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]
+        self.area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        self.h_cut = dolfinx.fem.Function(DG0, name="h_cut")
+        length = np.where(cells.cut, np.linalg.norm(cells.pieces[:, 1] - cells.pieces[:, 0],
+                                                    axis=1), 1.0)  # fmt: skip
+        self.h_cut.x.array[c0] = NITSCHE_LENGTH * self.area / length
+        cut = np.flatnonzero(cells.cut).astype(np.int32)
+        self.cut, self.cut_owned = cut, cut[cut < n_owned]
+
+    def enrichment(self, X):
+        """Its enrichment field in the unknown (or test function) X."""
+        return ufl.as_vector([X[self.first + i] for i in range(2)])
+
+    def coordinate(self, x):
+        """psi: the true crack's coordinate of the points x (UFL or numpy (2, n))."""
+        c, d = self.true.centre, self.true.direction
+        return (x[0] - c[0]) * d[0] + (x[1] - c[1]) * d[1]
+
+
 class UnfittedProblem(InterfaceProblem):
-    """A body with an unfitted crack (see the module docstring)."""
+    """A body with unfitted cracks (see the module docstring)."""
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
@@ -88,74 +151,57 @@ class UnfittedProblem(InterfaceProblem):
             raise ValueError("joint closure is not implemented on unfitted cracks")
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
-        comm, tdim = mesh.comm, mesh.topology.dim
+        tdim = mesh.topology.dim
         if mesh.geometry.dim != 2 or mesh.topology.cell_name() != "triangle":
             raise ValueError("unfitted cracks are implemented on triangle meshes (2D)")
         self.tol = 1e-9 * scene.length_scale()
-        self.tips = []  # the jump vanishes on the tip cells by the choice of enriched nodes
+        self.tips = []  # the jump vanishes at the tips by the choice of enriched nodes
         self.on_front = None
-        cracks = scene.crack_segments()
-        if len(cracks) != 1:
-            raise ValueError("one unfitted crack per scene is implemented")
-        self.crack = crack = cracks[0]
         X = _compat.cell_coordinates(mesh)
-        self.n_owned_cells = mesh.topology.index_map(tdim).size_local
-        near = near_cells(X, crack)
-        h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
-        if not np.isfinite(h):
-            raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
-        # every tip moved onto the boundary of the cell holding it (the same on every rank:
-        # from the ranks that hold that cell)
-        psi = np.array(comm.allgather(snapped_tips(X, crack, SNAP * h)))
-        d = crack.direction
-        ends = []
-        for k, tip in enumerate(crack.tips()):
-            found = psi[:, k][~np.isnan(psi[:, k])]
-            ends.append(crack.centre + found[0] * d if len(found) else tip)
-        self.effective = CrackSegment(*ends)
-        self.cells = cells = cut_cells(X, self.effective, SNAP * h)
-        for tip in crack.tips():
-            inside = _compat.PointLocator(mesh, np.asarray([tip]))
-            if inside.outside[0]:
-                raise ValueError(f"the crack tip {tip} lies outside the mesh")
-        if comm.allreduce(int(cells.cut[: self.n_owned_cells].sum()), op=MPI.SUM) == 0:
-            raise ValueError("the crack cuts no cell completely (shorter than the cells "
-                             "around it)")  # fmt: skip
-        e1, e2 = X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]
-        self.area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        self.n_owned_cells = n_owned = mesh.topology.index_map(tdim).size_local
         self.rule = _compat.quadrature_rule(mesh, QUADRATURE_DEGREE)
-        quad = CrackQuadrature(X, cells, self.rule)
-        DG0 = _compat.function_space(mesh, "DG", 0)
-        c0 = _compat.cell_dofs(DG0)[:, 0]
-        self.fraction = dolfinx.fem.Function(DG0, name="side_fraction")
-        self.fraction.x.array[c0] = cells.fraction
-        self.H = dolfinx.fem.Function(DG0, name="side")
-        self.H.x.array[c0] = np.where(cells.fraction >= 0.5, 1.0, -1.0)
-        Qs = _compat.quadrature_space(mesh, QUADRATURE_DEGREE)
-        qd = _compat.cell_dofs(Qs)
-        self.Y = [dolfinx.fem.Function(Qs) for _ in range(2)]
-        for i, Yi in enumerate(self.Y):
-            Yi.x.array[qd] = quad.points[:, :, i]
-        self.weight = dolfinx.fem.Function(Qs)
-        self.weight.x.array[qd] = quad.ratio
-        # Nitsche's length on a cut cell: NITSCHE_LENGTH |K| / |Gamma_K| (module docstring)
-        self.h_cut = dolfinx.fem.Function(DG0, name="h_cut")
-        length = np.where(cells.cut, np.linalg.norm(cells.pieces[:, 1] - cells.pieces[:, 0],
-                                                    axis=1), 1.0)  # fmt: skip
-        self.h_cut.x.array[c0] = NITSCHE_LENGTH * self.area / length
-        cut = np.flatnonzero(cells.cut).astype(np.int32)
-        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, np.full(len(cut), _CUT, np.int32))
-        self.cut_owned = cut[cut < self.n_owned_cells]
+        segments = scene.crack_segments()
+        #: U = (u, a_1, ..., a_K): one enrichment per crack
+        self.components_per_dim = 1 + len(segments)
+        self.cracks = [_Crack(mesh, X, seg, 2 * (k + 1), self.rule, n_owned)
+                       for k, seg in enumerate(segments)]  # fmt: skip
+        tags = np.zeros(len(X), dtype=np.int32)
+        touched = np.zeros(len(X), dtype=np.int32)  # cut or tip cells of a crack
+        clash = (0, 0)
+        for k, crack in enumerate(self.cracks):
+            mine = crack.cells.cut | crack.cells.tip
+            if np.any(mine & (touched > 0)) and clash == (0, 0):
+                clash = (int(touched[mine & (touched > 0)][0]), k + 1)
+            touched[mine] = k + 1
+            tags[crack.cells.cut] = k + 1
+        clash = mesh.comm.allreduce(clash, op=MPI.MAX)  # every rank raises, or none
+        if clash != (0, 0):
+            raise ValueError(f"cracks {clash[0]} and {clash[1]} cross or share a cell; unfitted "
+                             "cracks must be a cell apart")  # fmt: skip
+        cut = np.flatnonzero(tags).astype(np.int32)
+        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, tags[cut])
+        self.area = self.cracks[0].area
+        # the side of every crack's larger part of each cell: the ParaView displacement
+        self.H = self.cracks[0].H
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
 
     def output_split(self):
         return None
 
-    def free_mask(self, Q) -> np.ndarray:
-        """The enriched nodes: of a cut cell, with area on both sides of the crack in their
-        support and no tip inside it (summed over every rank's cells)."""
+    def total(self, X):
+        """w = u + sum_k H_k a_k from X = (u, a_1, ..., a_K)."""
+        d = self.gdim
+        u = ufl.as_vector([X[i] for i in range(d)])
+        return u + sum((c.H * c.enrichment(X) for c in self.cracks), ufl.zero(d))
+
+    def enrichments(self) -> list:
+        return [(c.first, functools.partial(self._enriched, c)) for c in self.cracks]
+
+    def _enriched(self, crack: _Crack, Q) -> np.ndarray:
+        """The enriched nodes of a crack: of a cut cell, with area on both sides of the crack
+        in their support and no tip inside it (summed over every rank's cells)."""
         dofs = _compat.cell_dofs(Q)
-        c = self.cells
+        c = crack.cells
         n = self.n_owned_cells
         plus = _accumulate(Q, c.fraction * self.area, dofs, n)
         minus = _accumulate(Q, (1.0 - c.fraction) * self.area, dofs, n)
@@ -176,105 +222,150 @@ class UnfittedProblem(InterfaceProblem):
             )
         return enriched
 
-    def make_surface(self) -> CutSurface:
-        mesh, scene, d = self.mesh, self.scene, self.gdim
-        self.w, self.dw, self.v_load = (self.total(X) for X in (self.U, self.dU, self.V_test))
-        x = ufl.SpatialCoordinate(mesh)
-        Y = ufl.as_vector(self.Y)
-
-        def at_crack(f):
-            return f + ufl.dot(ufl.grad(f), Y - x)
-
-        rule = {"quadrature_degree": QUADRATURE_DEGREE, "quadrature_rule": "default"}
-        dx = ufl.Measure("dx", domain=mesh, subdomain_data=self.cut_tags)
-        self.dSc = self.dS_fine = WeightedMeasure(dx(_CUT, metadata=rule), self.weight)
-        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
-        self.s_coord = scene.coordinate(Y)
-        self.fluid_value = scene.fluid_pressure()
-        self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
-        sigma = self.material.sigma
-
-        def body(X):
-            return ufl.as_vector([X[i] for i in range(d)])
-
-        def mean_stress(X):
-            """The sides' stresses weighted by their area fractions (Hansbo & Hansbo 2002,
-            doi:10.1016/S0045-7825(02)00524-8): sigma(u) + (2 f - 1) sigma(a)."""
-            a = ufl.as_vector([X[d + i] for i in range(d)])
-            return sigma(body(X)) + (2.0 * self.fraction - 1.0) * sigma(a)
-
-        return CutSurface(
-            self.U, self.V_test, ufl.as_vector([float(v) for v in self.crack.normal]), self.dSc,
-            mean_stress(self.U), mean_stress(self.V_test), scene.contact_modulus(), self.h_cut,
-            floor=scene.floor(self.s_coord), fluid=self.fluid, friction=self.friction,
-            u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
+    def _mean_stress(self, X):
+        """The stress of the cells' sides weighted by their area fractions (Hansbo & Hansbo
+        2002, doi:10.1016/S0045-7825(02)00524-8): sigma(u + sum_k (2 f_k - 1) a_k)."""
+        d = self.gdim
+        u = ufl.as_vector([X[i] for i in range(d)])
+        m = [2.0 * c.fraction - 1.0 for c in self.cracks]
+        return self.material.sigma(
+            u + sum((mk * c.enrichment(X) for mk, c in zip(m, self.cracks, strict=True)),
+                    ufl.zero(d))
         )  # fmt: skip
 
+    def make_surface(self) -> CutSurface:
+        """The surface of each crack (``surfaces``); the first is the kind's ``surface``."""
+        mesh, scene = self.mesh, self.scene
+        self.w, self.dw, self.v_load = (self.total(X) for X in (self.U, self.dU, self.V_test))
+        x = ufl.SpatialCoordinate(mesh)
+        rule = {"quadrature_degree": QUADRATURE_DEGREE, "quadrature_rule": "default"}
+        dx = ufl.Measure("dx", domain=mesh, subdomain_data=self.cut_tags)
+        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
+        self.fluid_value = scene.fluid_pressure()
+        self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
+        self.surfaces = []
+        for k, crack in enumerate(self.cracks):
+            Y = ufl.as_vector(crack.Y)
+
+            def at_crack(f, Y=Y):
+                return f + ufl.dot(ufl.grad(f), Y - x)
+
+            crack.ds = WeightedMeasure(dx(k + 1, metadata=rule), crack.weight)
+            crack.s_coord = crack.coordinate(Y)
+            self.surfaces.append(CutSurface(
+                self.U, self.V_test, ufl.as_vector([float(v) for v in crack.true.normal]),
+                crack.ds, self._mean_stress(self.U), self._mean_stress(self.V_test),
+                scene.contact_modulus(), crack.h_cut, floor=scene.floor(crack.s_coord),
+                fluid=self.fluid, friction=self.friction,
+                u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
+                first=crack.first,
+            ))  # fmt: skip
+        first = self.cracks[0]
+        self.dSc = self.dS_fine = first.ds
+        self.s_coord = first.s_coord
+        return self.surfaces[0]
+
+    def contact_residual(self):
+        return sum(self.method.residual(self.newton_surface(s)) for s in self.surfaces)
+
+    def extra_load(self, L):
+        if self.fluid is None:
+            return L
+        # the fluid pushes the faces of every crack apart
+        for s in self.surfaces:
+            L = L + self.fluid * ufl.dot(s.v, s.interface_normal()) * s.ds
+        return L
+
     def bulk_form(self):
-        """Each side of a cut cell with its area fraction (exact for P1)."""
-        d, f = self.gdim, self.fraction
+        """Each side of a cut cell with its area fraction (exact for P1): with m_k = 2 f_k - 1
+        the sides' mean of the sign of crack k's enrichment and 1 - m_k^2 its variance (no
+        cell is cut by two cracks),
+        sigma(u + sum m_k a_k) : eps(v + sum m_k b_k) + sum (1 - m_k^2) sigma(a_k) : eps(b_k)."""
+        d = self.gdim
         sigma = self.material.sigma
 
-        def sides(X):
-            u = ufl.as_vector([X[i] for i in range(d)])
-            a = ufl.as_vector([X[d + i] for i in range(d)])
-            return u + a, u - a
+        def eps(z):
+            return ufl.sym(ufl.grad(z))
 
-        (wp, wm), (vp, vm) = sides(self.dU), sides(self.V_test)
-        eps = ufl.sym
-        return (f * ufl.inner(sigma(wp), eps(ufl.grad(vp)))
-                + (1.0 - f) * ufl.inner(sigma(wm), eps(ufl.grad(vm)))) * ufl.dx  # fmt: skip
+        def mean(X):
+            u = ufl.as_vector([X[i] for i in range(d)])
+            return u + sum(((2.0 * c.fraction - 1.0) * c.enrichment(X) for c in self.cracks),
+                           ufl.zero(d))  # fmt: skip
+
+        form = ufl.inner(sigma(mean(self.dU)), eps(mean(self.V_test)))
+        for c in self.cracks:
+            m = 2.0 * c.fraction - 1.0
+            form += (1.0 - m * m) * ufl.inner(sigma(c.enrichment(self.dU)),
+                                              eps(c.enrichment(self.V_test)))  # fmt: skip
+        return form * ufl.dx
 
     def post_processor(self) -> CutPost:
         return CutPost(self)
 
 
 class CutPost(InterfacePost):
-    """The crack's quantities at its Gauss points, forces, errors against the closed forms."""
+    """The cracks' quantities at their Gauss points, forces, errors against the closed forms
+    (of the first crack: the scenes with closed forms have one)."""
 
     def __init__(self, pb) -> None:
         self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
-        mesh, s, method = pb.mesh, pb.surface, pb.method
-        t_I = tangent(s.interface_normal())
-        p = method.pressure(s)
-        closed = method.contact_indicator(s)
+        mesh, method = pb.mesh, pb.method
         self.w0 = 0.0
-        quantities = {"aperture": s.opening(), "slip": ufl.dot(s.u, t_I),
-                      "normal_traction": p, "gap": s.gap(), "x": pb.Y[0], "y": pb.Y[1],
-                      "weight": pb.weight}  # fmt: skip
-        if s.friction is not None:
-            quantities["tangential_traction"] = ufl.dot(method.tangential_traction(s), t_I)
-            quantities["slipping"] = method.slip_indicator(s)
-        if s.floor is not None:
-            quantities["proppant"] = s.floor
         points = pb.rule[0]
-        self.exprs = {k: dolfinx.fem.Expression(v, points) for k, v in quantities.items()}
-        dS = pb.dS_fine
-        self.force_form = dolfinx.fem.form(p * dS)
-        self.closed_form = dolfinx.fem.form(active(closed) * dS)
+        self.exprs, forms = [], {"force": 0, "closed": 0, "tangential": 0, "propped": 0}
+        for crack, s in zip(pb.cracks, pb.surfaces, strict=True):
+            t_I = tangent(s.interface_normal())
+            p = method.pressure(s)
+            quantities = {"aperture": s.opening(), "slip": ufl.dot(s.u, t_I),
+                          "normal_traction": p, "gap": s.gap(), "x": crack.Y[0],
+                          "y": crack.Y[1]}  # fmt: skip
+            forms["force"] += p * s.ds
+            forms["closed"] += active(method.contact_indicator(s)) * s.ds
+            if s.friction is not None:
+                quantities["tangential_traction"] = ufl.dot(method.tangential_traction(s), t_I)
+                quantities["slipping"] = method.slip_indicator(s)
+                forms["tangential"] += quantities["tangential_traction"] * s.ds
+            if s.floor is not None:
+                quantities["proppant"] = s.floor
+                forms["propped"] += p * active(s.floor) * s.ds
+            self.exprs.append({k: dolfinx.fem.Expression(v, points)
+                               for k, v in quantities.items()})  # fmt: skip
+        s = pb.surface
+        self.force_form = dolfinx.fem.form(forms["force"])
+        self.closed_form = dolfinx.fem.form(forms["closed"])
         self.tforce_form = None
         if s.friction is not None:
-            self.tforce_form = dolfinx.fem.form(quantities["tangential_traction"] * dS)
+            self.tforce_form = dolfinx.fem.form(forms["tangential"])
         self.propped_form = None
         if s.floor is not None:
-            self.propped_form = dolfinx.fem.form(p * active(s.floor) * dS)
-        self.err_forms = self._error_forms(s, p, t_I)
+            self.propped_form = dolfinx.fem.form(forms["propped"])
+        self.err_forms = self._error_forms(s, method.pressure(s), tangent(s.interface_normal()))
         self.extra = {}
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm_expr = _compat.expression(pb.material.von_mises(pb.w), DG0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
         V1 = _compat.function_space(mesh, "Lagrange", 1, (pb.gdim,))
         self.u_out = dolfinx.fem.Function(V1, name="displacement")
-        self.a_out = dolfinx.fem.Function(V1, name="enrichment")
         U, d = pb.U, pb.gdim
         self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(d)]), V1)
-        self.a_expr = _compat.expression(ufl.as_vector([U[d + i] for i in range(d)]), V1)
+        self.a_out = [dolfinx.fem.Function(V1, name=f"enrichment_{k + 1}")
+                      for k in range(len(pb.cracks))]  # fmt: skip
+        self.a_expr = [_compat.expression(c.enrichment(U), V1) for c in pb.cracks]
         self.values: dict[str, np.ndarray] = {}
 
     def _evaluate_points(self) -> dict[str, np.ndarray]:
-        """Every quantity at the Gauss points of the owned cut cells (flat arrays)."""
-        cells, mesh = self.pb.cut_owned, self.pb.mesh
-        return {k: _compat.eval_expression(e, mesh, cells).ravel() for k, e in self.exprs.items()}
+        """Every quantity at the Gauss points of the owned cut cells (flat arrays; ``crack``
+        numbers the cracks from 1, ``s`` is each one's own coordinate)."""
+        mesh, parts = self.pb.mesh, []
+        for k, (crack, exprs) in enumerate(zip(self.pb.cracks, self.exprs, strict=True)):
+            v = {name: _compat.eval_expression(e, mesh, crack.cut_owned).ravel()
+                 for name, e in exprs.items()}  # fmt: skip
+            v["s"] = crack.coordinate(np.vstack([v["x"], v["y"]]))
+            v["crack"] = np.full(len(v["s"]), k + 1.0)
+            parts.append(v)
+        names = set().union(*parts)
+        return {n: np.concatenate([p.get(n, np.zeros(len(p["s"]))) for p in parts])
+                for n in names}  # fmt: skip
 
     def evaluate(self, solver) -> Quantities:
         v = self.values = self._evaluate_points()
@@ -310,34 +401,26 @@ class CutPost(InterfacePost):
 
     def fields(self) -> list:
         self.u_out.interpolate(self.u_expr)
-        self.a_out.interpolate(self.a_expr)
+        for f, e in zip(self.a_out, self.a_expr, strict=True):
+            f.interpolate(e)
         self.vm.interpolate(self.vm_expr)
-        return [self.u_out, self.a_out, self.vm, self.pb.fraction]
+        return [self.u_out, *self.a_out, self.vm, *(c.fraction for c in self.pb.cracks)]
 
     def profile(self) -> Profile:
-        """The Gauss points' values gathered on rank 0, sorted by s."""
+        """The Gauss points' values gathered on rank 0, sorted by crack and s."""
         v = self.values or self._evaluate_points()
         x = np.column_stack([v["x"], v["y"]])
-        s = self.scene.coordinate(x.T)
 
         def col(name):
-            return v[name] if name in v else np.zeros(len(s))
+            return v[name] if name in v else np.zeros(len(v["s"]))
 
-        local = np.column_stack(
-            [
-                s,
-                x,
-                col("aperture"),
-                col("slip"),
-                col("normal_traction"),
-                col("tangential_traction"),
-                col("status"),
-                col("proppant"),
-            ]
-        )
+        local = np.column_stack([v["s"], x, col("aperture"), col("slip"), col("normal_traction"),
+                                 col("tangential_traction"), col("status"), col("proppant"),
+                                 v["crack"]])  # fmt: skip
         parts = self.comm.gather(local, root=0)
         if self.comm.rank != 0:
             return Profile(np.zeros(0), np.zeros((0, 2)), *(np.zeros(0) for _ in range(6)))
         a = np.vstack(parts)
-        a = a[np.argsort(a[:, 0], kind="stable")]
-        return Profile(a[:, 0], a[:, 1:3], *(a[:, 3 + i] for i in range(6)))
+        a = a[np.lexsort((a[:, 0], a[:, -1]))]
+        crack = a[:, -1] if len(self.pb.cracks) > 1 else None
+        return Profile(a[:, 0], a[:, 1:3], *(a[:, 3 + i] for i in range(6)), crack=crack)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from contactfx.numerics import Numerics
 from contactfx.scenes.bar import Bar1D
 from contactfx.scenes.base import Scene
-from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
+from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
@@ -30,6 +30,7 @@ SCENES: dict[str, type[Scene]] = {
         CrackSneddon,
         CrackInclined,
         ProppedFracture,
+        CrackSet,
         PennyCrack,
         PennyShear,
         JointColumn,

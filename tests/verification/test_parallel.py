@@ -64,7 +64,7 @@ def test_serial_and_parallel_agree_al_and_friction(scene, num):
 
 
 def _interface_cases():
-    from contactfx.scenes.crack import CrackInclined, CrackSneddon, ProppedFracture
+    from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
     from contactfx.scenes.joint import JointColumn
     from contactfx.scenes.penny import PennyCrack, PennyShear
 
@@ -93,6 +93,7 @@ def _interface_cases():
             ProppedFracture(ProppedFracture.Params(crack="unfitted")),
             {"method": "nitsche", "theta": 0},
         ),
+        ("crack-set", CrackSet(CrackSet.Params()), {"method": "nitsche"}),
         (
             "penny-nitsche",
             PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
