@@ -7,8 +7,10 @@ comparison is in test_parallel.py (``*-unfitted``).
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
+from contactfx.contact.cut import CrackSegment
 from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon
 
 #: K_II / (sigma sqrt(pi a)) at beta = 30 / 45 / 60 (docs/verification.md section 6)
@@ -166,3 +168,14 @@ def test_crack_set_against_isolated_cracks():
 def test_crack_set_refuses_bad_layouts(params, message):
     with pytest.raises(ValueError, match=message):
         CrackSet.Params(**params)
+
+
+def test_crossing_cracks_are_refused():
+    class Crossing(CrackSet):
+        def crack_segments(self):
+            return [CrackSegment(np.array([-1.0, 0.0]), np.array([1.0, 0.0])),
+                    CrackSegment(np.array([0.0, -1.0]), np.array([0.0, 1.0]))]  # fmt: skip
+
+    scene = Crossing(CrackSet.Params(angles="0"))
+    with pytest.raises(ValueError, match="cross or share a cell"):
+        _run(scene, method="nitsche")
