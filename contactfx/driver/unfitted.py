@@ -1,20 +1,22 @@
-"""The unfitted-crack problem kind: a straight crack that the mesh does not follow
+"""The unfitted-crack problem kind: straight cracks that the mesh does not follow
 (:mod:`contactfx.contact.cut`).
 
-The unknown is U = (u, a) as for a fitted interface (:mod:`contactfx.driver.interface`), the
-enrichment a confined to the enriched nodes; the bulk form weighs each cut cell's two sides by
-their area fractions, the crack's terms are the methods' residuals on a
-:class:`contactfx.contact.cut.CutSurface`. Nitsche's stress on the crack is the sides' mean
-weighted by their area fractions and its parameter scales with the piece's length over the
-cell's area (Annavarapu, Hautefeuille & Dolbow 2012, doi:10.1002/nme.4343): with the cell
-diameter instead the pressure oscillates from cut cell to cut cell, more with a larger gamma0
-(docs/verification.md section 14). P1 only (the area-fraction integration is exact for
-constant strains); the methods whose law needs the vertex rule or a tip continuation (the
-penalties, the augmented Lagrangian ones) are not offered.
+The unknown is U = (u, a_1, ..., a_K) as for a fitted interface
+(:mod:`contactfx.driver.interface`) with one enrichment per crack, each confined to its
+enriched nodes; the bulk form weighs each cut cell's two sides by their area fractions, each
+crack's terms are the methods' residuals on its :class:`contactfx.contact.cut.CutSurface`.
+Nitsche's stress on the crack is the sides' mean weighted by their area fractions and its
+parameter scales with the piece's length over the cell's area (Annavarapu, Hautefeuille &
+Dolbow 2012, doi:10.1002/nme.4343): with the cell diameter instead the pressure oscillates
+from cut cell to cut cell, more with a larger gamma0 (docs/verification.md section 14). P1
+only (the area-fraction integration is exact for constant strains); the methods whose law
+needs the vertex rule or a tip continuation (the penalties, the augmented Lagrangian ones)
+are not offered.
 
-Outputs: along the crack, at its Gauss points, the aperture, slip, tractions and status
-(``interface.csv``, ``interface.png``); in the ParaView files u, the enrichment a, the side
-fraction and the von Mises stress of u + H a (H the side of the larger part of each cell).
+Outputs: along the cracks, at their Gauss points, the aperture, slip, tractions and status
+(``interface.csv``, ``interface.png``); in the ParaView files u (with one crack u + H a, split
+along the cut cells' edges), each enrichment, the side fractions and the von Mises stress of
+u + sum H_k a_k (H_k the side of the larger part of each cell).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from contactfx.driver.fields import global_sum, nodal_contact
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, InterfacePost, Profile
 from contactfx.driver.problem import Problem
+from contactfx.io.vtk import Split
 from contactfx.results import InterfaceQuantities, Quantities
 
 __all__ = ["UnfittedProblem"]
@@ -154,9 +157,7 @@ class UnfittedProblem(InterfaceProblem):
         tdim = mesh.topology.dim
         if mesh.geometry.dim != 2 or mesh.topology.cell_name() != "triangle":
             raise ValueError("unfitted cracks are implemented on triangle meshes (2D)")
-        self.tol = 1e-9 * scene.length_scale()
-        self.tips = []  # the jump vanishes at the tips by the choice of enriched nodes
-        self.on_front = None
+        self.tol = 1e-9 * scene.length_scale()  # of point location (pinned vertices)
         X = _compat.cell_coordinates(mesh)
         self.n_owned_cells = n_owned = mesh.topology.index_map(tdim).size_local
         self.rule = _compat.quadrature_rule(mesh, QUADRATURE_DEGREE)
@@ -181,12 +182,28 @@ class UnfittedProblem(InterfaceProblem):
         cut = np.flatnonzero(tags).astype(np.int32)
         self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, tags[cut])
         self.area = self.cracks[0].area
-        # the side of every crack's larger part of each cell: the ParaView displacement
-        self.H = self.cracks[0].H
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
 
     def output_split(self):
-        return None
+        """One crack: the ParaView body split along the edges between the cut cells' larger
+        sides (u + H a on each cell, H its larger part's side: Warp By Vector opens the crack
+        along a zigzag of cell edges); several cracks: not split."""
+        if len(self.cracks) != 1:
+            return None
+        crack, mesh = self.cracks[0], self.mesh
+        tdim = mesh.topology.dim
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        f2c = mesh.topology.connectivity(tdim - 1, tdim)
+        n_facets = mesh.topology.index_map(tdim - 1).size_local + mesh.topology.index_map(
+            tdim - 1).num_ghosts  # fmt: skip
+        side = np.where(crack.cells.fraction >= 0.5, 1.0, -1.0)
+        facets = []
+        for f in range(n_facets):
+            cells = f2c.links(f)
+            if len(cells) == 2 and side[cells[0]] != side[cells[1]] and np.any(
+                    crack.cells.cut[cells]):  # fmt: skip
+                facets.append(f)
+        return Split(crack.H, np.asarray(facets, dtype=np.int32), jump="enrichment_1")
 
     def total(self, X):
         """w = u + sum_k H_k a_k from X = (u, a_1, ..., a_K)."""
