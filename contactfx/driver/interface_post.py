@@ -81,13 +81,16 @@ class InterfacePost:
         self.force_form = dolfinx.fem.form(p * dSf)
         self.closed_form = dolfinx.fem.form(active(closed) * dSf)
         self.tforce_form = None
+        extra = {}
         if s.friction is not None:
             self.tforce_form = dolfinx.fem.form(quantities["tangential_traction"] * dSf)
+            # the slipping part of the interface (its length in 2D, area in 3D)
+            extra["slipping_size"] = quantities["slipping"] * dSf
         self.propped_form = None
         if s.floor is not None:
             self.propped_form = dolfinx.fem.form(p * active(s.floor) * dSf)
         self.err_forms = self._error_forms(s, p, t_I)
-        extra = self.scene.extra_quantities(mesh, s.w, pb.ds)
+        extra.update(self.scene.extra_quantities(mesh, s.w, pb.ds))
         self.extra = {k: dolfinx.fem.form(v) for k, v in extra.items()}
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm_expr = _compat.expression(pb.material.von_mises(s.w), DG0)

@@ -329,7 +329,8 @@ class CutPost(InterfacePost):
         mesh, method = pb.mesh, pb.method
         self.w0 = 0.0
         points = pb.rule[0]
-        self.exprs, forms = [], {"force": 0, "closed": 0, "tangential": 0, "propped": 0}
+        self.exprs = []
+        forms = {"force": 0, "closed": 0, "tangential": 0, "propped": 0, "slipping": 0}
         for crack, s in zip(pb.cracks, pb.surfaces, strict=True):
             t_I = tangent(s.interface_normal())
             p = method.pressure(s)
@@ -342,6 +343,7 @@ class CutPost(InterfacePost):
                 quantities["tangential_traction"] = ufl.dot(method.tangential_traction(s), t_I)
                 quantities["slipping"] = method.slip_indicator(s)
                 forms["tangential"] += quantities["tangential_traction"] * s.ds
+                forms["slipping"] += quantities["slipping"] * s.ds
             if s.floor is not None:
                 quantities["proppant"] = s.floor
                 forms["propped"] += p * active(s.floor) * s.ds
@@ -358,6 +360,8 @@ class CutPost(InterfacePost):
             self.propped_form = dolfinx.fem.form(forms["propped"])
         self.err_forms = self._error_forms(s, method.pressure(s), tangent(s.interface_normal()))
         self.extra = {}
+        if s.friction is not None:  # the slipping length
+            self.extra["slipping_size"] = dolfinx.fem.form(forms["slipping"])
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm_expr = _compat.expression(pb.material.von_mises(pb.w), DG0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
@@ -398,11 +402,12 @@ class CutPost(InterfacePost):
         interface = InterfaceQuantities(
             tangential_force=0.0 if self.tforce_form is None else global_sum(self.tforce_form,
                                                                              self.comm),
+            extra={k: global_sum(form, self.comm) for k, form in self.extra.items()},
         )  # fmt: skip
         if self.propped_form is not None:
             propped = v["proppant"] > 0.0
             interface = InterfaceQuantities(
-                tangential_force=interface.tangential_force,
+                tangential_force=interface.tangential_force, extra=interface.extra,
                 proppant_force=global_sum(self.propped_form, self.comm),
                 min_aperture_propped=self.comm.allreduce(
                     float(np.min(v["aperture"][propped], initial=np.inf)), op=MPI.MIN),

@@ -9,7 +9,7 @@ from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, Proppe
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D
 from contactfx.scenes.joint import JointColumn
-from contactfx.scenes.penny import PennyCrack, PennyShear
+from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
@@ -33,6 +33,7 @@ SCENES: dict[str, type[Scene]] = {
         CrackSet,
         PennyCrack,
         PennyShear,
+        FaultBlock,
         JointColumn,
         PatchTest,
         HertzCylinders,

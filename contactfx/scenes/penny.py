@@ -56,7 +56,7 @@ from contactfx.scenes.base import elastic
 from contactfx.scenes.crack import SlidingCrack, extrapolated_K
 from contactfx.scenes.interface_base import InterfaceScene
 
-__all__ = ["PennyCrack", "PennyShear"]
+__all__ = ["PennyCrack", "PennyShear", "FaultBlock"]
 
 
 @dataclass(frozen=True)
@@ -294,4 +294,66 @@ class PennyShear(SlidingCrack, _PennyBlock):
             np.max(np.abs(shear - self._bound(sigma_n)), initial=0.0) / sigma_n
         )
         out["slipping_fraction"] = float(np.mean(prof.status[inner] == STATUS["slip"]))
+        return out
+
+
+@dataclass(frozen=True)
+class FaultBlockParams(_PennyParams):
+    sigma_v: float = param(20e6, "vertical remote compression sigma_v", positive=True)
+    sigma_h: float = param(8e6, "horizontal remote compression sigma_h (in the dip plane)",
+                           nonnegative=True)  # fmt: skip
+    dip: float = param(60.0, "the fault's dip: its normal's angle to the vertical, degrees")
+    overpressure: float = param(0.0, "fluid overpressure p on the fault's faces (it lowers "
+                                "the effective normal stress)", nonnegative=True)  # fmt: skip
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 0.0 <= self.dip <= 90.0:
+            raise ValueError(f"--dip ({self.dip}) must be within [0, 90] degrees")
+
+
+class FaultBlock(PennyShear):
+    """A circular fault patch of radius a in a block (the penny crack's geometry, its plane
+    z = 0 in the fault's frame) under the remote principal stresses sigma_v (vertical) and
+    sigma_h (horizontal, in the dip plane), the fault's normal at ``dip`` to the vertical, with
+    Coulomb friction and a fluid overpressure p on its faces. In the fault's frame the vertical
+    is (sin dip, 0, cos dip): on the fault sigma_n = sigma_v cos^2 + sigma_h sin^2 and
+    tau = -(sigma_v - sigma_h) sin cos along x. The fluid carries p of sigma_n, the contact
+    the effective sigma_n - p; where abs(tau) > mu (sigma_n - p) the whole fault slips under the
+    uniform driving shear q (penny-shear's closed forms with q), and the stress drop, the shear
+    released on the fault, is abs(q). Reported: the slip distribution (interface.csv, the
+    profile plot), the slipping area, the stress drop against abs(q)."""
+
+    name = "fault-block"
+    summary = "circular fault patch under remote stress, Coulomb, fluid overpressure (3D)"
+    Params = FaultBlockParams
+
+    def remote_stress(self) -> np.ndarray:
+        b = np.radians(self.p.dip)
+        v = np.array([np.sin(b), 0.0, np.cos(b)])  # the vertical in the fault's frame
+        h = np.array([np.cos(b), 0.0, -np.sin(b)])  # the horizontal in the dip plane
+        return -self.p.sigma_v * np.outer(v, v) - self.p.sigma_h * np.outer(h, h)
+
+    def fluid_pressure(self):
+        return self.p.overpressure if self.p.overpressure > 0.0 else None
+
+    def _plane(self) -> tuple[float, float]:
+        """(effective sigma_n, tau): the compression the contact carries and the shear."""
+        sigma_n, tau = super()._plane()
+        return sigma_n - self.p.overpressure, tau
+
+    def interface_reference(self, prof, q, friction):
+        out = super().interface_reference(prof, q, friction)
+        sigma_n, tau = self._plane()
+        q_d = self._q()
+        area = 0.5 * np.pi * self.p.crack_radius**2  # the half model's fault
+        out["slipping_area_fraction"] = q.interface.extra.get("slipping_size", 0.0) / area
+        out["stress_drop_exact"] = abs(q_d)
+        if q_d != 0.0:
+            # the shear released on the fault: tau before slip minus the face shear after,
+            # averaged away from the front
+            inner = prof.s < self.p.crack_radius - 2.0 * self.p.h_crack
+            drop = abs(tau) - float(np.mean(np.abs(prof.t[inner])))
+            out["stress_drop"] = drop
+            out["stress_drop_rel_error"] = abs(drop - abs(q_d)) / abs(q_d)
         return out

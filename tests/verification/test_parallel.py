@@ -66,7 +66,7 @@ def test_serial_and_parallel_agree_al_and_friction(scene, num):
 def _interface_cases():
     from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
     from contactfx.scenes.joint import JointColumn
-    from contactfx.scenes.penny import PennyCrack, PennyShear
+    from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 
     inclined = CrackInclined(CrackInclined.Params(beta=45.0))
     propped = ProppedFracture(ProppedFracture.Params())
@@ -103,6 +103,11 @@ def _interface_cases():
             "penny-shear-nitsche",
             PennyShear(PennyShear.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
             {"method": "nitsche"},
+        ),
+        (
+            "fault-block",
+            FaultBlock(FaultBlock.Params(h_front=0.2, h_crack=0.4, overpressure=3e6)),
+            {},
         ),
         (
             "penny-suction-nitsche",
