@@ -185,11 +185,16 @@ def test_unfitted_paraview_body_opens_the_crack(tmp_path):
     """The ParaView body of an unfitted crack: the nodes of the edges between the cut cells'
     larger sides are duplicated, each copy moves with its cells' side (u +- a), so Warp By
     Vector opens the crack; the largest jump between copies is Sneddon's centre opening."""
+    from pathlib import Path
+
+    from mpi4py import MPI
+
     from contactfx.io.vtk import read_pvd, read_vtu
 
+    out = Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0))  # one folder for every rank
     scene = CrackSneddon(CrackSneddon.Params(crack="unfitted"))
-    data = scene.run(scene.default_numerics(method="nitsche"), out=tmp_path, verbose=False)
-    (_, vtu), *_ = read_pvd(tmp_path / "crack-sneddon.pvd")
+    data = scene.run(scene.default_numerics(method="nitsche"), out=out, verbose=False)
+    (_, vtu), *_ = read_pvd(out / "crack-sneddon.pvd")
     body = read_vtu(vtu)
     x, u = body["points"], body["point_data"]["displacement"]
     keys = np.round(x / 1e-9).astype(np.int64)
