@@ -122,10 +122,12 @@ def test_init_round_trip(tmp_path, name, params, numerics):
             assert va == vb, (key, va, vb)
 
 
-#: scenes a problem file cannot say yet (a 3D interface), refused with one line
+#: scenes a problem file cannot say yet (a 3D interface, unfitted cracks), refused with one line
 NO_PROBLEM_FILE = {
     "penny-crack": "problem files carry 2D interfaces only",
     "penny-shear": "problem files carry 2D interfaces only",
+    "fault-block": "problem files carry 2D interfaces only",
+    "crack-set": "problem files carry fitted interfaces only",
 }
 
 
