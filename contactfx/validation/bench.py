@@ -54,6 +54,8 @@ class BenchCase:
     levels: int = 99
     #: numerics overrides of the case (e.g. its friction law), under the method variant's
     numerics: dict = dataclasses.field(default_factory=dict)
+    #: a case plotted with this one in common figures (error against time and h) when both ran
+    beside: str | None = None
 
 
 CASES: dict[str, BenchCase] = {
@@ -102,18 +104,34 @@ CASES: dict[str, BenchCase] = {
     # the same cracks on a mesh that ignores them (P1 and nitsche only; the rest: n/a), beside
     # the fitted rows above
     "crack-sneddon-unfitted": BenchCase(
-        "crack-sneddon", {"crack": "unfitted"}, 2.0, "pressurised crack, unfitted, Sneddon"
-    ),
+        "crack-sneddon",
+        {"crack": "unfitted"},
+        2.0,
+        "pressurised crack, unfitted, Sneddon",
+        beside="crack-sneddon",
+    ),  # fmt: skip
     "crack-inclined-unfitted": BenchCase(
         "crack-inclined",
         {"beta": 45.0, "crack": "unfitted"},
         2.0,
         "inclined crack, unfitted, compression, Coulomb mu 0.3",
+        beside="crack-inclined",
+    ),  # fmt: skip
+    "crack-set": BenchCase(
+        "crack-set", {}, 2.0, "three unfitted cracks under compression and shear, Coulomb"
     ),
     # level 2 is the scene's default mesh (68012 dofs with P2)
     "penny-crack": BenchCase(
         "penny-crack", {}, 4.0, "pressurised penny-shaped crack in 3D, Sneddon", p2_levels=3
     ),
+    # level 2 is the default mesh (132410 dofs with P2; the bench's P2 stops at level 1)
+    "fault-block": BenchCase(
+        "fault-block",
+        {"overpressure": 3e6},
+        4.0,
+        "circular fault, remote stress, fluid overpressure, Coulomb (3D)",
+        p2_levels=2,
+    ),  # fmt: skip
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
     "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
     "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),

@@ -172,10 +172,38 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
                 written.append(path)
             md += ["", f"![{case_name} {m} vs time]({case_name}_{m[4:]}_time.png)"
                    f" ![{case_name} {m} vs h]({case_name}_{m[4:]}_h.png)"]  # fmt: skip
+        md += _beside(plt, rows, case_name, plotted, out, written)
     path = out / "bench.md"
     path.write_text("\n".join(md) + "\n")
     written.append(path)
     return written
+
+
+def _beside(plt, rows: list[dict], case_name: str, plotted: list[str], out: Path,
+            written: list[Path]) -> list[str]:  # fmt: skip
+    """The case with the one it is benched beside (``BenchCase.beside``, e.g. an unfitted
+    crack beside the fitted one) in common figures: the measures both have, every series
+    labelled with its case. Returns the Markdown lines."""
+    from contactfx.validation.bench import CASES, MEASURES
+
+    other = CASES[case_name].beside
+    other_rows = [r for r in rows if r["case"] == other]
+    if other is None or not other_rows:
+        return []
+    series = {}
+    for name in (other, case_name):
+        for (label, degree), srs in _series([r for r in rows if r["case"] == name]).items():
+            series[(f"{name}: {label}", degree)] = srs
+    md = ["", f"### {case_name} beside {other}"]
+    for m in (m for m in plotted if _has(other_rows, m)):
+        names = []
+        for kind in ("time", "h"):
+            path = out / f"{case_name}_beside_{m[4:]}_{kind}.png"
+            _plot(plt, series, m, kind, f"{case_name} and {other}: {MEASURES[m][0]}", path)
+            written.append(path)
+            names.append(path.name)
+        md += ["", f"![{m} vs time]({names[0]}) ![{m} vs h]({names[1]})"]
+    return md
 
 
 #: one colour per method variant (tab10 and eight more of distinct hue), in order of appearance
