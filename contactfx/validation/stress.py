@@ -172,6 +172,20 @@ def _interface_cases() -> list[StressCase]:
     out.append(StressCase("unfitted crack beta=10 mu=0.3 (graded)", "unfitted crack position",
                           "crack-inclined", {**crack, "beta": 10.0, "crack": "unfitted"},
                           {"method": "nitsche"}))  # fmt: skip
+    # the 3D cracks on the coarse penny mesh (h_front = a / 5, P2): closing under suction,
+    # sliding without friction, sticking (penny-shear at mu 1.2 > tan 45; the fault at dip 80,
+    # where abs(tau) = 2.05 MPa < 0.3 sigma_n = 2.51 MPa), a fault held by 0.5 MPa of
+    # effective normal stress (overpressure 10.5 of sigma_n = 11 MPa)
+    penny = {"h_front": 0.2, "h_crack": 0.4}
+    for name, scene, params, numerics in (
+        ("penny-crack suction", "penny-crack", {"pressure": -1e6}, {}),
+        ("penny-shear mu=0", "penny-shear", {}, {"friction": "none", "mu": 0.0}),
+        ("penny-shear mu=1.2 (stick)", "penny-shear", {}, {"mu": 1.2}),
+        ("fault-block dip=80 (stick)", "fault-block", {"dip": 80.0}, {}),
+        ("fault-block overpressure=10.5e6", "fault-block", {"overpressure": 10.5e6}, {}),
+    ):
+        out.append(StressCase(name, "3D crack", scene, {**penny, **params},
+                              {"method": "nitsche", **numerics}))  # fmt: skip
     for s_c, p in ((30e6, 10e6), (3e9, 0.0), (30e6, 29.9e6), (30e6, 40e6)):
         # the last: fluid pressure above the load, no equilibrium (refused)
         out.append(StressCase(f"joint s_c={s_c:g} p={p:g}", "joint closure", "joint-column",
