@@ -192,15 +192,22 @@ def quadrature_rule(mesh, degree: int) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(points), np.asarray(weights)
 
 
-def quadrature_space(mesh, degree: int):
-    """A scalar space of values at the points of :func:`quadrature_rule` (one dof per cell and
-    point, in the rule's order)."""
+def quadrature_space(mesh, degree: int, shape: tuple[int, ...] = ()):
+    """A space of values at the points of :func:`quadrature_rule` (one dof per cell and point,
+    in the rule's order; a block of ``shape[0]`` components per dof for a vector)."""
     if _NEW:
         import basix.ufl
 
-        element = basix.ufl.quadrature_element(mesh.basix_cell(), scheme="default", degree=degree)
+        element = basix.ufl.quadrature_element(
+            mesh.basix_cell(), value_shape=tuple(shape), scheme="default", degree=degree
+        )
         return dolfinx.fem.functionspace(mesh, element)
-    element = ufl.FiniteElement("Quadrature", mesh.ufl_cell(), degree, quad_scheme="default")
+    cell = mesh.ufl_cell()
+    if shape:
+        element = ufl.VectorElement("Quadrature", cell, degree, dim=shape[0],
+                                    quad_scheme="default")  # fmt: skip
+    else:
+        element = ufl.FiniteElement("Quadrature", cell, degree, quad_scheme="default")
     return dolfinx.fem.FunctionSpace(mesh, element)
 
 

@@ -43,6 +43,7 @@ interface (:class:`CutSurface`).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -304,9 +305,11 @@ class CutSurface(InterfaceSurface):
     (the crack's enrichment from component ``first``); ``ds``
     a :class:`WeightedMeasure` on the cut cells; ``stress_cell`` / ``stress_test_cell`` the
     sides' stress weighted by their area fractions; ``H`` the crack's normal n_I; ``at_crack``
-    maps a P1 field to its value at the crack's Gauss points."""
+    maps a P1 field to its value at the crack's Gauss points, ``at_law`` to its value at the
+    midpoint of each cell's piece (:meth:`tip_extended`)."""
 
     at_crack: object = None
+    at_law: object = None
     #: the first component of this crack's enrichment in U = (u, a_1, ..., a_K)
     first: int = 2
 
@@ -347,7 +350,15 @@ class CutSurface(InterfaceSurface):
         return ufl.dot(jump, self.interface_normal())
 
     def tip_extended(self):
-        return self
+        """The surface that the law of a method collocated at a fitted crack's nodes (the
+        penalty: ``tip_continued``) reads: its motion at the midpoint of each cut cell's
+        piece, where the linear jump takes its mean, so that the law is one value per piece.
+        At the piece's six Gauss points instead the penalty's pressure oscillated from cut
+        cell to cut cell, the more the stiffer the penalty (docs/verification.md section 14).
+        No midpoint lies at a tip: no tip needs a continuation."""
+        if self.at_law is None:
+            return self
+        return dataclasses.replace(self, at_crack=self.at_law)
 
     def slip_increment(self, n):
         if self.u_prev is None:

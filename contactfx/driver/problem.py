@@ -63,11 +63,11 @@ class Problem:
         self.t_prev = None
         self._history = None
         if self.friction is not None and method.traction_history:
-            space = _compat.function_space(mesh, "Lagrange", 1, (self.gdim,))
+            space = self.surface_space((self.gdim,))
             self.t_prev = dolfinx.fem.Function(space, name="traction_history")
         self.multiplier = None
         if method.multiplier == "nodal":
-            space = _compat.function_space(mesh, "Lagrange", 1, self.mult_shape or None)
+            space = self.surface_space(self.mult_shape)
             self.multiplier = dolfinx.fem.Function(space, name="multiplier")
             self.lam = self.multiplier
         self.surface = self.make_surface()
@@ -75,6 +75,11 @@ class Problem:
             self.surface = dataclasses.replace(self.surface, h_nodal=self._nodal_size())
         #: Newton's previous iterate (the friction law's reversal guard), or None
         self.iterate = None
+
+    def surface_space(self, shape: tuple[int, ...]):
+        """The space of a method's values on the contact surface (a nodal multiplier, a
+        traction history): P1, the law collocated at the surface's nodes."""
+        return _compat.function_space(self.mesh, "Lagrange", 1, shape or None)
 
     def material_of(self, mesh):
         return self.scene.material()
@@ -223,13 +228,18 @@ class Problem:
         law's own nodal values, averaged over the facets of a node where they differ)."""
         if self.t_prev is not None:
             if self._history is None:
-                measure, restrict = self.nodal_rule()
-                proj = NodalProjection(measure, self.t_prev.function_space, restrict)
-                self._history = (proj, proj.form(self.method.tangential_traction(self.surface)))
-            proj, form = self._history
-            proj(form, self.t_prev)
+                self._history = self.history_update(self.method.tangential_traction)
+            self._history(self.t_prev)
         if self.prev is not None:
             self.prev.x.array[:] = self.state.x.array
+
+    def history_update(self, law):
+        """The filler of the traction history with ``law(surface)`` at the surface's nodes:
+        the vertex rule's lumped projection."""
+        measure, restrict = self.nodal_rule()
+        proj = NodalProjection(measure, self.t_prev.function_space, restrict)
+        form = proj.form(law(self.surface))
+        return lambda target: proj(form, target)
 
     def nested_fields(self) -> list:
         """The Functions nested iteration carries from a coarser mesh: the state and the

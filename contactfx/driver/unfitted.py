@@ -9,9 +9,16 @@ Nitsche's stress on the crack is the sides' mean weighted by their area fraction
 parameter scales with the piece's length over the cell's area (Annavarapu, Hautefeuille &
 Dolbow 2012, doi:10.1002/nme.4343): with the cell diameter instead the pressure oscillates
 from cut cell to cut cell, more with a larger gamma0 (docs/verification.md section 14). P1
-only (the area-fraction integration is exact for constant strains); the methods whose law
-needs the vertex rule or a tip continuation (the penalties, the augmented Lagrangian ones)
-are not offered.
+only (the area-fraction integration is exact for constant strains).
+
+The penalty, which a fitted crack collocates at its nodes, is collocated at the midpoint of
+each cut cell's piece (:meth:`contactfx.contact.cut.CutSurface.tip_extended`); its traction
+history (friction) is a function of the cell rule's points (:meth:`UnfittedProblem.
+surface_space`), the law's value there; its length is the cell diameter. The multiplier
+methods (al-uzawa, al-ssn) need a multiplier space on the cut cells that satisfies the
+inf-sup condition (Bechet, Moes & Wohlmuth 2009, doi:10.1002/nme.2515): on a piece of
+vanishing length the multiplier that closes it grows without bound (docs/verification.md
+section 14). Not offered.
 
 Outputs: along the cracks, at their Gauss points, the aperture, slip, tractions and status
 (``interface.csv``, ``interface.png``); in the ParaView files u (with one crack u + H a, split
@@ -114,6 +121,10 @@ class _Crack:
         self.Y = [dolfinx.fem.Function(Qs) for _ in range(2)]
         for i, Yi in enumerate(self.Y):
             Yi.x.array[qd] = quad.points[:, :, i]
+        # each piece's midpoint at every point of its cell
+        self.mid = [dolfinx.fem.Function(Qs) for _ in range(2)]
+        for i, Mi in enumerate(self.mid):
+            Mi.x.array[qd] = quad.points[:, :, i].mean(axis=1)[:, None]
         self.weight = dolfinx.fem.Function(Qs)
         self.weight.x.array[qd] = quad.ratio
         # Nitsche's length on a cut cell: NITSCHE_LENGTH |K| / |Gamma_K| (module docstring)
@@ -145,9 +156,10 @@ class UnfittedProblem(InterfaceProblem):
         if numerics.degree != 1:
             raise ValueError("unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                              "integration is exact for constant strains only")  # fmt: skip
-        if method.multiplier != "none" or method.tip_continued or method.nodal_size:
+        if method.multiplier != "none":
             raise ValueError(f"method {method.name} is not implemented on unfitted cracks "
-                             "(its law needs the crack's nodes); use nitsche")  # fmt: skip
+                             "(its multiplier needs a stable space on the cut cells); use "
+                             "nitsche or penalty")  # fmt: skip
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
         if scene.joint() is not None:
@@ -183,6 +195,33 @@ class UnfittedProblem(InterfaceProblem):
         self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, tags[cut])
         self.area = self.cracks[0].area
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
+
+    # -- a method's values at the cracks' pieces ----------------------------------------------
+    def surface_space(self, shape: tuple[int, ...]):
+        """Values at the points of the cell rule, which carry the cracks' Gauss points."""
+        return _compat.quadrature_space(self.mesh, QUADRATURE_DEGREE, shape)
+
+    def history_update(self, law):
+        """The filler of the traction history with ``law(s)`` at the points of each crack's
+        surface s (its owned cut cells; the ghosts by a scatter)."""
+        exprs = [dolfinx.fem.Expression(law(s), self.rule[0]) for s in self.surfaces]
+
+        def fill(target) -> None:
+            bs = target.function_space.dofmap.index_map_bs
+            dofs = _compat.cell_dofs(target.function_space)
+            values = target.x.array.reshape(-1, bs)
+            for crack, e in zip(self.cracks, exprs, strict=True):
+                v = _compat.eval_expression(e, self.mesh, crack.cut_owned)
+                values[dofs[crack.cut_owned].ravel()] = v.reshape(-1, bs)
+            target.x.scatter_forward()
+
+        return fill
+
+    def _nodal_size(self):
+        """The penalty's h (``nodal_size``): the cell diameter, which varies smoothly along the
+        crack. With Nitsche's h_K, large where a piece is short, the stiffness jumped from
+        cut cell to cut cell and so did the pressure (docs/verification.md section 14)."""
+        return self.h
 
     def output_split(self):
         """One crack: the ParaView body split along the edges between the cut cells' larger
@@ -262,10 +301,13 @@ class UnfittedProblem(InterfaceProblem):
         self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
         self.surfaces = []
         for k, crack in enumerate(self.cracks):
-            Y = ufl.as_vector(crack.Y)
+            Y, M = ufl.as_vector(crack.Y), ufl.as_vector(crack.mid)
 
             def at_crack(f, Y=Y):
                 return f + ufl.dot(ufl.grad(f), Y - x)
+
+            def at_midpoint(f, M=M):
+                return f + ufl.dot(ufl.grad(f), M - x)
 
             crack.ds = WeightedMeasure(dx(k + 1, metadata=rule), crack.weight)
             crack.s_coord = crack.coordinate(Y)
@@ -275,7 +317,8 @@ class UnfittedProblem(InterfaceProblem):
                 scene.contact_modulus(), crack.h_cut, floor=scene.floor(crack.s_coord),
                 fluid=self.fluid, friction=self.friction,
                 u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
-                first=crack.first,
+                at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
+                h_nodal=self._nodal_size(),
             ))  # fmt: skip
         first = self.cracks[0]
         self.dSc = self.dS_fine = first.ds

@@ -89,6 +89,11 @@ def _interface_cases():
             {"method": "nitsche", "mu": 0.3},
         ),
         (
+            "inclined-unfitted-penalty",
+            CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")),
+            {"method": "penalty", "mu": 0.3},
+        ),
+        (
             "propped-unfitted",
             ProppedFracture(ProppedFracture.Params(crack="unfitted")),
             {"method": "nitsche", "theta": 0},
