@@ -104,6 +104,22 @@ def test_unfitted_penalty_keeps_its_traction_history():
     )
 
 
+def test_unfitted_KII_at_30_degrees_converges():
+    """The table's worst case (beta 30, 2.3 % on the default mesh) on the mesh refined once
+    more (h_crack = a / 80, h_tip = a / 800)."""
+    runs = [
+        _run(CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted", **h)),
+             method="nitsche", mu=0.3)
+        for h in ({}, {"h_crack": 0.0125, "h_tip": 0.00125})
+    ]  # fmt: skip
+    errors = [r.reference["K_rel_error"] for r in runs]
+    # measured 2.26 % and 0.82 % (4.0 % at a / 20): about O(h^1.5)
+    assert errors[1] < 0.012 and errors[0] > 2.0 * errors[1], errors
+    slips = [r.errors["slip_L2_rel"] for r in runs]
+    # measured 0.93 % and 0.42 %: O(h)
+    assert slips[1] < 0.006 and slips[0] > 1.8 * slips[1], slips
+
+
 def test_unfitted_stick_has_no_slip():
     # beta 30, mu 0.6: tan(30) < 0.6, the crack sticks; the body carries the remote stress
     # alone, which the discrete space holds exactly
