@@ -128,7 +128,7 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
         Function, its nodal update and the contact nodes)."""
         from contactfx.solvers.uzawa import Uzawa
 
-        update = problem.nodal_update(self.update(problem.surface))
+        update = problem.surface_update(self.update)
         return Uzawa(solver, problem.multiplier, update, problem.multiplier_mask,
                      tol=self.al_tol, max_it=self.al_max_it)  # fmt: skip
 

@@ -63,6 +63,7 @@ __all__ = [
     "snapped_tips",
     "cell_sizes",
     "near_cells",
+    "CoarseGrid",
 ]
 
 #: a node within SNAP times its size of the crack's line is moved onto it
@@ -281,6 +282,58 @@ class CrackQuadrature:
         e1, e2 = X[c, 1] - X[c, 0], X[c, 2] - X[c, 0]
         det = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
         self.ratio[c] = 0.5 * length[:, None] * w[None, :] / (ref_w[None, :] * det[:, None])
+
+
+class CoarseGrid:
+    """A multiplier along the crack, piecewise linear in psi on a grid coarser than the cut
+    cells (the coarse-grained multiplier of Akula, Vignollet & Yastrebov 2019, MorteX,
+    arXiv:1902.04000). The multiplier whose values are the law's at every piece (or its
+    nodal trace) is not stable: a piece that clips a cell's corner moves the enrichment of a
+    far node with a small lever, and the multiplier that closes it grows without bound (Bechet,
+    Moes & Wohlmuth 2009, doi:10.1002/nme.2515; docs/verification.md section 14). The grid's
+    nodes are the crack's crossings of the cells' edges ``psi`` (in any order, repeated) with
+    the sizes ``size`` of the cells there: the first and the last, and each crossing at least
+    ``factor`` times its size beyond the last node kept (the last node moves to the crack's
+    end if that is nearer)."""
+
+    def __init__(self, psi: np.ndarray, size: np.ndarray, factor: float) -> None:
+        psi, size = np.asarray(psi, float), np.asarray(size, float)
+        order = np.lexsort((size, psi))  # the same grid whatever the order (ranks) given
+        psi, size = psi[order], size[order]
+        nodes = [psi[0]]
+        for p, h in zip(psi[1:], size[1:], strict=True):
+            if p - nodes[-1] >= factor * h:
+                nodes.append(p)
+        if psi[-1] > nodes[-1]:
+            if len(nodes) > 1 and psi[-1] - nodes[-1] < factor * size[-1]:
+                nodes[-1] = psi[-1]
+            else:
+                nodes.append(psi[-1])
+        self.nodes = np.asarray(nodes)
+
+    def _hats(self, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(left node, weight of the right node) of the points psi (clipped to the grid)."""
+        x = np.clip(psi, self.nodes[0], self.nodes[-1])
+        i = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, len(self.nodes) - 2)
+        return i, (x - self.nodes[i]) / (self.nodes[i + 1] - self.nodes[i])
+
+    def moments(self, psi: np.ndarray, weights: np.ndarray, values: np.ndarray):
+        """(int phi_j v, int phi_j) of the grid's hat functions phi_j against the values
+        (points, components) at the points psi with the quadrature weights: one rank's part
+        of the lumped L2 projection (sum them over the ranks, then divide)."""
+        i, t = self._hats(psi)
+        n = len(self.nodes)
+        num = np.zeros((n, values.shape[1]))
+        den = np.zeros(n)
+        for j, phi in ((i, 1.0 - t), (i + 1, t)):
+            np.add.at(num, j, (weights * phi)[:, None] * values)
+            np.add.at(den, j, weights * phi)
+        return num, den
+
+    def evaluate(self, psi: np.ndarray, nodal: np.ndarray) -> np.ndarray:
+        """The piecewise linear field of ``nodal`` (nodes, components) at the points psi."""
+        i, t = self._hats(psi)
+        return (1.0 - t)[:, None] * nodal[i] + t[:, None] * nodal[i + 1]
 
 
 class WeightedMeasure(ufl.Measure):

@@ -255,11 +255,13 @@ class InterfaceProblem(Problem):
         self._tolerances(solver)
 
     def _start_multiplier(self) -> None:
-        s = self.surface
-        start = ufl.dot(s.stress, s.normal()) if self.mult_shape else positive_part(
-            s.effective_pressure())  # fmt: skip
+        def start(s):
+            if self.mult_shape:
+                return ufl.dot(s.stress, s.normal())
+            return positive_part(s.effective_pressure())
+
         if self.multiplier is not None:
-            self.nodal_update(start)(self.multiplier)
+            self.surface_update(start)(self.multiplier)
             bs = self.multiplier.function_space.dofmap.index_map_bs
             self.multiplier.x.array[~np.repeat(self.multiplier_mask, bs)] = 0.0
             return
@@ -267,7 +269,7 @@ class InterfaceProblem(Problem):
         Q, q_to_w = W1.collapse()
         lam0 = dolfinx.fem.Function(Q)
         proj = NodalProjection(self.dS_nodal, Q, "+")
-        proj(proj.form(start), lam0)
+        proj(proj.form(start(self.surface)), lam0)
         self.state.x.array[np.asarray(q_to_w)] = lam0.x.array
         self.state.x.scatter_forward()
 

@@ -233,6 +233,11 @@ class Problem:
         if self.prev is not None:
             self.prev.x.array[:] = self.state.x.array
 
+    def surface_update(self, law):
+        """The filler of a nodal multiplier with ``law(surface)`` (a UFL expression on the
+        contact surface): its values at the surface's nodes."""
+        return self.nodal_update(law(self.surface))
+
     def history_update(self, law):
         """The filler of the traction history with ``law(surface)`` at the surface's nodes:
         the vertex rule's lumped projection."""

@@ -11,14 +11,17 @@ Dolbow 2012, doi:10.1002/nme.4343): with the cell diameter instead the pressure 
 from cut cell to cut cell, more with a larger gamma0 (docs/verification.md section 14). P1
 only (the area-fraction integration is exact for constant strains).
 
-The penalty, which a fitted crack collocates at its nodes, is collocated at the midpoint of
-each cut cell's piece (:meth:`contactfx.contact.cut.CutSurface.tip_extended`); its traction
-history (friction) is a function of the cell rule's points (:meth:`UnfittedProblem.
-surface_space`), the law's value there; its length is the cell diameter. The multiplier
-methods (al-uzawa, al-ssn) need a multiplier space on the cut cells that satisfies the
-inf-sup condition (Bechet, Moes & Wohlmuth 2009, doi:10.1002/nme.2515): on a piece of
-vanishing length the multiplier that closes it grows without bound (docs/verification.md
-section 14). Not offered.
+The penalty and al-uzawa, which a fitted crack collocates at its nodes, read their laws at
+the midpoint of each cut cell's piece (:meth:`contactfx.contact.cut.CutSurface.
+tip_extended`). Their values on the crack (the penalty's traction history, al-uzawa's
+multiplier) are functions of the cell rule's points (:meth:`UnfittedProblem.surface_space`):
+the history is the law's value there; the multiplier is piecewise linear along the crack on a
+grid of nodes GRID_FACTOR cell sizes apart (:class:`contactfx.contact.cut.CoarseGrid`), the
+lumped L2 projection of the law's values. A multiplier with one value per piece is not
+stable: on a piece of vanishing length the multiplier that closes it grows without bound
+(Bechet, Moes & Wohlmuth 2009, doi:10.1002/nme.2515; docs/verification.md section 14). The
+penalty's length is the cell diameter. al-ssn, whose multiplier is a field of the mixed
+space, is not offered: the grid is not a finite element space of the mesh.
 
 Outputs: along the cracks, at their Gauss points, the aperture, slip, tractions and status
 (``interface.csv``, ``interface.png``); in the ParaView files u (with one crack u + H a, split
@@ -39,6 +42,7 @@ from petsc4py import PETSc
 from contactfx import _compat
 from contactfx.contact.cut import (
     SNAP,
+    CoarseGrid,
     CrackQuadrature,
     CrackSegment,
     CutSurface,
@@ -67,6 +71,10 @@ _CUT = 1  # the cut cells' tag
 #: 2 E |Gamma_K| / |K| of Annavarapu, Hautefeuille & Dolbow 2012 (doi:10.1002/nme.4343) for the
 #: area-weighted mean stress
 NITSCHE_LENGTH = 5.0
+#: al-uzawa's multiplier grid along a crack: its nodes at least GRID_FACTOR cell sizes apart
+#: (:class:`contactfx.contact.cut.CoarseGrid`); 0.5, 1 and 2 give the same slip and pressure
+#: on crack-inclined, in 36, 23 and 14 outer iterations (docs/verification.md section 14)
+GRID_FACTOR = 2.0
 
 
 def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
@@ -136,6 +144,15 @@ class _Crack:
         self.h_cut.x.array[c0] = NITSCHE_LENGTH * self.area / length
         cut = np.flatnonzero(cells.cut).astype(np.int32)
         self.cut, self.cut_owned = cut, cut[cut < n_owned]
+        # the Gauss points' psi and weights, and the multiplier's grid along the crack (the
+        # same on every rank: from every rank's crossings of its owned cells' edges)
+        self.psi_q = self.coordinate(quad.points.reshape(-1, 2).T).reshape(quad.ratio.shape)
+        self.weight_q = quad.ratio * rule[1][None, :] * 2.0 * self.area[:, None]
+        ends = cells.pieces[self.cut_owned].reshape(-1, 2)
+        sizes = np.repeat(cell_sizes(X[self.cut_owned]), 2)
+        gathered = comm.allgather((self.coordinate(ends.T), sizes))
+        self.grid = CoarseGrid(np.concatenate([g[0] for g in gathered]),
+                               np.concatenate([g[1] for g in gathered]), GRID_FACTOR)  # fmt: skip
 
     def enrichment(self, X):
         """Its enrichment field in the unknown (or test function) X."""
@@ -156,10 +173,10 @@ class UnfittedProblem(InterfaceProblem):
         if numerics.degree != 1:
             raise ValueError("unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                              "integration is exact for constant strains only")  # fmt: skip
-        if method.multiplier != "none":
+        if method.multiplier == "field":
             raise ValueError(f"method {method.name} is not implemented on unfitted cracks "
-                             "(its multiplier needs a stable space on the cut cells); use "
-                             "nitsche or penalty")  # fmt: skip
+                             "(its multiplier field would need a finite element space on the "
+                             "cut cells); use nitsche, penalty or al-uzawa")  # fmt: skip
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
         if scene.joint() is not None:
@@ -200,6 +217,39 @@ class UnfittedProblem(InterfaceProblem):
     def surface_space(self, shape: tuple[int, ...]):
         """Values at the points of the cell rule, which carry the cracks' Gauss points."""
         return _compat.quadrature_space(self.mesh, QUADRATURE_DEGREE, shape)
+
+    @functools.cached_property
+    def multiplier_mask(self) -> np.ndarray:
+        """The points of the cut cells (every crack's)."""
+        Q = self.multiplier.function_space
+        dofs = _compat.cell_dofs(Q)
+        mask = np.zeros(Q.dofmap.index_map.size_local + Q.dofmap.index_map.num_ghosts, bool)
+        for c in self.cracks:
+            mask[dofs[c.cut].ravel()] = True
+        return mask
+
+    def surface_update(self, law):
+        """The filler of al-uzawa's multiplier with ``law(s)`` on each crack's surface s: the
+        law's values at the Gauss points projected onto the crack's grid (lumped L2, summed
+        over the ranks), and the grid's piecewise linear field at the points."""
+        exprs = [dolfinx.fem.Expression(law(s), self.rule[0]) for s in self.surfaces]
+        comm = self.mesh.comm
+
+        def fill(target) -> None:
+            bs = target.function_space.dofmap.index_map_bs
+            dofs = _compat.cell_dofs(target.function_space)
+            values = target.x.array.reshape(-1, bs)
+            for crack, e in zip(self.cracks, exprs, strict=True):
+                cells = crack.cut_owned
+                v = _compat.eval_expression(e, self.mesh, cells).reshape(-1, bs)
+                psi = crack.psi_q[cells].ravel()
+                num, den = crack.grid.moments(psi, crack.weight_q[cells].ravel(), v)
+                num, den = comm.allreduce(num, op=MPI.SUM), comm.allreduce(den, op=MPI.SUM)
+                nodal = num / np.where(den > 0.0, den, 1.0)[:, None]
+                values[dofs[cells].ravel()] = crack.grid.evaluate(psi, nodal)
+            target.x.scatter_forward()
+
+        return fill
 
     def history_update(self, law):
         """The filler of the traction history with ``law(s)`` at the points of each crack's
@@ -318,6 +368,7 @@ class UnfittedProblem(InterfaceProblem):
                 fluid=self.fluid, friction=self.friction,
                 u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
                 at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
+                multiplier=self.multiplier,
                 h_nodal=self._nodal_size(),
             ))  # fmt: skip
         first = self.cracks[0]

@@ -11,7 +11,14 @@ import ufl
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.contact.cut import SNAP, CrackQuadrature, CrackSegment, WeightedMeasure, cut_cells
+from contactfx.contact.cut import (
+    SNAP,
+    CoarseGrid,
+    CrackQuadrature,
+    CrackSegment,
+    WeightedMeasure,
+    cut_cells,
+)
 
 N = 16  # cells per side of the unit square, h = 1 / 16 along the edges
 
@@ -110,3 +117,34 @@ def test_crack_along_edges_belongs_to_one_side():
 def test_segment_of_zero_length_is_refused():
     with pytest.raises(ValueError, match="zero length"):
         CrackSegment(np.array([0.5, 0.5]), np.array([0.5, 0.5]))
+
+
+def test_coarse_grid_nodes_and_projection():
+    """al-uzawa's multiplier grid along a crack (CoarseGrid): crossings at psi with the cell
+    sizes there, graded like a mesh towards one end, given twice and shuffled (as gathered
+    from the ranks)."""
+    rng = np.random.default_rng(7)
+    psi = np.concatenate([[-1.0], -1.0 + np.cumsum(np.geomspace(1e-3, 0.2, 25)), [1.0]])
+    psi = psi[psi <= 1.0]
+    size = np.full(len(psi), 0.05)
+    size[:8] = 2e-3  # small cells at the psi = -1 end
+    both = np.concatenate([psi, psi])
+    order = rng.permutation(len(both))
+    grid = CoarseGrid(both[order], np.concatenate([size, size])[order], 2.0)
+    assert np.array_equal(grid.nodes, CoarseGrid(psi, size, 2.0).nodes)  # order-free
+    nodes = grid.nodes
+    assert nodes[0] == -1.0 and nodes[-1] == 1.0
+    assert np.all(np.isin(nodes, psi))  # every node a crossing
+    # each node but the last at least twice the size of its cell beyond the one before
+    kept = np.searchsorted(psi, nodes[1:-1])
+    assert np.all(np.diff(nodes)[:-1] >= 2.0 * size[kept] - 1e-15)
+    assert len(nodes) < len(psi)  # the short pieces are merged
+    # the lumped L2 projection keeps constants, the grid's field interpolates its nodes
+    x = np.linspace(-1.0, 1.0, 401)
+    w = np.full(len(x), 2.0 / 400)
+    num, den = grid.moments(x, w, np.column_stack([np.full(len(x), 3.0), -np.ones(len(x))]))
+    assert np.allclose(num / den[:, None], [3.0, -1.0], rtol=0, atol=1e-13)
+    field = rng.normal(size=(len(nodes), 1))
+    assert np.allclose(grid.evaluate(nodes, field), field, rtol=0, atol=1e-14)
+    mid = 0.5 * (nodes[:-1] + nodes[1:])
+    assert np.allclose(grid.evaluate(mid, field)[:, 0], 0.5 * (field[:-1, 0] + field[1:, 0]))

@@ -94,6 +94,11 @@ def _interface_cases():
             {"method": "penalty", "mu": 0.3},
         ),
         (
+            "inclined-unfitted-al-uzawa",
+            CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")),
+            {"method": "al-uzawa", "mu": 0.3},
+        ),
+        (
             "propped-unfitted",
             ProppedFracture(ProppedFracture.Params(crack="unfitted")),
             {"method": "nitsche", "theta": 0},
