@@ -108,6 +108,19 @@ CASES = {
 }  # fmt: skip
 
 
+def _display_taken(n: int) -> bool:
+    """Whether X display n is in use: its lock file or socket, or its abstract socket, which
+    a server in another mount namespace (a chroot on this host) shares with us and which
+    clients try first."""
+    if Path(f"/tmp/.X{n}-lock").exists() or Path(f"/tmp/.X11-unix/X{n}").exists():
+        return True
+    try:
+        lines = Path("/proc/net/unix").read_text().splitlines()
+    except OSError:
+        return False
+    return any(ln.split()[-1] == f"@/tmp/.X11-unix/X{n}" for ln in lines[1:] if ln.split())
+
+
 @pytest.fixture(scope="module")
 def display():
     """The DISPLAY to render on: the user's, or a private Xvfb server for the module."""
@@ -116,7 +129,7 @@ def display():
         return
     server, number = None, None
     for n in range(90, 200):  # a free display: no lock file, and the server stays up
-        if Path(f"/tmp/.X{n}-lock").exists() or Path(f"/tmp/.X11-unix/X{n}").exists():
+        if _display_taken(n):
             continue
         argv = [XVFB, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"]
         server = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
