@@ -136,7 +136,11 @@ class _PennyBlock(InterfaceScene):
         the modulus E / (1 - nu^2) of the mode)."""
         p = self.p
         a, n = p.crack_radius, p.front_bins
-        phi = np.degrees(np.arctan2(prof.x[:, 1], prof.x[:, 0]))
+        # the model is y >= 0 (and x >= 0 for the quarter): the nodes on its symmetry planes
+        # carry coordinates of +-1e-18 from the cell they are tabulated from, which depends on
+        # the partition, and a sign would put them outside [0, 90] / [0, 180]
+        x, y = prof.x[:, 0], np.abs(prof.x[:, 1])
+        phi = np.degrees(np.arctan2(y, x if self.half else np.abs(x)))
         edges = np.linspace(0.0, 180.0 if self.half else 90.0, n + 1)
         K = np.array([
             extrapolated_K(a - prof.s, jump, E, nu, a, near=(phi >= lo) & (phi <= hi))
