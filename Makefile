@@ -28,9 +28,10 @@ demo: install
 	mpirun -n $(NP) $(VENV)/bin/contactfx run hertz2d --out results/hertz2d
 
 # The serial session runs its tests on NP workers (pytest-xdist: each test in one process, as
-# alone); the MPI session runs every test on NP ranks together.
+# alone; the tests of an xdist_group, the ParaView probes, on one worker); the MPI session runs
+# every test on NP ranks together.
 test: install
-	$(PY) -m pytest -q -n $(NP) tests
+	$(PY) -m pytest -q -n $(NP) --dist loadgroup tests
 	mpirun -n $(NP) $(PY) -m mpi4py -m pytest -q -m "not serial_only" tests
 
 # The committed results page docs/results.md (over an hour on 2 cores: up to 850 runs): error against run time

@@ -13,17 +13,17 @@ surface dataset carrying the same contact fields.
 
 Needs ``pvpython`` (Debian: ``apt-get install paraview python3-paraview``) and, without a
 display, ``Xvfb`` (``xvfb``): ParaView 5.11 of Debian 12 renders through X even with
-``--force-offscreen-rendering``. One Xvfb server serves the module, on a display number no
-other server holds (starting one per probe with ``xvfb-run -a`` raced: a probe sometimes got
-"bad X server connection"). Launches subprocesses: ``serial_only``.
+``--force-offscreen-rendering``. One Xvfb server serves the module, on a display number it
+picks itself, and one test worker runs the module (starting a server per probe with
+``xvfb-run -a``, or one per worker, made a probe fail now and then with "bad X server
+connection"). Launches subprocesses: ``serial_only``.
 """
 
 import json
 import os
+import select
 import shutil
 import subprocess
-import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,6 +34,10 @@ PVPYTHON = shutil.which("pvpython")
 XVFB = shutil.which("Xvfb")
 pytestmark = [
     pytest.mark.serial_only,
+    # one pytest-xdist worker runs the module (make test: --dist loadgroup), with one Xvfb
+    # server: two servers side by side made a probe fail now and then with "bad X server
+    # connection" (one server serves two clients side by side well)
+    pytest.mark.xdist_group("paraview"),
     pytest.mark.skipif(
         PVPYTHON is None, reason="pvpython is not installed (Debian: paraview python3-paraview)"
     ),
@@ -108,40 +112,23 @@ CASES = {
 }  # fmt: skip
 
 
-def _display_taken(n: int) -> bool:
-    """Whether X display n is in use: its lock file or socket, or its abstract socket, which
-    a server in another mount namespace (a chroot on this host) shares with us and which
-    clients try first."""
-    if Path(f"/tmp/.X{n}-lock").exists() or Path(f"/tmp/.X11-unix/X{n}").exists():
-        return True
-    try:
-        lines = Path("/proc/net/unix").read_text().splitlines()
-    except OSError:
-        return False
-    return any(ln.split()[-1] == f"@/tmp/.X11-unix/X{n}" for ln in lines[1:] if ln.split())
-
-
 @pytest.fixture(scope="module")
 def display():
-    """The DISPLAY to render on: the user's, or a private Xvfb server for the module."""
+    """The DISPLAY to render on: the user's, or a private Xvfb server for the module. Xvfb
+    picks a free display number itself and reports it (``-displayfd``): no other server, of
+    this session or of another on the host, can take the same one."""
     if os.environ.get("DISPLAY"):
         yield os.environ["DISPLAY"]
         return
-    server, number = None, None
-    for n in range(90, 200):  # a free display: no lock file, and the server stays up
-        if _display_taken(n):
-            continue
-        argv = [XVFB, f":{n}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"]
-        server = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        for _ in range(200):  # up once its socket exists (or it exited: display taken)
-            if Path(f"/tmp/.X11-unix/X{n}").exists() or server.poll() is not None:
-                break
-            time.sleep(0.05)
-        time.sleep(0.5)
-        if server.poll() is None:
-            number = n
-            break
-    assert number is not None, "no Xvfb server could start"
+    read, write = os.pipe()
+    argv = [XVFB, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"]
+    server = subprocess.Popen(argv, pass_fds=(write,), stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)  # fmt: skip
+    os.close(write)
+    with os.fdopen(read) as pipe:
+        ready, _, _ = select.select([pipe], [], [], 60.0)
+        number = pipe.readline().strip() if ready else ""
+    assert number.isdigit() and server.poll() is None, "no Xvfb server could start"
     try:
         yield f":{number}"
     finally:
