@@ -229,9 +229,19 @@ class UnfittedProblem(InterfaceProblem):
         return mask
 
     def surface_update(self, law):
-        """The filler of al-uzawa's multiplier with ``law(s)`` on each crack's surface s: the
-        law's values at the Gauss points projected onto the crack's grid (lumped L2, summed
-        over the ranks), and the grid's piecewise linear field at the points."""
+        """The filler of al-uzawa's multiplier: ``law(s)`` on each crack's surface s projected
+        onto the crack's grid (:meth:`_filler`)."""
+        return self._filler(law, on_grid=True)
+
+    def history_update(self, law):
+        """The filler of the traction history: ``law(s)`` at each crack's points."""
+        return self._filler(law, on_grid=False)
+
+    def _filler(self, law, *, on_grid: bool):
+        """The filler of a :meth:`surface_space` Function with ``law(s)`` at the Gauss points
+        of each crack's surface s (its owned cut cells; the ghosts by a scatter); ``on_grid``:
+        those values projected onto the crack's grid (lumped L2, summed over the ranks) and
+        the grid's piecewise linear field taken at the points instead."""
         exprs = [dolfinx.fem.Expression(law(s), self.rule[0]) for s in self.surfaces]
         comm = self.mesh.comm
 
@@ -242,27 +252,12 @@ class UnfittedProblem(InterfaceProblem):
             for crack, e in zip(self.cracks, exprs, strict=True):
                 cells = crack.cut_owned
                 v = _compat.eval_expression(e, self.mesh, cells).reshape(-1, bs)
-                psi = crack.psi_q[cells].ravel()
-                num, den = crack.grid.moments(psi, crack.weight_q[cells].ravel(), v)
-                num, den = comm.allreduce(num, op=MPI.SUM), comm.allreduce(den, op=MPI.SUM)
-                nodal = num / np.where(den > 0.0, den, 1.0)[:, None]
-                values[dofs[cells].ravel()] = crack.grid.evaluate(psi, nodal)
-            target.x.scatter_forward()
-
-        return fill
-
-    def history_update(self, law):
-        """The filler of the traction history with ``law(s)`` at the points of each crack's
-        surface s (its owned cut cells; the ghosts by a scatter)."""
-        exprs = [dolfinx.fem.Expression(law(s), self.rule[0]) for s in self.surfaces]
-
-        def fill(target) -> None:
-            bs = target.function_space.dofmap.index_map_bs
-            dofs = _compat.cell_dofs(target.function_space)
-            values = target.x.array.reshape(-1, bs)
-            for crack, e in zip(self.cracks, exprs, strict=True):
-                v = _compat.eval_expression(e, self.mesh, crack.cut_owned)
-                values[dofs[crack.cut_owned].ravel()] = v.reshape(-1, bs)
+                if on_grid:
+                    psi = crack.psi_q[cells].ravel()
+                    num, den = crack.grid.moments(psi, crack.weight_q[cells].ravel(), v)
+                    num, den = comm.allreduce(num, op=MPI.SUM), comm.allreduce(den, op=MPI.SUM)
+                    v = crack.grid.evaluate(psi, num / np.where(den > 0.0, den, 1.0)[:, None])
+                values[dofs[cells].ravel()] = v
             target.x.scatter_forward()
 
         return fill
