@@ -24,6 +24,7 @@ import os
 import select
 import shutil
 import subprocess
+import time
 
 import numpy as np
 import pytest
@@ -112,6 +113,12 @@ CASES = {
 }  # fmt: skip
 
 
+#: pvpython's X connection to the module's Xvfb failed now and then under load ("bad X server
+#: connection", 2 of 4 probes in one CI run, none in the next): a probe that could not
+#: connect is started again, up to this many times; its results are asserted as ever
+X_ATTEMPTS = 4
+
+
 @pytest.fixture(scope="module")
 def display():
     """The DISPLAY to render on: the user's, or a private Xvfb server for the module. Xvfb
@@ -143,7 +150,11 @@ def _probe(out, scene, field, scale, display):
     cmd = [PVPYTHON, "--force-offscreen-rendering", str(script), str(out / f"{scene}.pvd"),
            str(out / f"{scene}_surface.pvd"), str(png), "POINTS", str(scale), field]  # fmt: skip
     env = {**clean_env(), "DISPLAY": display}
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
+    for _ in range(X_ATTEMPTS):
+        res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
+        if "bad X server connection" not in res.stdout + res.stderr:
+            break
+        time.sleep(1.0)
     lines = [ln for ln in res.stdout.splitlines() if ln.startswith("PROBE ")]
     assert res.returncode == 0 and lines, res.stdout + res.stderr
     return json.loads(lines[-1][len("PROBE ") :]), png
