@@ -34,6 +34,28 @@ __all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "Cont
            "GAMG_OPTIONS"]  # fmt: skip
 
 
+#: MUMPS's errors of a workspace too small for the factorisation (INFOG(1); MUMPS users'
+#: guide, section "Error diagnostics": -8, -9, -11, -14, -15, -17, -20 ask for a larger ICNTL(14))
+_MUMPS_WORKSPACE = (-8, -9, -11, -14, -15, -17, -20)
+
+
+def _mumps_error(ksp) -> int | None:
+    """MUMPS's INFOG(1) of the factorisation behind ``ksp``'s preconditioner, None without
+    MUMPS."""
+    pc = ksp.getPC()
+    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+        return None
+    try:
+        return int(pc.getFactorMatrix().getMumpsInfog(1))
+    except PETSc.Error:  # no factor (the preconditioner's set-up failed before it)
+        return None
+
+
+def _reason_name(reason: int) -> str:
+    names = {v: k for k, v in vars(PETSc.KSP.ConvergedReason).items() if isinstance(v, int)}
+    return names.get(reason, str(reason))
+
+
 class ConvergenceError(RuntimeError):
     """The nonlinear solve failed; names the SNES reason, the load step and the load factor."""
 
@@ -285,6 +307,9 @@ class ContactSNES:
             name = key if key.startswith("contactfx_") else self.prefix + key
             opts[name] = _option_value(value)
 
+    #: the linear start's solves again with a larger MUMPS workspace (ICNTL(14) doubled)
+    MUMPS_RETRIES = 3
+
     #: Krylov iterations at most with a reused factorisation (then it is refactorised)
     REUSE_MAX_IT = 20
     #: Krylov iterations above which a kept AMG preconditioner is rebuilt at the next Jacobian
@@ -458,13 +483,36 @@ class ContactSNES:
         b = self.b.copy()
         b.getArray()[rows] = 0.0
         x = _compat.petsc_vec(self.u)
-        ksp = PETSc.KSP().create(self.comm)
-        ksp.setOptionsPrefix(self.prefix)
-        ksp.setOperators(A)
-        ksp.setFromOptions()
-        ksp.solve(b, x)
+        opts = PETSc.Options()
+        workspace = self.prefix + "mat_mumps_icntl_14"
+        user_workspace = opts.getString(workspace) if opts.hasName(workspace) else None
+        try:
+            for attempt in range(self.MUMPS_RETRIES + 1):
+                ksp = PETSc.KSP().create(self.comm)
+                ksp.setOptionsPrefix(self.prefix)
+                ksp.setOperators(A)
+                ksp.setFromOptions()
+                ksp.solve(b, x)
+                reason, infog = ksp.getConvergedReason(), _mumps_error(ksp)
+                ksp.destroy()
+                if reason >= 0:
+                    break
+                if infog not in _MUMPS_WORKSPACE or attempt == self.MUMPS_RETRIES:
+                    mumps = "" if infog is None else f", MUMPS INFOG(1) = {infog}"
+                    raise ConvergenceError(f"the linear start's solve failed: KSP reason "
+                                           f"{_reason_name(reason)}{mumps}")  # fmt: skip
+                # MUMPS ran out of its estimated workspace (its estimate holds for the pivots
+                # of the analysis; in parallel the delayed pivots differ from run to run):
+                # again with MUMPS's advice, a larger relative workspace ICNTL(14)
+                opts[workspace] = 2 ** (attempt + 1) * int(user_workspace or 20)
+        finally:
+            if user_workspace is None:
+                if opts.hasName(workspace):
+                    opts.delValue(workspace)
+            else:
+                opts[workspace] = user_workspace
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        for obj in (ksp, A, b):
+        for obj in (A, b):
             obj.destroy()
 
     # -- solve ---------------------------------------------------------------------------

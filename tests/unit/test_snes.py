@@ -314,3 +314,25 @@ def test_rigid_body_modes(gdim):
         K.mult(z, Kz)
         # K's entries are O(1) on this mesh, z has unit norm: K z is round-off
         assert Kz.norm() < 1e-12
+
+
+def test_linear_start_failure_names_the_reason():
+    """A singular linear start (the stiffness minus itself on the free dofs) raises
+    ConvergenceError naming the KSP reason and MUMPS's INFOG(1) (-10: numerically singular),
+    instead of leaving PETSc's Inf in u as the Newton solve's start."""
+    solver, u, _ = make_solver("cfx_unit_linear_")
+    solver.assemble_load()
+    V = u.function_space
+    du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    minus_k = dolfinx.fem.form(-E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx)
+    free = np.ones(V.dofmap.index_map.size_local, dtype=bool)
+    with pytest.raises(ConvergenceError, match=r"linear start.*INFOG\(1\) = -10"):
+        solver.solve_linear(free, minus_k)
+    solver.solve_linear(free)  # the regular start still solves: the spring-free bar
+    solver.destroy()
+    assert not [k for k in PETSc.Options().getAll() if k.startswith("cfx_unit_linear_")]
+    n = V.dofmap.index_map.size_local
+    x = _compat.dof_coordinates(V)[:n, 0]
+    exact = -F * x**2 / (2.0 * E) + F * L * x / E  # u' (L) = 0, t = 1
+    # P1 is nodally exact in 1D; the LU solve is exact to round-off
+    assert COMM.allreduce(np.abs(u.x.array[:n] - exact).max(initial=0.0), op=MPI.MAX) < 1e-12
