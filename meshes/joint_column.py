@@ -10,6 +10,9 @@ geometry, Frontal-Delaunay triangulation (gmsh ``Mesh.Algorithm`` 6), linear tri
 Physical groups: the cells of both blocks are tagged :attr:`JointColumnCells.DOMAIN`, the
 column's edges and the joint :class:`JointColumnFacets` (every boundary edge carries exactly one
 tag; the joint edges, interior facets, carry :attr:`JointColumnFacets.JOINT`).
+
+With ``fitted=False`` the column is one rectangle meshed without the joint line (no ``JOINT``
+group): the background of an unfitted joint, which the mesh's edges do not follow.
 """
 
 from __future__ import annotations
@@ -55,6 +58,7 @@ def joint_column(
     width: float,
     block_height: float,
     h: float,
+    fitted: bool = True,
 ) -> None:
     """Build and mesh the two-block column [0, width] x [0, 2 H] in ``model`` (a gmsh builder).
 
@@ -63,6 +67,7 @@ def joint_column(
         width: Width of the column and length of the joint (length).
         block_height: Height H of each block; the joint is the line y = H (length).
         h: Element size (length).
+        fitted: Whether the mesh follows the joint (False: one rectangle, no ``JOINT``).
 
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
@@ -72,11 +77,15 @@ def joint_column(
 
     height = 2.0 * block_height
     surface = model.occ.addRectangle(0.0, 0.0, 0.0, width, height)
-    line = model.occ.addLine(
-        model.occ.addPoint(0.0, block_height, 0.0), model.occ.addPoint(width, block_height, 0.0)
-    )
-    # The column comes out as the two blocks; children[1] is the joint line's image.
-    _, children = model.occ.fragment([(2, surface)], [(1, line)])
+    interior = None
+    if fitted:
+        line = model.occ.addLine(
+            model.occ.addPoint(0.0, block_height, 0.0),
+            model.occ.addPoint(width, block_height, 0.0),
+        )
+        # The column comes out as the two blocks; children[1] is the joint line's image.
+        _, children = model.occ.fragment([(2, surface)], [(1, line)])
+        interior = {JointColumnFacets.JOINT: [tag for _, tag in children[1]]}
     model.occ.synchronize()
     add_physical_groups(
         model,
@@ -87,7 +96,7 @@ def joint_column(
             JointColumnFacets.TOP: (1, height),
             JointColumnFacets.LEFT: (0, 0.0),
         },
-        interior={JointColumnFacets.JOINT: [tag for _, tag in children[1]]},
+        interior=interior,
     )
 
     # Uniform size: size_min == size_max makes the distance irrelevant.

@@ -366,16 +366,18 @@ class CutSurface(InterfaceSurface):
     #: the first component of this crack's enrichment in U = (u, a_1, ..., a_K)
     first: int = 2
 
-    def _jump(self, X):
+    def jump(self, X):
+        """[[w]] = 2 a at the crack's Gauss points, for X = (u, a_1, ...) (the unknown, its
+        test or trial function)."""
         return 2.0 * self.at_crack(ufl.as_vector([X[self.first + i] for i in range(2)]))
 
     @property
     def u(self):
-        return self._jump(self.w)
+        return self.jump(self.w)
 
     @property
     def v(self):
-        return self._jump(self.v_total)
+        return self.jump(self.v_total)
 
     @property
     def h(self):
@@ -399,7 +401,7 @@ class CutSurface(InterfaceSurface):
         return self.H
 
     def opening(self, w=None):
-        jump = self.u if w is None else self._jump(w)
+        jump = self.u if w is None else self.jump(w)
         return ufl.dot(jump, self.interface_normal())
 
     def tip_extended(self):
@@ -416,4 +418,4 @@ class CutSurface(InterfaceSurface):
     def slip_increment(self, n):
         if self.u_prev is None:
             raise ValueError("the slip increment needs the previous state (friction only)")
-        return tangential(self.u - self._jump(self.u_prev), n)
+        return tangential(self.u - self.jump(self.u_prev), n)

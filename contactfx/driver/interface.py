@@ -234,25 +234,32 @@ class InterfaceProblem(Problem):
         the next iterations. Multipliers start at that state's traction."""
         self.apply_load(1.0 / self.num.steps)
         solver.assemble_load()
-        joint, s = self.scene.joint(), self.surface
+        joint = self.scene.joint()
         spring = None
         if joint is not None:
-            n_I = s.interface_normal()
-            jd = oriented_jump(self.dw, self.H)
-            k_t = self.scene.contact_modulus() / s.h
-            spring = dolfinx.fem.form(
-                (joint.Kni * ufl.dot(jd, n_I) * ufl.dot(s.v, n_I)
-                 + k_t * ufl.dot(tangential(jd, n_I), s.v)) * self.dSc
-            )  # fmt: skip
+            spring = dolfinx.fem.form(sum(
+                self._spring(joint, s, jump, ds) for s, jump, ds in self._trial_jumps()))  # fmt: skip
         n_owned = owned_size(self.state.function_space)
         free = np.zeros(n_owned, dtype=bool)
-        for i in range(self.gdim if spring is None else 2 * self.gdim):
+        for i in range(self.gdim * (1 if spring is None else self.components_per_dim)):
             parent = np.asarray(self.V.sub(i).collapse()[1])
             free[parent[parent < n_owned]] = True
         solver.solve_linear(free, spring)
         if self.lam is not None:
             self._start_multiplier()
         self._tolerances(solver)
+
+    def _spring(self, joint, s, jump, ds):
+        """The joint held by its initial normal stiffness K_ni and tangentially by E / h:
+        the start's bilinear form on the surface s, for the trial function's jump."""
+        n_I = s.interface_normal()
+        k_t = self.scene.contact_modulus() / s.h
+        return (joint.Kni * ufl.dot(jump, n_I) * ufl.dot(s.v, n_I)
+                + k_t * ufl.dot(tangential(jump, n_I), s.v)) * ds  # fmt: skip
+
+    def _trial_jumps(self) -> list:
+        """(surface, the trial function's jump on it, its measure) of every interface."""
+        return [(self.surface, oriented_jump(self.dw, self.H), self.dSc)]
 
     def _start_multiplier(self) -> None:
         def start(s):

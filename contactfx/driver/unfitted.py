@@ -102,9 +102,10 @@ class _Crack:
         h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
         if not np.isfinite(h):
             raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
-        for tip in crack.tips():
-            if _compat.PointLocator(mesh, np.asarray([tip])).outside[0]:
-                raise ValueError(f"the crack tip {tip} lies outside the mesh")
+        #: a tip outside the mesh: the crack runs to the boundary (through the body, or an
+        #: edge crack), and the enrichment reaches the boundary's nodes there
+        self.exits = any(_compat.PointLocator(mesh, np.asarray([tip])).outside[0]
+                         for tip in crack.tips())  # fmt: skip
         # every tip moved onto the boundary of the cell holding it (the same on every rank:
         # from the ranks that hold that cell)
         psi = np.array(comm.allgather(snapped_tips(X, crack, SNAP * h)))
@@ -124,6 +125,8 @@ class _Crack:
         self.fraction.x.array[c0] = cells.fraction
         self.H = dolfinx.fem.Function(DG0, name="side")
         self.H.x.array[c0] = np.where(cells.fraction >= 0.5, 1.0, -1.0)
+        self.is_cut = dolfinx.fem.Function(DG0)
+        self.is_cut.x.array[c0] = cells.cut
         Qs = _compat.quadrature_space(mesh, QUADRATURE_DEGREE)
         qd = _compat.cell_dofs(Qs)
         self.Y = [dolfinx.fem.Function(Qs) for _ in range(2)]
@@ -154,6 +157,13 @@ class _Crack:
         self.grid = CoarseGrid(np.concatenate([g[0] for g in gathered]),
                                np.concatenate([g[1] for g in gathered]), GRID_FACTOR)  # fmt: skip
 
+    def side(self, x):
+        """The side (+1 / -1) of the points x (UFL): the crack's level set's sign in its cut
+        cells, elsewhere the cell's side."""
+        c, n = self.true.centre, self.true.normal
+        phi = (x[0] - c[0]) * n[0] + (x[1] - c[1]) * n[1]
+        return ufl.conditional(ufl.gt(self.is_cut, 0.5), ufl.sign(phi), self.H)
+
     def enrichment(self, X):
         """Its enrichment field in the unknown (or test function) X."""
         return ufl.as_vector([X[self.first + i] for i in range(2)])
@@ -179,8 +189,6 @@ class UnfittedProblem(InterfaceProblem):
                              "cut cells); use nitsche, penalty or al-uzawa")  # fmt: skip
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
-        if scene.joint() is not None:
-            raise ValueError("joint closure is not implemented on unfitted cracks")
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
         tdim = mesh.topology.dim
@@ -295,6 +303,14 @@ class UnfittedProblem(InterfaceProblem):
         u = ufl.as_vector([X[i] for i in range(d)])
         return u + sum((c.H * c.enrichment(X) for c in self.cracks), ufl.zero(d))
 
+    def boundary_total(self, X):
+        """w = u + sum_k H_k a_k with each H_k the side of the point (:meth:`_Crack.side`): on
+        a boundary facet that a crack crosses, the load and the boundary's quantities see
+        each part's own side."""
+        d, x = self.gdim, ufl.SpatialCoordinate(self.mesh)
+        u = ufl.as_vector([X[i] for i in range(d)])
+        return u + sum((c.side(x) * c.enrichment(X) for c in self.cracks), ufl.zero(d))
+
     def enrichments(self) -> list:
         return [(c.first, functools.partial(self._enriched, c)) for c in self.cracks]
 
@@ -316,7 +332,7 @@ class UnfittedProblem(InterfaceProblem):
         outer = _compat.locate_dofs_topological(
             Q, fdim, dolfinx.mesh.exterior_facet_indices(mesh.topology)
         )
-        if mesh.comm.allreduce(bool(np.any(enriched[outer])), op=MPI.LOR):
+        if not crack.exits and mesh.comm.allreduce(bool(np.any(enriched[outer])), op=MPI.LOR):
             raise ValueError(
                 "the crack is closer to the boundary than a cell (a cut cell's "
                 "node lies on the boundary); move it inwards or refine"
@@ -337,7 +353,8 @@ class UnfittedProblem(InterfaceProblem):
     def make_surface(self) -> CutSurface:
         """The surface of each crack (``surfaces``); the first is the kind's ``surface``."""
         mesh, scene = self.mesh, self.scene
-        self.w, self.dw, self.v_load = (self.total(X) for X in (self.U, self.dU, self.V_test))
+        self.w, self.dw = self.total(self.U), self.total(self.dU)
+        self.v_load = self.boundary_total(self.V_test)
         x = ufl.SpatialCoordinate(mesh)
         rule = {"quadrature_degree": QUADRATURE_DEGREE, "quadrature_rule": "default"}
         dx = ufl.Measure("dx", domain=mesh, subdomain_data=self.cut_tags)
@@ -360,7 +377,7 @@ class UnfittedProblem(InterfaceProblem):
                 self.U, self.V_test, ufl.as_vector([float(v) for v in crack.true.normal]),
                 crack.ds, self._mean_stress(self.U), self._mean_stress(self.V_test),
                 scene.contact_modulus(), crack.h_cut, floor=scene.floor(crack.s_coord),
-                fluid=self.fluid, friction=self.friction,
+                fluid=self.fluid, friction=self.friction, joint=scene.joint(),
                 u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
                 at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
                 multiplier=self.multiplier,
@@ -370,6 +387,9 @@ class UnfittedProblem(InterfaceProblem):
         self.dSc = self.dS_fine = first.ds
         self.s_coord = first.s_coord
         return self.surfaces[0]
+
+    def _trial_jumps(self) -> list:
+        return [(s, s.jump(self.dU), s.ds) for s in self.surfaces]
 
     def contact_residual(self):
         return sum(self.method.residual(self.newton_surface(s)) for s in self.surfaces)
@@ -416,14 +436,15 @@ class CutPost(InterfacePost):
     def __init__(self, pb) -> None:
         self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
         mesh, method = pb.mesh, pb.method
-        self.w0 = 0.0
+        joint = pb.surface.joint
+        self.w0 = 0.0 if joint is None else joint.w0  # the aperture's opening at zero jump
         points = pb.rule[0]
         self.exprs = []
         forms = {"force": 0, "closed": 0, "tangential": 0, "propped": 0, "slipping": 0}
         for crack, s in zip(pb.cracks, pb.surfaces, strict=True):
             t_I = tangent(s.interface_normal())
             p = method.pressure(s)
-            quantities = {"aperture": s.opening(), "slip": ufl.dot(s.u, t_I),
+            quantities = {"aperture": s.opening() + self.w0, "slip": ufl.dot(s.u, t_I),
                           "normal_traction": p, "gap": s.gap(), "x": crack.Y[0],
                           "y": crack.Y[1]}  # fmt: skip
             forms["force"] += p * s.ds
@@ -448,7 +469,8 @@ class CutPost(InterfacePost):
         if s.floor is not None:
             self.propped_form = dolfinx.fem.form(forms["propped"])
         self.err_forms = self._error_forms(s, method.pressure(s), tangent(s.interface_normal()))
-        self.extra = {}
+        self.extra = {k: dolfinx.fem.form(v) for k, v in self.scene.extra_quantities(
+            mesh, pb.boundary_total(pb.U), pb.ds).items()}  # fmt: skip
         if s.friction is not None:  # the slipping length
             self.extra["slipping_size"] = dolfinx.fem.form(forms["slipping"])
         DG0 = _compat.function_space(mesh, "DG", 0)
@@ -525,7 +547,7 @@ class CutPost(InterfacePost):
         def col(name):
             return v[name] if name in v else np.zeros(len(v["s"]))
 
-        local = np.column_stack([v["s"], x, col("aperture"), col("slip"), col("normal_traction"),
+        local = np.column_stack([v["s"], x, col("aperture") - self.w0, col("slip"), col("normal_traction"),
                                  col("tangential_traction"), col("status"), col("proppant"),
                                  v["crack"]])  # fmt: skip
         parts = self.comm.gather(local, root=0)

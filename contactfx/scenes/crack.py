@@ -35,9 +35,7 @@ import ufl
 from contactfx import references as cf
 from contactfx._compat import numpy_math, ufl_math
 from contactfx.contact.cut import CrackSegment
-from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, Profile
-from contactfx.driver.unfitted import UnfittedProblem
 from contactfx.meshes import CrackPlateFacets, crack_plate, crack_set_plate, structured_plate
 from contactfx.params import param
 from contactfx.scenes import export
@@ -146,11 +144,6 @@ class _CrackPlate(InterfaceScene):
 
     def split_points(self) -> tuple[float, ...]:
         return ()
-
-    @property
-    def problem(self):
-        """The fitted-interface kind, or with ``--crack unfitted`` the unfitted crack's."""
-        return UnfittedProblem if self.p.crack == "unfitted" else InterfaceProblem
 
     def crack_segments(self) -> list[CrackSegment]:
         """The crack as a segment (tip to tip), for ``--crack unfitted``."""
@@ -264,11 +257,7 @@ class _CrackPlate(InterfaceScene):
     def problem_data(self, numerics) -> dict:
         """The plate with its boundary stress on the four edges (traction sigma n, the same
         degree-8 rule), the pinned corners, and the crack with the scene's frame and h."""
-        if self.p.crack == "unfitted":
-            raise ValueError(
-                f"scene '{self.name}' with --crack unfitted cannot be written as a "
-                "problem file: problem files carry fitted interfaces only"
-            )
+        self._fitted_only()
         stress = self._boundary_stress_text()
         boundary = []
         if any(v != 0.0 for row in stress for v in row):

@@ -10,6 +10,7 @@ import numpy as np
 from contactfx.contact.interface import BartonBandis
 from contactfx.driver.fields import near_points
 from contactfx.driver.interface import InterfaceProblem
+from contactfx.driver.unfitted import UnfittedProblem
 from contactfx.scenes.base import Scene
 
 __all__ = ["InterfaceScene"]
@@ -19,8 +20,23 @@ class InterfaceScene(Scene):
     """Base of the fitted-interface scenes. Subclasses give the mesh, the interface (tag, sides,
     tips, frame), the supports and loads, and the closed-form references."""
 
-    problem = InterfaceProblem
     interface_tag: ClassVar[int]
+
+    @property
+    def problem(self):
+        """The fitted-interface kind, or with ``--crack unfitted`` (the scenes that have that
+        parameter) the unfitted crack's."""
+        if getattr(self.p, "crack", "fitted") == "unfitted":
+            return UnfittedProblem
+        return InterfaceProblem
+
+    def _fitted_only(self) -> None:
+        """Raise for ``--crack unfitted``: problem files carry fitted interfaces only."""
+        if self.problem is UnfittedProblem:
+            raise ValueError(
+                f"scene '{self.name}' with --crack unfitted cannot be written as a "
+                "problem file: problem files carry fitted interfaces only"
+            )
 
     def dimension(self) -> int:
         """The space dimension of the scene's mesh (2: plane strain)."""

@@ -7,6 +7,12 @@ effective stress s' = s_c - p by the Barton-Bandis law (Bandis, Lumsden & Barton
 doi:10.1016/0148-9062(83)90595-8): v = s' V_m / (K_ni V_m + s'), aperture w = w0 - v; the top
 settles by 2 H s_c / M + v. The solution is uniform in each block, so every mesh and method
 reproduces it to the solver tolerance (docs/verification.md section 7).
+
+With ``--crack unfitted`` the joint is a level set y = H + offset on a mesh of the column that
+ignores it (:class:`contactfx.driver.unfitted.UnfittedProblem`): a crack through the column,
+from one lateral side to the other. The exact solution (uniform stress, a uniform jump) is in
+the enriched P1 space for any offset, so the unfitted joint too reproduces it to the solver
+tolerance (docs/verification.md section 14).
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from contactfx import references as cf
+from contactfx.contact.cut import CrackSegment
 from contactfx.contact.interface import BartonBandis
 from contactfx.meshes import JointColumnFacets, joint_column
 from contactfx.params import param
@@ -38,9 +45,20 @@ class JointColumnParams(elastic(10e9, 0.25)):
                        positive=True)  # fmt: skip
     Vm: float = param(3e-4, "maximal closure V_m", positive=True)
     h: float = param(0.25, "element size", positive=True)
+    crack: str = param("fitted", "the joint: fitted (a chain of mesh edges) or unfitted (a level "
+                       "set on a mesh of the column that ignores it)",
+                       choices=("fitted", "unfitted"))  # fmt: skip
+    joint_offset: float = param(0.0, "the unfitted joint's height above H (its position "
+                                "against the mesh's nodes)")  # fmt: skip
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        if self.crack == "fitted" and self.joint_offset != 0.0:
+            raise ValueError("--joint-offset needs --crack unfitted")
+        if not abs(self.joint_offset) < self.block_height - self.h:
+            raise ValueError(f"--joint-offset ({self.joint_offset:g}) must leave a cell between "
+                             f"the joint and the column's ends (|offset| < block-height - h = "
+                             f"{self.block_height - self.h:g})")  # fmt: skip
         if self.Vm > self.aperture:
             raise ValueError(f"--Vm ({self.Vm}) must be <= --aperture ({self.aperture})")
         if self.fluid_pressure > self.closure_stress:
@@ -58,12 +76,20 @@ class JointColumn(InterfaceScene):
     def mesh_builder(self):
         p = self.p
         return functools.partial(joint_column, width=p.width, block_height=p.block_height,
-                                 h=p.h), 2  # fmt: skip
+                                 h=p.h, fitted=p.crack == "fitted"), 2  # fmt: skip
+
+    def crack_segments(self) -> list[CrackSegment]:
+        """The unfitted joint: the line y = H + offset, its ends a width beyond the column's
+        sides (a crack through the column)."""
+        p = self.p
+        y = p.block_height + p.joint_offset
+        return [CrackSegment((-p.width, y), (2.0 * p.width, y))]
 
     def problem_data(self, numerics) -> dict:
         """Rollers, the compression on the top as a traction, the joint with the scene's
         frame, h, fluid pressure and Barton-Bandis law; the top's mean settlement."""
         p = self.p
+        self._fitted_only()
         origin, direction = self.frame()
         F = JointColumnFacets
         return {

@@ -105,6 +105,11 @@ def _interface_cases():
         ),
         ("crack-set", CrackSet(CrackSet.Params()), {"method": "nitsche"}),
         (
+            "joint-unfitted",
+            JointColumn(JointColumn.Params(crack="unfitted", joint_offset=0.0123, h=0.1)),
+            {"method": "al-uzawa", "friction": "coulomb"},
+        ),
+        (
             "penny-nitsche",
             PennyCrack(PennyCrack.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
             {"method": "nitsche", "degree": 2},
