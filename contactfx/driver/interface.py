@@ -237,8 +237,8 @@ class InterfaceProblem(Problem):
         joint = self.scene.joint()
         spring = None
         if joint is not None:
-            spring = dolfinx.fem.form(sum(
-                self._spring(joint, s, jump, ds) for s, jump, ds in self._trial_jumps()))  # fmt: skip
+            terms = [self._spring(joint, s, jump, ds) for s, jump, ds in self._trial_jumps()]
+            spring = dolfinx.fem.form(sum(terms))
         n_owned = owned_size(self.state.function_space)
         free = np.zeros(n_owned, dtype=bool)
         for i in range(self.gdim * (1 if spring is None else self.components_per_dim)):

@@ -547,7 +547,8 @@ class CutPost(InterfacePost):
         def col(name):
             return v[name] if name in v else np.zeros(len(v["s"]))
 
-        local = np.column_stack([v["s"], x, col("aperture") - self.w0, col("slip"), col("normal_traction"),
+        opening = col("aperture") - self.w0
+        local = np.column_stack([v["s"], x, opening, col("slip"), col("normal_traction"),
                                  col("tangential_traction"), col("status"), col("proppant"),
                                  v["crack"]])  # fmt: skip
         parts = self.comm.gather(local, root=0)
