@@ -189,10 +189,22 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     def slip_indicator(self, s: Surface):
         return self._slip(s)
 
+    def projected_law(self, s: Surface):
+        """The augmented traction the multiplier equals at a solution: p (scalar multiplier)
+        or -p n + T (traction): the law whose projection onto a multiplier space the driver
+        writes as the multiplier's equation where the multiplier has no nodal collocation
+        (``s.ds_nodal`` None: an unfitted crack, :mod:`contactfx.driver.unfitted`)."""
+        p, _, t_T = self._augmented(s)
+        return p if t_T is None else -p * s.normal() + t_T
+
     def residual(self, s: Surface):
         n = s.normal()
         lam, mu = s.multiplier, s.multiplier_test
         lam_n, lam_t = split_multiplier(lam, n)
+        if s.ds_nodal is None:  # the u-equation only (see projected_law)
+            if lam_t is None:
+                return lam * ufl.dot(s.v, n) * s.ds
+            return -ufl.dot(lam, s.v) * s.ds
         r = self.r(s)
         p, _, t_T = self._augmented(s)
         if self.ncp == "min":

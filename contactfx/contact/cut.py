@@ -311,7 +311,7 @@ class CoarseGrid:
                 nodes.append(psi[-1])
         self.nodes = np.asarray(nodes)
 
-    def _hats(self, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def hats(self, psi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(left node, weight of the right node) of the points psi (clipped to the grid)."""
         x = np.clip(psi, self.nodes[0], self.nodes[-1])
         i = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, len(self.nodes) - 2)
@@ -321,7 +321,7 @@ class CoarseGrid:
         """(int phi_j v, int phi_j) of the grid's hat functions phi_j against the values
         (points, components) at the points psi with the quadrature weights: one rank's part
         of the lumped L2 projection (sum them over the ranks, then divide)."""
-        i, t = self._hats(psi)
+        i, t = self.hats(psi)
         n = len(self.nodes)
         num = np.zeros((n, values.shape[1]))
         den = np.zeros(n)
@@ -332,7 +332,7 @@ class CoarseGrid:
 
     def evaluate(self, psi: np.ndarray, nodal: np.ndarray) -> np.ndarray:
         """The piecewise linear field of ``nodal`` (nodes, components) at the points psi."""
-        i, t = self._hats(psi)
+        i, t = self.hats(psi)
         return (1.0 - t)[:, None] * nodal[i] + t[:, None] * nodal[i + 1]
 
 

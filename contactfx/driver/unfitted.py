@@ -54,7 +54,8 @@ from contactfx.contact.cut import (
 )
 from contactfx.contact.interface import tangent
 from contactfx.contact.laws import active
-from contactfx.driver.fields import global_sum, nodal_contact
+from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
+from contactfx.driver.grid_multiplier import GridMultiplier, crack_nodes
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, InterfacePost, Profile
 from contactfx.driver.problem import Problem
@@ -183,10 +184,9 @@ class UnfittedProblem(InterfaceProblem):
         if numerics.degree != 1:
             raise ValueError("unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                              "integration is exact for constant strains only")  # fmt: skip
-        if method.multiplier == "field":
-            raise ValueError(f"method {method.name} is not implemented on unfitted cracks "
-                             "(its multiplier field would need a finite element space on the "
-                             "cut cells); use nitsche, penalty or al-uzawa")  # fmt: skip
+        if method.multiplier == "field" and getattr(method, "ncp", "min") != "min":
+            raise ValueError("al-ssn on unfitted cracks projects its multiplier's law (--ncp "
+                             "min); the Fischer-Burmeister function is not a projection")  # fmt: skip
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
 
@@ -229,12 +229,40 @@ class UnfittedProblem(InterfaceProblem):
     @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
         """The points of the cut cells (every crack's)."""
-        Q = self.multiplier.function_space
-        dofs = _compat.cell_dofs(Q)
-        mask = np.zeros(Q.dofmap.index_map.size_local + Q.dofmap.index_map.num_ghosts, bool)
-        for c in self.cracks:
-            mask[dofs[c.cut].ravel()] = True
-        return mask
+        return self._on_cracks(self.multiplier.function_space)
+
+    def _on_cracks(self, Q) -> np.ndarray:
+        """The dofs of the space Q on the cut cells of every crack."""
+        return np.any([crack_nodes(c, Q) for c in self.cracks], axis=0)
+
+    def confine_multiplier(self, supports=()) -> list:
+        """al-ssn's multiplier lives on the nodes of the cracks' cut cells."""
+        if self.method.multiplier != "field":
+            return []
+        return self.confine(self.state.function_space.sub(1), self._on_cracks)
+
+    @functools.cache  # noqa: B019 (one problem, one coupling)
+    def coupling(self):
+        """al-ssn: its multiplier's equations (:class:`contactfx.driver.grid_multiplier.
+        GridMultiplier`); no coupling for the other methods."""
+        if self.method.multiplier != "field":
+            return None
+        return GridMultiplier(self, self.method.projected_law)
+
+    def _start_multiplier(self) -> None:
+        """al-ssn: the projection of the start's traction; al-uzawa: as a fitted crack's."""
+        if self.method.multiplier != "field":
+            return super()._start_multiplier()
+        coupling = self.coupling()
+
+        def start(s):
+            if self.mult_shape:
+                return ufl.dot(s.stress, s.normal())
+            return ufl.max_value(s.effective_pressure(), 0.0)
+
+        vec = _compat.petsc_vec(self.state)
+        vec.getArray()[coupling.rows] = coupling.project(start)
+        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     def surface_update(self, law):
         """The filler of al-uzawa's multiplier: ``law(s)`` on each crack's surface s projected
@@ -380,7 +408,7 @@ class UnfittedProblem(InterfaceProblem):
                 fluid=self.fluid, friction=self.friction, joint=scene.joint(),
                 u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
                 at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
-                multiplier=self.multiplier,
+                multiplier=self._multiplier_at(at_crack),
                 h_nodal=self._nodal_size(),
             ))  # fmt: skip
         first = self.cracks[0]
@@ -390,6 +418,13 @@ class UnfittedProblem(InterfaceProblem):
 
     def _trial_jumps(self) -> list:
         return [(s, s.jump(self.dU), s.ds) for s in self.surfaces]
+
+    def _multiplier_at(self, at_crack):
+        """al-uzawa's multiplier (values at the points), al-ssn's P1 field at the crack's
+        points, or None."""
+        if self.multiplier is not None or self.lam is None:
+            return self.multiplier
+        return at_crack(self.lam)
 
     def contact_residual(self):
         return sum(self.method.residual(self.newton_surface(s)) for s in self.surfaces)
@@ -423,7 +458,11 @@ class UnfittedProblem(InterfaceProblem):
             m = 2.0 * c.fraction - 1.0
             form += (1.0 - m * m) * ufl.inner(sigma(c.enrichment(self.dU)),
                                               eps(c.enrichment(self.V_test)))  # fmt: skip
-        return form * ufl.dx
+        if not self.split:
+            return form * ufl.dx
+        # a multiplier field: the pattern of its couplings with the cells' dofs
+        return form * ufl.dx + zero_pattern(self.mesh, self.trial, self.test,
+                                            [(ufl.dx, lambda f: f)])  # fmt: skip
 
     def post_processor(self) -> CutPost:
         return CutPost(self)
