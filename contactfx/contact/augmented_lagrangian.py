@@ -176,9 +176,13 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     )  # fmt: skip
 
     def pressure(self, s: Surface):
+        if s.ds_nodal is None:  # a projected multiplier (projected_law)
+            return self._augmented(s)[0]
         return split_multiplier(s.multiplier, s.normal())[0]
 
     def tangential_traction(self, s: Surface):
+        if s.ds_nodal is None:
+            return self._augmented(s)[2]
         return split_multiplier(s.multiplier, s.normal())[1]
 
     def contact_indicator(self, s: Surface):
@@ -189,11 +193,22 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     def slip_indicator(self, s: Surface):
         return self._slip(s)
 
+    def law_surface(self, s: Surface):
+        """A projected multiplier (``s.ds_nodal`` None): the law reads the surface as
+        al-uzawa's does (its motion at each unfitted piece's midpoint, ``tip_extended``)."""
+        return s.tip_extended() if s.ds_nodal is None else s
+
     def projected_law(self, s: Surface):
-        """The augmented traction the multiplier equals at a solution: p (scalar multiplier)
-        or -p n + T (traction): the law whose projection onto a multiplier space the driver
-        writes as the multiplier's equation where the multiplier has no nodal collocation
-        (``s.ds_nodal`` None: an unfitted crack, :mod:`contactfx.driver.unfitted`)."""
+        """The augmented traction p (scalar multiplier) or -p n + T (traction).
+
+        Where the multiplier has no nodal collocation (``s.ds_nodal`` None: an unfitted
+        crack, :mod:`contactfx.driver.unfitted`), the driver writes the multiplier's equation
+        as lambda = the projection of this law onto a coarser multiplier space, and the faces
+        carry the augmented traction itself (``pressure``, ``tangential_traction``, the
+        u-equation): al-uzawa's fixed point (lambda the projection of the augmented traction
+        it produces), solved by Newton for u and lambda together. The faces carrying lambda
+        instead would see only the coarse field, and the traction where it jumps (a proppant
+        zone's ends) would be spread over a coarse element."""
         p, _, t_T = self._augmented(s)
         return p if t_T is None else -p * s.normal() + t_T
 
@@ -203,8 +218,8 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         lam_n, lam_t = split_multiplier(lam, n)
         if s.ds_nodal is None:  # the u-equation only (see projected_law)
             if lam_t is None:
-                return lam * ufl.dot(s.v, n) * s.ds
-            return -ufl.dot(lam, s.v) * s.ds
+                return self.projected_law(s) * ufl.dot(s.v, n) * s.ds
+            return -ufl.dot(self.projected_law(s), s.v) * s.ds
         r = self.r(s)
         p, _, t_T = self._augmented(s)
         if self.ncp == "min":

@@ -39,11 +39,15 @@ __all__ = ["GridMultiplier", "crack_nodes"]
 
 
 def crack_nodes(crack, Q) -> np.ndarray:
-    """Bool mask of the local (block) dofs of the P1 space Q on the crack's cut cells."""
-    n = Q.dofmap.index_map.size_local + Q.dofmap.index_map.num_ghosts
-    mask = np.zeros(n, dtype=bool)
-    mask[_compat.cell_dofs(Q)[crack.cut].ravel()] = True
-    return mask
+    """Bool mask of the local (block) dofs of the space Q on the crack's cut cells, on every
+    rank's cut cells (a node's cut cell may be neither owned nor a ghost where the node is)."""
+    f = dolfinx.fem.Function(Q)
+    bs = Q.dofmap.index_map_bs
+    f.x.array.reshape(-1, bs)[_compat.cell_dofs(Q)[crack.cut_owned].ravel()] = 1.0
+    vec = _compat.petsc_vec(f)
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    return f.x.array.reshape(-1, bs)[:, 0] > 0.0
 
 
 class GridMultiplier:

@@ -185,8 +185,10 @@ class UnfittedProblem(InterfaceProblem):
             raise ValueError("unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                              "integration is exact for constant strains only")  # fmt: skip
         if method.multiplier == "field" and getattr(method, "ncp", "min") != "min":
-            raise ValueError("al-ssn on unfitted cracks projects its multiplier's law (--ncp "
-                             "min); the Fischer-Burmeister function is not a projection")  # fmt: skip
+            raise ValueError(
+                "al-ssn on unfitted cracks projects its multiplier's law (--ncp min); the "
+                "Fischer-Burmeister function is not a projection"
+            )
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
 

@@ -99,6 +99,11 @@ def _interface_cases():
             {"method": "al-uzawa", "mu": 0.3},
         ),
         (
+            "inclined-unfitted-al-ssn",
+            CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")),
+            {"method": "al-ssn", "mu": 0.3},
+        ),
+        (
             "propped-unfitted",
             ProppedFracture(ProppedFracture.Params(crack="unfitted")),
             {"method": "nitsche", "theta": 0},
