@@ -123,7 +123,8 @@ class GridMultiplier:
                         if a > 0.0 and den[j] > 0.0:
                             k = by_node[j]
                             entries.setdefault(int(row), []).append(
-                                (q_of[k] * bs + c, a / den[j] * n_q[k]))
+                                (q_of[k] * bs + c, a / den[j] * n_q[k])
+                            )
         rows = np.array(sorted(entries), dtype=np.int32)
         indptr, indices, values = [0], [], []
         for row in range(self.n_owned):
