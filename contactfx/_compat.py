@@ -227,6 +227,18 @@ def cell_coordinates(mesh) -> np.ndarray:
     return mesh.geometry.x[dofmap][:, :, : mesh.geometry.dim]
 
 
+def entity_coordinates(mesh, dim: int, entities: np.ndarray) -> np.ndarray:
+    """(entities, nodes per entity, gdim): the coordinates of the entities' geometry nodes."""
+    entities = np.asarray(entities, dtype=np.int32)
+    if _NEW:
+        nodes = dolfinx.mesh.entities_to_geometry(mesh, dim, entities, False)
+    else:
+        # (Debian's 0.5 wraps the C++ mesh in ``_mesh``; upstream's Mesh is the C++ one)
+        cpp = getattr(mesh, "_mesh", mesh)
+        nodes = dolfinx.cpp.mesh.entities_to_geometry(cpp, dim, entities, False)
+    return mesh.geometry.x[nodes][:, :, : mesh.geometry.dim]
+
+
 # Math namespaces (sqrt, atan2, cos, sin) for closed forms written once for numpy arrays and UFL
 # expressions (contactfx.references). numpy < 2 has no atan2 alias, UFL < 2023 names it atan_2.
 numpy_math = SimpleNamespace(sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin,

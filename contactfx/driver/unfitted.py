@@ -100,7 +100,8 @@ class _Crack:
         comm = mesh.comm
         self.true, self.first = crack, first
         near = near_cells(X, crack)
-        h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
+        self.h = h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)),
+                                    op=MPI.MIN)  # fmt: skip
         if not np.isfinite(h):
             raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
         #: a tip outside the mesh: the crack runs to the boundary (through the body, or an
@@ -413,10 +414,37 @@ class UnfittedProblem(InterfaceProblem):
                 multiplier=self._multiplier_at(at_crack),
                 h_nodal=self._nodal_size(),
             ))  # fmt: skip
+        self._refuse_loaded_crossings()
         first = self.cracks[0]
         self.dSc = self.dS_fine = first.ds
         self.s_coord = first.s_coord
         return self.surfaces[0]
+
+    def _refuse_loaded_crossings(self) -> None:
+        """Raise if a crack crosses a boundary facet that carries a load: the load on that
+        facet would have to be split at the crossing between the two sides' enrichment, which
+        the facet rule does not do (the supports and a load-free boundary need no split)."""
+        mesh, fdim = self.mesh, self.fdim
+        tags = self.facet_tags
+        crossed = np.zeros(len(tags.indices), dtype=bool)
+        if len(tags.indices):
+            ends = _compat.entity_coordinates(mesh, fdim, tags.indices)
+            for crack in self.cracks:
+                phi = crack.true.phi(ends)
+                phi = np.where(np.abs(phi) < SNAP * crack.h, 0.0, phi)
+                crossed |= phi[:, 0] * phi[:, 1] < 0.0
+        cut = dolfinx.mesh.meshtags(mesh, fdim, tags.indices[crossed], tags.values[crossed])
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=cut)
+        load = self.scene.load(self.v_load, ds, dolfinx.fem.Constant(mesh, 1.0))
+        if load is None:
+            return
+        form = dolfinx.fem.form(load)
+        b = _compat.assemble_vector(_compat.create_vector(form), form)
+        loaded = b.norm() > 0.0
+        b.destroy()
+        if loaded:
+            raise ValueError("a crack crosses a loaded boundary (the load would have to be "
+                             "split at the crossing); move the crack or hold that boundary")  # fmt: skip
 
     def _trial_jumps(self) -> list:
         return [(s, s.jump(self.dU), s.ds) for s in self.surfaces]

@@ -248,6 +248,20 @@ def test_unfitted_joint_column_is_exact(numerics, offset):
     assert data.force == pytest.approx((30e6 - 10e6) * 0.5, rel=1e-6)
 
 
+def test_unfitted_crack_across_a_loaded_boundary_is_refused():
+    """A vertical crack through the column's loaded top: its load would have to be split
+    between the two sides at the crossing; refused (the horizontal joint above crosses the
+    rollers only)."""
+
+    class Vertical(JointColumn):
+        def crack_segments(self):
+            return [CrackSegment((0.26, -1.0), (0.26, 3.0))]
+
+    scene = Vertical(JointColumn.Params(crack="unfitted", h=0.25))
+    with pytest.raises(ValueError, match="crosses a loaded boundary"):
+        _run(scene, method="nitsche")
+
+
 #: the crack's offset from the node line y = 0 of the structured mesh, in cells: along the
 #: edges, 1e-6 of a cell off them (snapped onto them), and 0.4 of a cell off (cutting cells)
 OFFSETS = (0.0, 1e-6, 0.4)
