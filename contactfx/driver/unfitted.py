@@ -443,8 +443,10 @@ class UnfittedProblem(InterfaceProblem):
         loaded = b.norm() > 0.0
         b.destroy()
         if loaded:
-            raise ValueError("a crack crosses a loaded boundary (the load would have to be "
-                             "split at the crossing); move the crack or hold that boundary")  # fmt: skip
+            raise ValueError(
+                "a crack crosses a loaded boundary (the load would have to be split at the "
+                "crossing); move the crack or hold that boundary"
+            )
 
     def _trial_jumps(self) -> list:
         return [(s, s.jump(self.dU), s.ds) for s in self.surfaces]
