@@ -41,16 +41,6 @@ from contactfx.solvers.snes import owned_size
 __all__ = ["InterfaceProblem"]
 
 
-def _check_front(dim: int, method) -> None:
-    """Methods continued over the tips' elements (the penalties, the augmented Lagrangian
-    ones: ``_tip_terms``) are written for the point tips of 2D cracks."""
-    if dim == 3 and (method.tip_continued or method.multiplier != "none"):
-        raise ValueError(
-            f"method {method.name} is not implemented on a 3D crack front (its tip "
-            "continuation is written for 2D tips); use nitsche"
-        )
-
-
 class InterfaceProblem(Problem):
     """A body with a fitted interface (see the module docstring)."""
 
@@ -68,14 +58,19 @@ class InterfaceProblem(Problem):
             )
         if numerics.formulation != "displacement":
             raise ValueError("fitted interfaces use --formulation displacement")
-        _check_front(scene.dimension(), method)
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
-        _check_front(mesh.geometry.dim, method)  # the mesh's, whatever the scene says
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.interface_tag]
         self.tol = 1e-9 * scene.length_scale()  # of point location
         self.tips = [(np.asarray(t, dtype=float), self.tol) for t in scene.tips()]
         self.on_front = functools.partial(scene.on_front, tol=self.tol)
+        if mesh.geometry.dim == 3:
+            # a 3D front is a curve of nodes: no continuation over its elements (the 2D tip's
+            # neighbour is one node, a front node's are several). The jump vanishes
+            # identically there, so no law fixes a multiplier: it is held at zero, and the
+            # traction falls to zero across the front's elements, as the penalty's does
+            # (docs/verification.md section 13)
+            self.multiplier_excluded = self.on_front
         # the side sign H: +1 / -1 from the cell midpoints
         self.H = dolfinx.fem.Function(_compat.function_space(mesh, "DG", 0), name="side")
         self.H.interpolate(lambda x: np.where(scene.side(x) >= 0.0, 1.0, -1.0))
@@ -203,9 +198,10 @@ class InterfaceProblem(Problem):
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
     def multiplier_mask(self) -> np.ndarray:
-        """On the interface, the tips included (al-uzawa's update gives a tip its neighbour's
-        value: ``InterfaceSurface.tip_extended``)."""
-        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets)
+        """On the interface, the 2D tips included (al-uzawa's update gives a tip its
+        neighbour's value: ``InterfaceSurface.tip_extended``), a 3D front not."""
+        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets,
+                            self.multiplier_excluded)  # fmt: skip
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:

@@ -110,6 +110,9 @@ class Problem:
         self.lam, self.lam_test = (extra, extra_test) if field else (None, None)
         self.p, self.dp, self.q = (extra, d_extra, extra_test) if self.up else (None,) * 3
 
+    #: where a multiplier stays zero on the contact surface (a predicate of points, or None)
+    multiplier_excluded = None
+
     def confine_multiplier(self, supports=()) -> list:
         """The ``"field"`` multiplier is zero away from the contact surface, and a traction
         multiplier's component i is zero where the displacement's component i is held by one
@@ -122,7 +125,7 @@ class Problem:
         W1 = self.state.function_space.sub(1)
 
         def on_surface(Q):
-            return surface_mask(Q, self.fdim, self.contact_facets)
+            return surface_mask(Q, self.fdim, self.contact_facets, self.multiplier_excluded)
 
         held = [np.asarray(_compat.bc_dofs(bc)) for bc in supports]
         if not self.mult_shape or not held:

@@ -125,6 +125,11 @@ def _interface_cases():
             {"method": "nitsche"},
         ),
         (
+            "penny-shear-al-ssn",
+            PennyShear(PennyShear.Params(h_front=0.2, h_crack=0.4, front_bins=3)),
+            {"method": "al-ssn"},
+        ),
+        (
             "fault-block",
             FaultBlock(FaultBlock.Params(h_front=0.2, h_crack=0.4, overpressure=3e6)),
             {},

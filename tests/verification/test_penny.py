@@ -60,10 +60,30 @@ def test_penny_suction_closes_with_uniform_pressure(theta):
     assert data.reference["force_rel_error"] < 0.2**2 / 6
 
 
-@pytest.mark.parametrize("method", ["al-ssn", "al-uzawa", "penalty"])
-def test_penny_refuses_methods_without_a_3d_front(method):
-    with pytest.raises(ValueError, match="3D crack front"):
-        _run(dict(h_front=0.2, h_crack=0.4), method=method, degree=1)
+#: slip L2 on the coarse mesh of MESHES: measured 5.9 % (penalty), 6.5 % (al-uzawa), 6.0 %
+#: (al-ssn), Nitsche's 6.8 %; face shear within 1.0 %, 0.33 %, 0.63 % of mu sigma_n
+OTHER_METHODS = {"penalty": 0.015, "al-uzawa": 0.005, "al-ssn": 0.01}
+
+
+@pytest.mark.parametrize("method", sorted(OTHER_METHODS))
+def test_penny_shear_with_the_other_methods(method):
+    """penny-shear with the penalty and the augmented Lagrangian methods. A 3D front has no
+    continuation over its elements and its multiplier is held at zero (docs/verification.md
+    section 13): the traction falls to zero across the front's elements, the slip is as
+    accurate as Nitsche's."""
+    from contactfx.scenes.penny import PennyShear
+
+    hf, hc = MESHES[0]
+    scene = PennyShear(PennyShear.Params(h_front=hf, h_crack=hc, front_bins=3))
+    data = scene.run(scene.default_numerics(method=method), verbose=False)
+    assert data.errors["slip_L2_rel"] < 0.075
+    ref = data.reference
+    assert ref["slipping_fraction"] == 1.0
+    # the penalty's stick spring and its kappa [-g]_+ falling to zero over the front's
+    # elements give the largest face-shear error (the nodal projection near the front)
+    assert ref["face_shear_error"] < OTHER_METHODS[method], ref
+    if method == "al-ssn":  # a semi-smooth Newton on (u, lambda): measured 3 iterations
+        assert data.newton_iterations <= 5
 
 
 def test_penny_shear_slides_with_coulomb_friction():
