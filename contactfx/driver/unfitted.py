@@ -432,11 +432,16 @@ class UnfittedProblem(InterfaceProblem):
             for crack in self.cracks:
                 phi = crack.true.phi(ends)
                 phi = np.where(np.abs(phi) < SNAP * crack.h, 0.0, phi)
-                crossed |= phi[:, 0] * phi[:, 1] < 0.0
+                sign_change = phi[:, 0] * phi[:, 1] < 0.0
+                # where the crack's line crosses the facet: on the crack itself?
+                t = phi[:, 0] / np.where(sign_change, phi[:, 0] - phi[:, 1], 1.0)
+                point = ends[:, 0] + t[:, None] * (ends[:, 1] - ends[:, 0])
+                on_crack = np.abs(crack.true.psi(point)) <= crack.true.half_length
+                crossed |= sign_change & on_crack
         cut = dolfinx.mesh.meshtags(mesh, fdim, tags.indices[crossed], tags.values[crossed])
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=cut)
         load = self.scene.load(self.v_load, ds, dolfinx.fem.Constant(mesh, 1.0))
-        if load is None:
+        if load is None or load.empty() or not load.arguments():  # no load (UFL's zero)
             return
         form = dolfinx.fem.form(load)
         b = _compat.assemble_vector(_compat.create_vector(form), form)
