@@ -150,7 +150,8 @@ def test_serial_and_parallel_agree_interfaces(case):
     num = scene.default_numerics(**overrides)
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
-    # Newton / Uzawa converged (rtol 1e-10, Uzawa 1e-8): equal to the solver tolerance
+    # Newton / Uzawa converged (rtol 1e-10, Uzawa 1e-8): the partition changes round-off only
+    # (measured at most 6e-12 relative over these cases): required to 1e-8
     scale = max(abs(serial.force), 1.0)
     pairs = {"force": (serial.force, parallel.force),
              "tangential force": (serial.interface.tangential_force,
@@ -158,7 +159,7 @@ def test_serial_and_parallel_agree_interfaces(case):
              "closed length": (serial.contact_size, parallel.contact_size),
              "peak pressure": (serial.peak_pressure, parallel.peak_pressure)}  # fmt: skip
     for key, (s, p) in pairs.items():
-        assert p == pytest.approx(s, rel=1e-7, abs=1e-9 * scale), key
+        assert p == pytest.approx(s, rel=1e-8, abs=1e-10 * scale), key
     for key, value in serial.errors.items():
         # an exact solution's error is round-off: relative to the norm of the field it measures
         # (the absolute error over the relative one), e.g. 1e-11 Pa on pressures of 1e6 Pa
