@@ -501,12 +501,13 @@ class UnfittedProblem(InterfaceProblem):
         # a multiplier field: the pattern of its couplings with the cut cells' dofs, and its
         # diagonal everywhere (its dofs off the cracks are held at zero): not the couplings
         # with every cell's dofs, which doubled the LU's memory
-        dx_cut = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cut_tags)
-        cut = [(dx_cut(k + 1), lambda f: f) for k in range(len(self.cracks))]
+        # (one measure for every cell integral: dolfinx 0.9 wants one subdomain data per form)
+        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cut_tags)
+        cut = [(dx(k + 1), lambda f: f) for k in range(len(self.cracks))]
         lam, mu = ufl.split(self.trial)[1], ufl.split(self.test)[1]
         zero = dolfinx.fem.Constant(self.mesh, 0.0)
-        return (form * ufl.dx + zero_pattern(self.mesh, self.trial, self.test, cut)
-                + zero * ufl.inner(lam, mu) * ufl.dx)  # fmt: skip
+        return (form * dx + zero_pattern(self.mesh, self.trial, self.test, cut)
+                + zero * ufl.inner(lam, mu) * dx)  # fmt: skip
 
     def post_processor(self) -> CutPost:
         return CutPost(self)
