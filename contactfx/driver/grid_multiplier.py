@@ -35,19 +35,7 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["GridMultiplier", "crack_nodes"]
-
-
-def crack_nodes(crack, Q) -> np.ndarray:
-    """Bool mask of the local (block) dofs of the space Q on the crack's cut cells, on every
-    rank's cut cells (a node's cut cell may be neither owned nor a ghost where the node is)."""
-    f = dolfinx.fem.Function(Q)
-    bs = Q.dofmap.index_map_bs
-    f.x.array.reshape(-1, bs)[_compat.cell_dofs(Q)[crack.cut_owned].ravel()] = 1.0
-    vec = _compat.petsc_vec(f)
-    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-    return f.x.array.reshape(-1, bs)[:, 0] > 0.0
+__all__ = ["GridMultiplier"]
 
 
 class GridMultiplier:
@@ -107,12 +95,11 @@ class GridMultiplier:
             j_q = np.concatenate([left, left + 1])  # (grid node, Gauss point, hat value)
             q_of = np.concatenate([gq, gq])
             n_q = np.concatenate([1.0 - t, t])
-            den = np.bincount(j_q, weights=np.concatenate([w_q, w_q]) * n_q,
-                              minlength=len(grid.nodes))  # fmt: skip
+            _, den = grid.moments(psi_q, w_q, np.zeros((len(psi_q), 0)))  # int N_j ds
             by_node = [np.flatnonzero(j_q == j) for j in range(len(grid.nodes))]
             for c, Wc in enumerate(subs):
                 Qc, to_w = Wc.collapse()
-                nodes = np.flatnonzero(crack_nodes(crack, Qc))
+                nodes = np.flatnonzero(crack.nodes(Qc))
                 w_local = np.asarray(to_w)[nodes]
                 own = w_local < self.n_owned
                 nodes, w_local = nodes[own], w_local[own]

@@ -257,12 +257,15 @@ class InterfaceProblem(Problem):
         """(surface, the trial function's jump on it, its measure) of every interface."""
         return [(self.surface, oriented_jump(self.dw, self.H), self.dSc)]
 
-    def _start_multiplier(self) -> None:
-        def start(s):
-            if self.mult_shape:
-                return ufl.dot(s.stress, s.normal())
-            return positive_part(s.effective_pressure())
+    def _start_traction(self, s):
+        """The multipliers' start on the surface s: the traction (with friction) or the
+        compressive normal stress of the start's state."""
+        if self.mult_shape:
+            return ufl.dot(s.stress, s.normal())
+        return positive_part(s.effective_pressure())
 
+    def _start_multiplier(self) -> None:
+        start = self._start_traction
         if self.multiplier is not None:
             self.surface_update(start)(self.multiplier)
             bs = self.multiplier.function_space.dofmap.index_map_bs

@@ -55,7 +55,7 @@ from contactfx.contact.cut import (
 from contactfx.contact.interface import tangent
 from contactfx.contact.laws import active
 from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
-from contactfx.driver.grid_multiplier import GridMultiplier, crack_nodes
+from contactfx.driver.grid_multiplier import GridMultiplier
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, InterfacePost, Profile
 from contactfx.driver.problem import Problem
@@ -80,15 +80,17 @@ GRID_FACTOR = 2.0
 
 def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
     """Sum over every rank's owned cells of ``values`` (per cell, or per cell and vertex) at
-    each cell's dofs of the scalar P1 space Q, on the local dofs (owned and ghosts)."""
+    each cell's (block) dofs ``dofs`` of the space Q, on the local dofs (owned and ghosts;
+    one value per block)."""
     f = dolfinx.fem.Function(Q)
+    blocks = f.x.array.reshape(-1, Q.dofmap.index_map_bs)
     per_vertex = np.broadcast_to(np.asarray(values, float).reshape(len(values), -1),
                                  dofs.shape)  # fmt: skip
-    np.add.at(f.x.array, dofs[:n_owned].ravel(), per_vertex[:n_owned].ravel())
+    np.add.at(blocks[:, 0], dofs[:n_owned].ravel(), per_vertex[:n_owned].ravel())
     vec = _compat.petsc_vec(f)
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-    return f.x.array.copy()
+    return blocks[:, 0].copy()
 
 
 class _Crack:
@@ -98,7 +100,7 @@ class _Crack:
 
     def __init__(self, mesh, X, crack: CrackSegment, first: int, rule, n_owned: int) -> None:
         comm = mesh.comm
-        self.true, self.first = crack, first
+        self.true, self.first, self.n_owned = crack, first, n_owned
         near = near_cells(X, crack)
         self.h = h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)),
                                     op=MPI.MIN)  # fmt: skip
@@ -158,6 +160,12 @@ class _Crack:
         gathered = comm.allgather((self.coordinate(ends.T), sizes))
         self.grid = CoarseGrid(np.concatenate([g[0] for g in gathered]),
                                np.concatenate([g[1] for g in gathered]), GRID_FACTOR)  # fmt: skip
+
+    def nodes(self, Q) -> np.ndarray:
+        """Bool per local (block) dof of the space Q: on one of this crack's cut cells, on any
+        rank (a node's cut cell may be neither owned nor a ghost where the node is)."""
+        return _accumulate(Q, self.cells.cut.astype(float), _compat.cell_dofs(Q),
+                           self.n_owned) > 0.0  # fmt: skip
 
     def side(self, x):
         """The side (+1 / -1) of the points x (UFL): the crack's level set's sign in its cut
@@ -236,7 +244,7 @@ class UnfittedProblem(InterfaceProblem):
 
     def _on_cracks(self, Q) -> np.ndarray:
         """The dofs of the space Q on the cut cells of every crack."""
-        return np.any([crack_nodes(c, Q) for c in self.cracks], axis=0)
+        return np.any([c.nodes(Q) for c in self.cracks], axis=0)
 
     def confine_multiplier(self, supports=()) -> list:
         """al-ssn's multiplier lives on the nodes of the cracks' cut cells."""
@@ -257,14 +265,8 @@ class UnfittedProblem(InterfaceProblem):
         if self.method.multiplier != "field":
             return super()._start_multiplier()
         coupling = self.coupling()
-
-        def start(s):
-            if self.mult_shape:
-                return ufl.dot(s.stress, s.normal())
-            return ufl.max_value(s.effective_pressure(), 0.0)
-
         vec = _compat.petsc_vec(self.state)
-        vec.getArray()[coupling.rows] = coupling.project(start)
+        vec.getArray()[coupling.rows] = coupling.project(self._start_traction)
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     def surface_update(self, law):
