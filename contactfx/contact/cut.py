@@ -25,10 +25,11 @@ completely (area on both sides, no tip inside the support). Across the crack [[w
 elsewhere w is continuous. At the tips: a tip inside a cell is first moved along the crack to
 the nearer of the two points where the crack's line crosses that cell's boundary
 (:func:`snapped_tips`, by at most half the cell), so that every tip lies on a node or an edge.
-The node at the tip, or the two nodes of the tip's edge, are not enriched (``tip_nodes``): the
-jump falls linearly to zero over the last cut cell and vanishes at the tip, as at the tip node
-of a fitted crack
-(docs/verification.md section 14 measures the effect on the opening and on K).
+The node at the tip, or the two nodes of the tip's edge (``tip_nodes``), carry the branch
+function sqrt(r) sin(theta / 2) instead of H (:mod:`contactfx.contact.tip`): the jump vanishes
+at the tip and opens as sqrt(r) next to it. With those nodes unenriched (the jump falling
+linearly to zero over the last cut cells) K was about 1 % lower (docs/verification.md
+section 14).
 
 Integrals. For P1 the strain is constant on each side of a cut cell, so the bulk energy is
 f W(eps(u + a)) + (1 - f) W(eps(u - a)) times the cell's area: a DG0 coefficient f keeps it in
@@ -117,8 +118,8 @@ class CutCells:
     docstring): ``phi`` (cells, 3) the snapped level set at each cell's vertices; ``fraction``
     (cells,) the +side's area fraction; ``cut`` (cells,) bool, and ``pieces`` (cells, 2, 2) the
     crack's piece in each cut cell (NaN elsewhere); ``tip`` (cells,) bool; ``tip_nodes``
-    (cells, 3) bool: the vertices whose support holds a tip inside (a tip's barycentric
-    coordinate > 0 in a cell containing it)."""
+    (cells, 3) bool: the vertices whose support holds a tip inside (in a cell containing
+    the tip, farther than ``snap`` from the vertex's opposite edge)."""
 
     phi: np.ndarray
     fraction: np.ndarray
@@ -227,12 +228,17 @@ def cut_cells(X: np.ndarray, crack: CrackSegment, snap: float) -> CutCells:
     cut = has & inside & (~on_edge | plus_side)
     tip = touches & ~inside
     tip_nodes = np.zeros((len(X), 3), dtype=bool)
+    # each vertex's height over its opposite edge: a tip within ``snap`` of an edge or a node
+    # is on it, as a node within ``snap`` of the crack's line is
+    e = [X[:, (i + 2) % 3] - X[:, (i + 1) % 3] for i in range(3)]
+    area2 = np.abs(e[0][:, 0] * e[1][:, 1] - e[0][:, 1] * e[1][:, 0])
+    height = area2[:, None] / np.stack([np.linalg.norm(ei, axis=1) for ei in e], axis=1)
     for t in crack.tips():
-        bary = _barycentric(X, np.asarray(t, float))
-        holds = np.all(bary >= -1e-10, axis=1)
+        dist = _barycentric(X, np.asarray(t, float)) * height
+        holds = np.all(dist >= -max(snap, 1e-10 * a), axis=1)
         # (a cell along the crack, cut or the -side's twin of an edge piece, is not a tip cell)
         tip |= holds & ~(has & inside)
-        tip_nodes |= holds[:, None] & (bary > 1e-10)
+        tip_nodes |= holds[:, None] & (dist > max(snap, 1e-10 * a))
     cut &= ~tip
     pieces = np.where(cut[:, None, None], line, np.nan)
     return CutCells(phi, _positive_fraction(X, phi), cut, pieces, tip, tip_nodes)
@@ -363,13 +369,18 @@ class CutSurface(InterfaceSurface):
 
     at_crack: object = None
     at_law: object = None
+    #: the enrichment's half jump at the Gauss points and at the pieces' midpoints (the tip
+    #: enrichment's part included: contactfx.contact.tip); None: ``at_crack`` / ``at_law``
+    at_jump: object = None
+    at_jump_law: object = None
     #: the first component of this crack's enrichment in U = (u, a_1, ..., a_K)
     first: int = 2
 
     def jump(self, X):
-        """[[w]] = 2 a at the crack's Gauss points, for X = (u, a_1, ...) (the unknown, its
-        test or trial function)."""
-        return 2.0 * self.at_crack(ufl.as_vector([X[self.first + i] for i in range(2)]))
+        """[[w]] = 2 a at the crack's Gauss points (2 (a_H + sqrt(r) a_T) with the tip
+        enrichment), for X = (u, a_1, ...) (the unknown, its test or trial function)."""
+        half = self.at_crack if self.at_jump is None else self.at_jump
+        return 2.0 * half(ufl.as_vector([X[self.first + i] for i in range(2)]))
 
     @property
     def u(self):
@@ -413,7 +424,7 @@ class CutSurface(InterfaceSurface):
         No midpoint lies at a tip: no tip needs a continuation."""
         if self.at_law is None:
             return self
-        return dataclasses.replace(self, at_crack=self.at_law)
+        return dataclasses.replace(self, at_crack=self.at_law, at_jump=self.at_jump_law)
 
     def slip_increment(self, n):
         if self.u_prev is None:

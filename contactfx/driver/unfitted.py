@@ -3,8 +3,12 @@
 
 The unknown is U = (u, a_1, ..., a_K) as for a fitted interface
 (:mod:`contactfx.driver.interface`) with one enrichment per crack, each confined to its
-enriched nodes; the bulk form weighs each cut cell's two sides by their area fractions, each
-crack's terms are the methods' residuals on its :class:`contactfx.contact.cut.CutSurface`.
+enriched nodes: Heaviside on the cut cells' nodes, the branch function on the tips' nodes
+(:mod:`contactfx.contact.tip`). The bulk form weighs each cut cell's two sides by their area
+fractions, except on the cells around the tips' nodes (their *star*), where the star rule
+integrates the strain of u + H a_H + F a_T point by point; each crack's terms are the methods'
+residuals on its :class:`contactfx.contact.cut.CutSurface`, whose jump 2 (a_H + sqrt(r) a_T)
+holds both parts.
 Nitsche's stress on the crack is the sides' mean weighted by their area fractions and its
 parameter scales with the piece's length over the cell's area (Annavarapu, Hautefeuille &
 Dolbow 2012, doi:10.1002/nme.4343): with the cell diameter instead the pressure oscillates
@@ -26,7 +30,8 @@ space, is not offered: the grid is not a finite element space of the mesh.
 Outputs: along the cracks, at their Gauss points, the aperture, slip, tractions and status
 (``interface.csv``, ``interface.png``); in the ParaView files u (with one crack u + H a, split
 along the cut cells' edges), each enrichment, the side fractions and the von Mises stress of
-u + sum H_k a_k (H_k the side of the larger part of each cell).
+u + sum H_k a_k (H_k the side of the larger part of each cell; on the star cells the tip
+nodes' a is read as a Heaviside amplitude there: the pictures' few cells around each tip).
 """
 
 from __future__ import annotations
@@ -53,6 +58,7 @@ from contactfx.contact.cut import (
     snapped_tips,
 )
 from contactfx.contact.interface import tangent
+from contactfx.contact.tip import STAR_POINTS, branch, snapped_point, star_rule, tip_split
 from contactfx.contact.laws import active
 from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
 from contactfx.driver.grid_multiplier import GridMultiplier
@@ -66,6 +72,10 @@ __all__ = ["UnfittedProblem"]
 
 #: the degree of the cell rule that carries the crack's Gauss points (6 points per piece)
 QUADRATURE_DEGREE = 4
+#: the degree of the cell rule whose points carry the star rule (contactfx.contact.tip): 28
+#: points for at most three triangles of STAR_POINTS^2
+STAR_DEGREE = 11
+assert 3 * STAR_POINTS**2 <= 28
 _CUT = 1  # the cut cells' tag
 #: Nitsche's length h_K = 5 |K| / |Gamma_K| on a cut cell K (area |K|, crack piece |Gamma_K|):
 #: gamma = gamma0 E / h_K is then, at the default gamma0 = 10, the stabilisation
@@ -123,6 +133,7 @@ class _Crack:
             raise ValueError("the crack cuts no cell completely (shorter than the cells "
                              "around it)")  # fmt: skip
         quad = CrackQuadrature(X, cells, rule)
+        self.quad_points = quad.points
         DG0 = _compat.function_space(mesh, "DG", 0)
         c0 = _compat.cell_dofs(DG0)[:, 0]
         self.fraction = dolfinx.fem.Function(DG0, name="side_fraction")
@@ -184,6 +195,130 @@ class _Crack:
         return (x[0] - c[0]) * d[0] + (x[1] - c[1]) * d[1]
 
 
+class _TipFields:
+    """The tip enrichment (:mod:`contactfx.contact.tip`) of every crack, as functions of the
+    cells and of the points of their rules: on the star cells (the cells around a tip's
+    nodes) the star rule's points, weights, sides, F and grad F, and the tip part's L and P;
+    at the cracks' Gauss points and the pieces' midpoints sqrt(r), grad sqrt(r) and L, P; per
+    cell gL and gP (:func:`contactfx.contact.tip.tip_split`). Zero off the stars: there the
+    enrichment is Heaviside only. ``tags`` (cells,): crack k's star cells get k."""
+
+    def __init__(self, mesh, X, area, cracks, n_owned: int) -> None:
+        self.slots = len(_compat.quadrature_rule(mesh, STAR_DEGREE)[1])
+        ref_w = _compat.quadrature_rule(mesh, STAR_DEGREE)[1]
+        Qb = _compat.quadrature_space(mesh, STAR_DEGREE)
+        Qs = _compat.quadrature_space(mesh, QUADRATURE_DEGREE)
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        qb, qs, c0 = (_compat.cell_dofs(S) for S in (Qb, Qs, DG0))
+        c0 = c0[:, 0]
+
+        def functions(space, n):
+            return [dolfinx.fem.Function(space) for _ in range(n)]
+
+        # the star rule: points (2), weight ratio, side, F, grad F (2), L, P (2)
+        self.Y, self.ratio, self.side = functions(Qb, 2), *functions(Qb, 2)
+        self.F, self.gF = dolfinx.fem.Function(Qb), functions(Qb, 2)
+        self.L, self.P = dolfinx.fem.Function(Qb), functions(Qb, 2)
+        # the Gauss points (crack) and the midpoints (law): sqrt(r), grad sqrt(r), L, P
+        self.R, self.gR, self.Lc, self.Pc = (dolfinx.fem.Function(Qs), functions(Qs, 2),
+                                             dolfinx.fem.Function(Qs), functions(Qs, 2))
+        self.Rm, self.Lm, self.Pm = (dolfinx.fem.Function(Qs), dolfinx.fem.Function(Qs),
+                                     functions(Qs, 2))
+        self.gL, self.gP = functions(DG0, 2), functions(DG0, 4)
+        Q1 = _compat.function_space(mesh, "Lagrange", 1)
+        dofs = _compat.cell_dofs(Q1)
+        self.tags = np.full(len(X), -1, dtype=np.int32)
+        for k, crack in enumerate(cracks):
+            cells = crack.cells
+            node = _accumulate(Q1, cells.tip_nodes, dofs, n_owned) > 0.0
+            flags = node[dofs]
+            star = np.flatnonzero(np.any(flags, axis=1))
+            seg = crack.segment
+            # the tips on the edges or nodes that they are within the snap of (the same on
+            # every rank: from the ranks that hold them)
+            snap = SNAP * crack.h
+            held = mesh.comm.allgather([snapped_point(X[star], np.asarray(p, float), snap)
+                                        for p in (seg.p0, seg.p1)])  # fmt: skip
+            ends = np.array([next((h[t] for h in held if not np.isnan(h[t][0])), p)
+                             for t, p in enumerate((seg.p0, seg.p1))], float)  # fmt: skip
+            if len(star) == 0:
+                continue
+            self.tags[star] = k
+            ahead = np.array([-seg.direction, seg.direction])
+            centre = X[star].mean(axis=1)
+            which = np.argmin(np.linalg.norm(centre[:, None] - ends[None], axis=2), axis=1)
+            tips = ends[which]
+            side = np.where(cells.fraction[star] >= 0.5, 1.0, -1.0)
+            pts, w, sides, cut_side = star_rule(X[star], cells.phi[star], cells.cut[star],
+                                                side, tips, self.slots, snap)  # fmt: skip
+            F, gF = np.zeros(w.shape), np.zeros(w.shape + (2,))
+            crack_pts = crack.quad_points[star]
+            mids = crack_pts.mean(axis=1, keepdims=True)
+            R, gR, Rm = np.zeros(crack_pts.shape[:2]), np.zeros(crack_pts.shape), np.zeros(
+                (len(star), 1))  # fmt: skip
+            for t in range(2):
+                on = which == t
+                F[on], gF[on] = branch(pts[on], ends[t], ahead[t], seg.normal, cut_side[on])
+                d = crack_pts[on] - ends[t]
+                r = np.linalg.norm(d, axis=2)
+                R[on] = np.sqrt(r)
+                gR[on] = d / (2.0 * np.maximum(r, 1e-300) ** 1.5)[..., None]
+                Rm[on] = np.sqrt(np.linalg.norm(mids[on] - ends[t], axis=2))
+            cut = cells.cut[star]
+            L, P, gL, gP = tip_split(X[star], flags[star], pts)
+            Lc, Pc = tip_split(X[star], flags[star], crack_pts)[:2]
+            Lm, Pm = tip_split(X[star], flags[star], mids)[:2]
+            # the crack's points only in the cut cells (elsewhere they are the cell's centre)
+            Lc, Pc = Lc * cut[:, None], Pc * cut[:, None, None]
+            Lm, Pm = Lm * cut[:, None], Pm * cut[:, None, None]
+            ratio = w / (ref_w[None, :] * 2.0 * area[star, None])
+            for f, v in ((self.ratio, ratio), (self.side, sides), (self.F, F), (self.L, L),
+                         *zip(self.Y, np.moveaxis(pts, 2, 0)),
+                         *zip(self.gF, np.moveaxis(gF, 2, 0)),
+                         *zip(self.P, np.moveaxis(P, 2, 0))):  # fmt: skip
+                f.x.array[qb[star]] = v
+            for f, v in ((self.R, R), (self.Lc, Lc), (self.Rm, np.repeat(Rm, R.shape[1], 1)),
+                         (self.Lm, np.repeat(Lm, R.shape[1], 1)),
+                         *zip(self.gR, np.moveaxis(gR, 2, 0)),
+                         *zip(self.Pc, np.moveaxis(Pc, 2, 0)),
+                         *zip(self.Pm, np.moveaxis(np.repeat(Pm, R.shape[1], 1), 2, 0))):
+                f.x.array[qs[star]] = v
+            for f, v in zip([*self.gL, *self.gP], [*gL.T, *gP.reshape(-1, 4).T], strict=True):
+                f.x.array[c0[star]] = v
+
+        self.x = ufl.SpatialCoordinate(mesh)
+
+    def part(self, f, L, P):
+        """The tip nodes' share of the P1 field f at the points of L and P (lists)."""
+        return L * f + ufl.dot(ufl.grad(f), ufl.as_vector(P) - L * self.x)
+
+    def part_grad(self, f):
+        """The gradient of the tip nodes' share of the P1 field f."""
+        gL = ufl.as_vector(self.gL)
+        gP = ufl.as_matrix([self.gP[:2], self.gP[2:]])
+        return ufl.outer(f, gL) + ufl.dot(ufl.grad(f), gP - ufl.outer(self.x, gL))
+
+    def half_jump(self, at, f, R, L, P):
+        """The half jump of the enrichment f at the points: f's value there (``at``) with its
+        tip nodes' share weighted by sqrt(r) (F = H sqrt(r) on the crack)."""
+        return at(f) + (R - 1.0) * self.part(f, L, P)
+
+    def strain(self, X, crack, others, side):
+        """The strain of w at the star rule's points, crack's enrichment split into its
+        Heaviside part (with ``side``) and its tip part (with F); ``others``: the other
+        cracks' (sign, enrichment) (constant sides here)."""
+        d = len(self.Y)
+        u = ufl.as_vector([X[i] for i in range(d)])
+        a = crack.enrichment(X)
+        gT = self.part_grad(a)
+        aT = self.part(a, self.L, self.P)
+        grad = ufl.grad(u) + side * (ufl.grad(a) - gT) + ufl.outer(aT, ufl.as_vector(self.gF))
+        grad = grad + self.F * gT
+        for m, b in others:
+            grad = grad + m * ufl.grad(b)
+        return ufl.sym(grad)
+
+
 class UnfittedProblem(InterfaceProblem):
     """A body with unfitted cracks (see the module docstring)."""
 
@@ -214,11 +349,14 @@ class UnfittedProblem(InterfaceProblem):
         self.components_per_dim = 1 + len(segments)
         self.cracks = [_Crack(mesh, X, seg, 2 * (k + 1), self.rule, n_owned)
                        for k, seg in enumerate(segments)]  # fmt: skip
+        self.area = self.cracks[0].area
+        self.tip = _TipFields(mesh, X, self.area, self.cracks, n_owned)
+        K = len(self.cracks)
         tags = np.zeros(len(X), dtype=np.int32)
-        touched = np.zeros(len(X), dtype=np.int32)  # cut or tip cells of a crack
+        touched = np.zeros(len(X), dtype=np.int32)  # cut, tip or star cells of a crack
         clash = (0, 0)
         for k, crack in enumerate(self.cracks):
-            mine = crack.cells.cut | crack.cells.tip
+            mine = crack.cells.cut | crack.cells.tip | (self.tip.tags == k)
             if np.any(mine & (touched > 0)) and clash == (0, 0):
                 clash = (int(touched[mine & (touched > 0)][0]), k + 1)
             touched[mine] = k + 1
@@ -227,9 +365,11 @@ class UnfittedProblem(InterfaceProblem):
         if clash != (0, 0):
             raise ValueError(f"cracks {clash[0]} and {clash[1]} cross or share a cell; unfitted "
                              "cracks must be a cell apart")  # fmt: skip
-        cut = np.flatnonzero(tags).astype(np.int32)
-        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, cut, tags[cut])
-        self.area = self.cracks[0].area
+        # every cell tagged: 0, k + 1 (cut by crack k), K + 1 + k (around a tip of crack k)
+        star = self.tip.tags >= 0
+        tags[star] = K + 1 + self.tip.tags[star]
+        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, np.arange(len(X), dtype=np.int32),
+                                              tags)  # fmt: skip
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
 
     # -- a method's values at the cracks' pieces ----------------------------------------------
@@ -359,30 +499,38 @@ class UnfittedProblem(InterfaceProblem):
         cut = _accumulate(Q, c.cut.astype(float), dofs, n)
         tip = _accumulate(Q, c.tip_nodes, dofs, n)
         both = np.minimum(plus, minus) > 1e-12 * (plus + minus)
-        enriched = (cut > 0.0) & (tip == 0.0) & both
+        # Heaviside on the cut cells' nodes, the branch function on the tips' nodes
+        enriched = ((cut > 0.0) & (tip == 0.0) & both) | (tip > 0.0)
+        star = _accumulate(Q, np.any(tip[dofs] > 0.0, axis=1).astype(float), dofs, n) > 0.0
         mesh = self.mesh
         fdim = mesh.topology.dim - 1
         mesh.topology.create_connectivity(fdim, mesh.topology.dim)
         outer = _compat.locate_dofs_topological(
             Q, fdim, dolfinx.mesh.exterior_facet_indices(mesh.topology)
         )
-        if not crack.exits and mesh.comm.allreduce(bool(np.any(enriched[outer])), op=MPI.LOR):
+        near = enriched[outer] | star[outer]  # (the tips' cells have no boundary rule)
+        if not crack.exits and mesh.comm.allreduce(bool(np.any(near)), op=MPI.LOR):
             raise ValueError(
                 "the crack is closer to the boundary than a cell (a cut cell's "
                 "node lies on the boundary); move it inwards or refine"
             )
         return enriched
 
-    def _mean_stress(self, X):
-        """The stress of the cells' sides weighted by their area fractions (Hansbo & Hansbo
-        2002, doi:10.1016/S0045-7825(02)00524-8): sigma(u + sum_k (2 f_k - 1) a_k)."""
-        d = self.gdim
+    def _mean_stress(self, X, crack):
+        """The stress at crack's Gauss points of the cells' sides weighted by their area
+        fractions (Hansbo & Hansbo 2002, doi:10.1016/S0045-7825(02)00524-8):
+        sigma(u + sum_k (2 f_k - 1) a_k), and the tip part's (F = H sqrt(r) on the crack)."""
+        d, t = self.gdim, self.tip
         u = ufl.as_vector([X[i] for i in range(d)])
         m = [2.0 * c.fraction - 1.0 for c in self.cracks]
-        return self.material.sigma(
+        mean = self.material.sigma(
             u + sum((mk * c.enrichment(X) for mk, c in zip(m, self.cracks, strict=True)),
                     ufl.zero(d))
         )  # fmt: skip
+        a = crack.enrichment(X)
+        aT = t.part(a, t.Lc, t.Pc)
+        tip = ufl.outer(aT, ufl.as_vector(t.gR)) + (t.R - 1.0) * t.part_grad(a)
+        return mean + self.material.stress((2.0 * crack.fraction - 1.0) * ufl.sym(tip))
 
     def make_surface(self) -> CutSurface:
         """The surface of each crack (``surfaces``); the first is the kind's ``surface``."""
@@ -405,15 +553,20 @@ class UnfittedProblem(InterfaceProblem):
             def at_midpoint(f, M=M):
                 return f + ufl.dot(ufl.grad(f), M - x)
 
-            crack.ds = WeightedMeasure(dx(k + 1, metadata=rule), crack.weight)
+            t, K = self.tip, len(self.cracks)
+            crack.at_crack = at_crack
+            crack.ds = WeightedMeasure(dx((k + 1, K + 1 + k), metadata=rule), crack.weight)
             crack.s_coord = crack.coordinate(Y)
             self.surfaces.append(CutSurface(
                 self.U, self.V_test, ufl.as_vector([float(v) for v in crack.true.normal]),
-                crack.ds, self._mean_stress(self.U), self._mean_stress(self.V_test),
+                crack.ds, self._mean_stress(self.U, crack), self._mean_stress(self.V_test, crack),
                 scene.contact_modulus(), crack.h_cut, floor=scene.floor(crack.s_coord),
                 fluid=self.fluid, friction=self.friction, joint=scene.joint(),
                 u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
                 at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
+                at_jump=functools.partial(t.half_jump, at_crack, R=t.R, L=t.Lc, P=t.Pc),
+                at_jump_law=functools.partial(t.half_jump, at_midpoint, R=t.Rm, L=t.Lm,
+                                              P=t.Pm),
                 multiplier=self._multiplier_at(at_crack),
                 h_nodal=self._nodal_size(),
             ))  # fmt: skip
@@ -498,18 +651,36 @@ class UnfittedProblem(InterfaceProblem):
             m = 2.0 * c.fraction - 1.0
             form += (1.0 - m * m) * ufl.inner(sigma(c.enrichment(self.dU)),
                                               eps(c.enrichment(self.V_test)))  # fmt: skip
+        # (one measure for every cell integral: dolfinx 0.9 wants one subdomain data per form)
+        K = len(self.cracks)
+        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cut_tags)
+        form = form * dx(tuple(range(K + 1))) + self._star_form(dx)
         if not self.split:
-            return form * ufl.dx
+            return form
         # a multiplier field: the pattern of its couplings with the cut cells' dofs, and its
         # diagonal everywhere (its dofs off the cracks are held at zero): not the couplings
         # with every cell's dofs, which doubled the LU's memory
-        # (one measure for every cell integral: dolfinx 0.9 wants one subdomain data per form)
-        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cut_tags)
-        cut = [(dx(k + 1), lambda f: f) for k in range(len(self.cracks))]
+        cut = [(dx((k + 1, K + 1 + k)), lambda f: f) for k in range(K)]
         lam, mu = ufl.split(self.trial)[1], ufl.split(self.test)[1]
         zero = dolfinx.fem.Constant(self.mesh, 0.0)
-        return (form * dx + zero_pattern(self.mesh, self.trial, self.test, cut)
+        return (form + zero_pattern(self.mesh, self.trial, self.test, cut)
                 + zero * ufl.inner(lam, mu) * dx)  # fmt: skip
+
+    def _star_form(self, dx):
+        """The bulk energy on the cells around the tips' nodes, by the star rule
+        (:mod:`contactfx.contact.tip`): the tip enrichment is not P1."""
+        t, K = self.tip, len(self.cracks)
+        rule = {"quadrature_degree": STAR_DEGREE, "quadrature_rule": "default"}
+        form = 0
+        for k, crack in enumerate(self.cracks):
+            if self.mesh.comm.allreduce(int(np.sum(t.tags == k)), op=MPI.SUM) == 0:
+                continue
+            others = [(2.0 * c.fraction - 1.0, c) for c in self.cracks if c is not crack]
+            e_u, e_v = (t.strain(X, crack, [(m, c.enrichment(X)) for m, c in others], t.side)
+                        for X in (self.dU, self.V_test))  # fmt: skip
+            form += ufl.inner(self.material.stress(e_u), e_v) * t.ratio * dx(
+                K + 1 + k, metadata=rule)  # fmt: skip
+        return form
 
     def post_processor(self) -> CutPost:
         return CutPost(self)

@@ -77,14 +77,17 @@ class Elastic:
     def sigma(self, u, p=None):
         """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
         (p the pressure -lambda div u): 2 mu eps(u) - p I."""
-        E, mu, lmbda = self._moduli()
         eps = ufl.sym(ufl.grad(u))
-        identity = ufl.Identity(ufl.shape(eps)[0])
         if p is not None:
-            return 2.0 * mu * eps - p * identity
+            return 2.0 * self._moduli()[1] * eps - p * ufl.Identity(ufl.shape(eps)[0])
+        return self.stress(eps)
+
+    def stress(self, eps):
+        """Stress of the strain eps (a UFL tensor)."""
+        E, mu, lmbda = self._moduli()
         if ufl.shape(eps) == (1, 1):
             return E * eps
-        return 2.0 * mu * eps + lmbda * ufl.tr(eps) * identity
+        return 2.0 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(ufl.shape(eps)[0])
 
     def pressure_law(self, u, p, q):
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u

@@ -31,13 +31,14 @@ def test_unfitted_sneddon_opening_and_K_converge():
     for data in runs:
         assert data.force == 0.0  # the pressurised crack is open everywhere: no contact
     errors = [d.errors["opening_L2_rel"] for d in runs]
-    # opening in L2 along the crack: measured 1.0e-2 (h_crack = a / 20) and 4.7e-3 (a / 40,
-    # the default; the fitted crack 5.8e-3): first order, as the fitted P1 crack's
-    assert errors[1] < 0.0075 and errors[0] > 1.6 * errors[1], errors
-    # K_I by displacement extrapolation over r in [a / 20, a / 2]: measured 0.73 % on the
-    # default mesh (the fitted crack 1.0 %), 2.1 % at a / 20. The tips move onto the edges of
-    # their cells (contactfx.contact.cut), by up to half a tip cell (h_tip = a / 400): the
-    # jump at r = a / 20 changes by up to 1.25 %, which the fit carries to K
+    # opening in L2 along the crack: measured 9.3e-3 (h_crack = a / 20) and 3.7e-3 (a / 40,
+    # the default; the fitted crack 5.8e-3), with the tips' nodes enriched by the branch
+    # function (without: 1.0e-2 and 4.7e-3)
+    assert errors[1] < 0.006 and errors[0] > 1.8 * errors[1], errors
+    # K_I by displacement extrapolation over r in [a / 20, a / 2]: measured 0.38 % on the
+    # default mesh (the fitted crack 1.0 %), 1.9 % at a / 20. The issue's bound is 2 %; the
+    # tips move onto the edges of their cells (contactfx.contact.cut) by up to half a tip cell
+    # (h_tip = a / 400), which changes the jump at r = a / 20 by up to 1.25 %
     assert runs[1].reference["K_rel_error"] < 0.02, runs[1].reference
 
 
@@ -50,11 +51,11 @@ def test_unfitted_inclined_crack_KII_table(mu, column, beta):
     ref = data.reference
     expected = KII_TABLE[mu][column]
     assert ref["K_II_normalised_exact"] == pytest.approx(expected, abs=5e-6)
-    # displacement extrapolation of the slip: measured 1.7-2.3 % low over the table (the
-    # moved tips as in the Sneddon test above; Debian 13's gmsh mesh: 2.3 % at beta 45); the
-    # slip in L2 0.74-0.93 %
-    assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.03)
-    assert data.errors["slip_L2_rel"] < 0.0125
+    # displacement extrapolation of the slip: measured 0.91-1.39 % low over the table (with
+    # the tips' nodes unenriched 1.7-2.3 %); the issue's bound is 2 %. The slip in L2
+    # 0.51-0.61 % (first order in h: the P1 jump against the ellipse)
+    assert ref["K_II_normalised"] == pytest.approx(expected, rel=0.02)
+    assert data.errors["slip_L2_rel"] < 0.008
     # the whole crack slides, the Coulomb law holds at every Gauss point to round-off
     assert ref["slipping_fraction"] == 1.0
     assert ref["friction_law_error"] < 1e-9
@@ -165,27 +166,30 @@ def test_unfitted_penalty_keeps_its_traction_history():
 
 
 def test_unfitted_KII_at_30_degrees_converges():
-    """The table's worst case (beta 30, 2.3 % on the default mesh) on the mesh refined once
-    more (h_crack = a / 80, h_tip = a / 800)."""
+    """The table's beta 30 (1.3 % on the default mesh) on the mesh refined once more
+    (h_crack = a / 80, h_tip = a / 800)."""
     runs = [
         _run(CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted", **h)),
              method="nitsche", mu=0.3)
         for h in ({}, {"h_crack": 0.0125, "h_tip": 0.00125})
     ]  # fmt: skip
     errors = [r.reference["K_rel_error"] for r in runs]
-    # measured 2.26 % and 0.82 % (4.0 % at a / 20): about O(h^1.5)
-    assert errors[1] < 0.012 and errors[0] > 2.0 * errors[1], errors
+    # measured 1.29 % and 0.57 % (2.5 % at a / 20): about O(h)
+    assert errors[1] < 0.008 and errors[0] > 1.8 * errors[1], errors
     slips = [r.errors["slip_L2_rel"] for r in runs]
-    # measured 0.93 % and 0.42 %: O(h)
-    assert slips[1] < 0.006 and slips[0] > 1.8 * slips[1], slips
+    # measured 0.57 % and 0.33 % (1.07 % at a / 20)
+    assert slips[1] < 0.0045 and slips[0] > 1.5 * slips[1], slips
 
 
 def test_unfitted_stick_has_no_slip():
     # beta 30, mu 0.6: tan(30) < 0.6, the crack sticks; the body carries the remote stress
-    # alone, which the discrete space holds exactly
+    # alone, which the discrete space holds (a = 0). The branch function's integrals are
+    # quadratures (the star rule, the pieces' Gauss points), not exact for sqrt(r): measured
+    # 2.8e-9 (5.9e-10 with a 4 x 4 star rule; 1e-13 with the tips' nodes unenriched), against
+    # a sliding crack's slip of 4e-4 (K_II table)
     scene = CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted"))
     data = _run(scene, method="nitsche", mu=0.6)
-    assert data.reference["max_slip"] < 1e-12
+    assert data.reference["max_slip"] < 1e-8
     assert data.errors["pressure_interior_L2_rel"] < 1e-10
 
 
