@@ -166,10 +166,10 @@ def star_rule(X: np.ndarray, phi: np.ndarray, cut: np.ndarray, cell_side: np.nda
                 if q + n > slots:
                     raise ValueError("a star cell needs more quadrature points than its rule")
                 xi, eta = ref[:, :1], ref[:, 1:]
-                points[c, q:q + n] = t[0] + xi * (t[1] - t[0]) + xi * eta * (t[2] - t[1])
-                weights[c, q:q + n] = ref_w * 2.0 * area
-                side[c, q:q + n] = s
+                points[c, q : q + n] = t[0] + xi * (t[1] - t[0]) + xi * eta * (t[2] - t[1])
+                weights[c, q : q + n] = ref_w * 2.0 * area
+                side[c, q : q + n] = s
                 if cut[c]:
-                    cut_side[c, q:q + n] = s
+                    cut_side[c, q : q + n] = s
                 q += n
     return points, weights, side, cut_side

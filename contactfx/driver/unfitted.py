@@ -58,8 +58,8 @@ from contactfx.contact.cut import (
     snapped_tips,
 )
 from contactfx.contact.interface import tangent
-from contactfx.contact.tip import STAR_POINTS, branch, snapped_point, star_rule, tip_split
 from contactfx.contact.laws import active
+from contactfx.contact.tip import STAR_POINTS, branch, snapped_point, star_rule, tip_split
 from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
 from contactfx.driver.grid_multiplier import GridMultiplier
 from contactfx.driver.interface import InterfaceProblem
@@ -72,6 +72,12 @@ __all__ = ["UnfittedProblem"]
 
 #: the degree of the cell rule that carries the crack's Gauss points (6 points per piece)
 QUADRATURE_DEGREE = 4
+#: Nitsche's parameter on the cut cells around a tip is TIP_NITSCHE times larger: the branch
+#: function's stress on the crack grows as 1 / sqrt(r), which the inverse estimate behind
+#: NITSCHE_LENGTH does not bound (with gamma0 = 10 there, the symmetric variant's contact
+#: status cycled on a mesh refined to a / 80; gamma0 = 100 or theta = -1 converged:
+#: docs/verification.md section 14)
+TIP_NITSCHE = 10.0
 #: the degree of the cell rule whose points carry the star rule (contactfx.contact.tip): 28
 #: points for at most three triangles of STAR_POINTS^2
 STAR_DEGREE = 11
@@ -220,10 +226,17 @@ class _TipFields:
         self.F, self.gF = dolfinx.fem.Function(Qb), functions(Qb, 2)
         self.L, self.P = dolfinx.fem.Function(Qb), functions(Qb, 2)
         # the Gauss points (crack) and the midpoints (law): sqrt(r), grad sqrt(r), L, P
-        self.R, self.gR, self.Lc, self.Pc = (dolfinx.fem.Function(Qs), functions(Qs, 2),
-                                             dolfinx.fem.Function(Qs), functions(Qs, 2))
-        self.Rm, self.Lm, self.Pm = (dolfinx.fem.Function(Qs), dolfinx.fem.Function(Qs),
-                                     functions(Qs, 2))
+        self.R, self.gR, self.Lc, self.Pc = (
+            dolfinx.fem.Function(Qs),
+            functions(Qs, 2),
+            dolfinx.fem.Function(Qs),
+            functions(Qs, 2),
+        )
+        self.Rm, self.Lm, self.Pm = (
+            dolfinx.fem.Function(Qs),
+            dolfinx.fem.Function(Qs),
+            functions(Qs, 2),
+        )
         self.gL, self.gP = functions(DG0, 2), functions(DG0, 4)
         Q1 = _compat.function_space(mesh, "Lagrange", 1)
         dofs = _compat.cell_dofs(Q1)
@@ -273,15 +286,19 @@ class _TipFields:
             Lm, Pm = Lm * cut[:, None], Pm * cut[:, None, None]
             ratio = w / (ref_w[None, :] * 2.0 * area[star, None])
             for f, v in ((self.ratio, ratio), (self.side, sides), (self.F, F), (self.L, L),
-                         *zip(self.Y, np.moveaxis(pts, 2, 0)),
-                         *zip(self.gF, np.moveaxis(gF, 2, 0)),
-                         *zip(self.P, np.moveaxis(P, 2, 0))):  # fmt: skip
+                         *zip(self.Y, np.moveaxis(pts, 2, 0), strict=True),
+                         *zip(self.gF, np.moveaxis(gF, 2, 0), strict=True),
+                         *zip(self.P, np.moveaxis(P, 2, 0), strict=True)):  # fmt: skip
                 f.x.array[qb[star]] = v
-            for f, v in ((self.R, R), (self.Lc, Lc), (self.Rm, np.repeat(Rm, R.shape[1], 1)),
-                         (self.Lm, np.repeat(Lm, R.shape[1], 1)),
-                         *zip(self.gR, np.moveaxis(gR, 2, 0)),
-                         *zip(self.Pc, np.moveaxis(Pc, 2, 0)),
-                         *zip(self.Pm, np.moveaxis(np.repeat(Pm, R.shape[1], 1), 2, 0))):
+            for f, v in (
+                (self.R, R),
+                (self.Lc, Lc),
+                (self.Rm, np.repeat(Rm, R.shape[1], 1)),
+                (self.Lm, np.repeat(Lm, R.shape[1], 1)),
+                *zip(self.gR, np.moveaxis(gR, 2, 0), strict=True),
+                *zip(self.Pc, np.moveaxis(Pc, 2, 0), strict=True),
+                *zip(self.Pm, np.moveaxis(np.repeat(Pm, R.shape[1], 1), 2, 0), strict=True),
+            ):
                 f.x.array[qs[star]] = v
             for f, v in zip([*self.gL, *self.gP], [*gL.T, *gP.reshape(-1, 4).T], strict=True):
                 f.x.array[c0[star]] = v
@@ -351,6 +368,10 @@ class UnfittedProblem(InterfaceProblem):
                        for k, seg in enumerate(segments)]  # fmt: skip
         self.area = self.cracks[0].area
         self.tip = _TipFields(mesh, X, self.area, self.cracks, n_owned)
+        c0 = _compat.cell_dofs(self.cracks[0].h_cut.function_space)[:, 0]
+        for k, crack in enumerate(self.cracks):  # Nitsche's parameter on the tips' pieces
+            near_tip = np.flatnonzero((self.tip.tags == k) & crack.cells.cut)
+            crack.h_cut.x.array[c0[near_tip]] /= TIP_NITSCHE
         K = len(self.cracks)
         tags = np.zeros(len(X), dtype=np.int32)
         touched = np.zeros(len(X), dtype=np.int32)  # cut, tip or star cells of a crack

@@ -33,7 +33,7 @@ def test_branch_function_values_and_gradient(angle, normal_sign):
     for i in range(2):
         step = np.zeros(2)
         step[i] = 1e-6
-        fd = (branch(pts + step, tip, e1, normal)[0] - branch(pts - step, tip, e1, normal)[0])
+        fd = branch(pts + step, tip, e1, normal)[0] - branch(pts - step, tip, e1, normal)[0]
         assert grad[:, i] == pytest.approx(fd / 2e-6, abs=1e-7)
     # on the crack behind the tip F = +-sqrt(r) and grad F = +-grad sqrt(r) = -+e1 / (2 sqrt r)
     for side in (1.0, -1.0):
