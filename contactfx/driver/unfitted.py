@@ -29,9 +29,10 @@ space, is not offered: the grid is not a finite element space of the mesh.
 
 Outputs: along the cracks, at their Gauss points, the aperture, slip, tractions and status
 (``interface.csv``, ``interface.png``); in the ParaView files u (with one crack u + H a, split
-along the cut cells' edges), each enrichment, the side fractions and the von Mises stress of
-u + sum H_k a_k (H_k the side of the larger part of each cell; on the star cells the tip
-nodes' a is read as a Heaviside amplitude there: the pictures' few cells around each tip).
+along the cut cells' edges), each enrichment (at a tip's node abs(F) a, its part of the
+displacement there), the side fractions and the von Mises stress of u + sum H_k a_k (H_k the
+side of the larger part of each cell; on the star cells that reads the tip nodes' F a as a
+Heaviside part: the picture's few cells around each tip).
 """
 
 from __future__ import annotations
@@ -241,12 +242,15 @@ class _TipFields:
         Q1 = _compat.function_space(mesh, "Lagrange", 1)
         dofs = _compat.cell_dofs(Q1)
         self.tags = np.full(len(X), -1, dtype=np.int32)
+        #: per crack: its tips (on their edges or nodes), the directions ahead, its normal
+        self.frames = []
         for k, crack in enumerate(cracks):
             cells = crack.cells
             node = _accumulate(Q1, cells.tip_nodes, dofs, n_owned) > 0.0
             flags = node[dofs]
             star = np.flatnonzero(np.any(flags, axis=1))
             seg = crack.segment
+            ahead = np.array([-seg.direction, seg.direction])
             # the tips on the edges or nodes that they are within the snap of (the same on
             # every rank: from the ranks that hold them)
             snap = SNAP * crack.h
@@ -254,10 +258,10 @@ class _TipFields:
                                         for p in (seg.p0, seg.p1)])  # fmt: skip
             ends = np.array([next((h[t] for h in held if not np.isnan(h[t][0])), p)
                              for t, p in enumerate((seg.p0, seg.p1))], float)  # fmt: skip
+            self.frames.append((ends, ahead, seg.normal))
             if len(star) == 0:
                 continue
             self.tags[star] = k
-            ahead = np.array([-seg.direction, seg.direction])
             centre = X[star].mean(axis=1)
             which = np.argmin(np.linalg.norm(centre[:, None] - ends[None], axis=2), axis=1)
             tips = ends[which]
@@ -761,7 +765,23 @@ class CutPost(InterfacePost):
         self.a_out = [dolfinx.fem.Function(V1, name=f"enrichment_{k + 1}")
                       for k in range(len(pb.cracks))]  # fmt: skip
         self.a_expr = [_compat.expression(c.enrichment(U), V1) for c in pb.cracks]
+        self._tip_scales = [self._tip_scale(V1, c, frame)
+                            for c, frame in zip(pb.cracks, pb.tip.frames, strict=True)]  # fmt: skip
         self.values: dict[str, np.ndarray] = {}
+
+    def _tip_scale(self, V1, crack, frame) -> np.ndarray:
+        """Per node of V1: abs(F) at a tip's node (the branch function there, F a_T its
+        enriched displacement), 1 elsewhere: the enrichment written for ParaView is then the
+        displacement's part at every node."""
+        dofs = _compat.cell_dofs(V1)
+        node = _accumulate(V1, crack.cells.tip_nodes, dofs, self.pb.n_owned_cells) > 0.0
+        scale = np.ones(len(node))
+        x = _compat.dof_coordinates(V1)[:, :2]
+        ends, ahead, normal = frame
+        for i in np.flatnonzero(node):
+            t = int(np.argmin(np.linalg.norm(ends - x[i], axis=1)))
+            scale[i] = abs(float(branch(x[i], ends[t], ahead[t], normal)[0]))
+        return scale
 
     def _evaluate_points(self) -> dict[str, np.ndarray]:
         """Every quantity at the Gauss points of the owned cut cells (flat arrays; ``crack``
@@ -812,8 +832,9 @@ class CutPost(InterfacePost):
 
     def fields(self) -> list:
         self.u_out.interpolate(self.u_expr)
-        for f, e in zip(self.a_out, self.a_expr, strict=True):
+        for f, e, scale in zip(self.a_out, self.a_expr, self._tip_scales, strict=True):
             f.interpolate(e)
+            f.x.array.reshape(-1, self.pb.gdim)[:] *= scale[:, None]
         self.vm.interpolate(self.vm_expr)
         return [self.u_out, *self.a_out, self.vm, *(c.fraction for c in self.pb.cracks)]
 
