@@ -307,7 +307,8 @@ class ContactSNES:
             name = key if key.startswith("contactfx_") else self.prefix + key
             opts[name] = _option_value(value)
 
-    #: the linear start's solves again with a larger MUMPS workspace (ICNTL(14) doubled)
+    #: the linear start's and the SNES solves again with a larger MUMPS workspace (ICNTL(14)
+    #: doubled), at most this many times
     MUMPS_RETRIES = 3
 
     #: Krylov iterations at most with a reused factorisation (then it is refactorised)
@@ -589,17 +590,35 @@ class ContactSNES:
     #: continued solves with the reversal guard before one without it (see _newton)
     GUARD_ROUNDS = 3
 
+    def _more_mumps_workspace(self, attempt: int) -> bool:
+        """After a SNES solve: whether its linear solve failed for MUMPS's workspace (in
+        parallel the delayed pivots, and so the workspace a factorisation needs, differ from
+        run to run) with retries left; then ICNTL(14) of the factor is doubled."""
+        ksp = self.snes.getKSP()
+        failed = self.snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+        if not failed or attempt == self.MUMPS_RETRIES or _mumps_error(ksp) not in _MUMPS_WORKSPACE:
+            return False
+        factor = ksp.getPC().getFactorMatrix()
+        factor.setMumpsIcntl(14, 2 * max(int(factor.getMumpsIcntl(14)), 20))
+        return True
+
     def _snes_solve(self, x: PETSc.Vec, before: SolveStats, max_it: int | None) -> SolveStats:
         """One SNES solve from x; the counts added to ``before``; raises on failure."""
         limit = self.snes.getTolerances()[3]
         if max_it is not None and max_it < limit:
             self.snes.setTolerances(max_it=max_it)
         xs = x if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
+        start = xs.copy()
         try:
-            self.snes.solve(None, xs)
+            for attempt in range(self.MUMPS_RETRIES + 1):
+                self.snes.solve(None, xs)
+                if not self._more_mumps_workspace(attempt):
+                    break
+                start.copy(xs)  # again from the start, with a larger workspace
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
             raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
         finally:
+            start.destroy()
             self.snes.setTolerances(max_it=limit)
             if self.reduced is not None:
                 self._sync(xs)  # into x = u
@@ -611,7 +630,14 @@ class ContactSNES:
                            ksp=before.ksp + self.snes.getLinearSolveIterations(),
                            reason=snes_reason_name(reason))  # fmt: skip
         if reason <= 0:
-            raise ConvergenceError(stats.reason, stats=stats)
+            message = stats.reason
+            if reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
+                ksp = self.snes.getKSP()
+                infog = _mumps_error(ksp)
+                message += f" (KSP {_reason_name(ksp.getConvergedReason())}" + (
+                    ")" if infog is None else f", MUMPS INFOG(1) = {infog})"
+                )
+            raise ConvergenceError(message, stats=stats)
         return stats
 
     def _law_converged(self, x: PETSc.Vec) -> bool:
