@@ -62,6 +62,7 @@ __all__ = [
     "WeightedMeasure",
     "cut_cells",
     "snapped_tips",
+    "vertex_distances",
     "cell_sizes",
     "near_cells",
     "CoarseGrid",
@@ -203,6 +204,15 @@ def _barycentric(X: np.ndarray, point: np.ndarray) -> np.ndarray:
     return np.column_stack([1.0 - lam.sum(axis=1), lam])
 
 
+def vertex_distances(X: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """(cells, 3): the point's signed distance to each vertex's opposite edge in each triangle
+    of X (its barycentric coordinate times the vertex's height; >= 0 inside)."""
+    e = [X[:, (i + 2) % 3] - X[:, (i + 1) % 3] for i in range(3)]
+    area2 = np.abs(e[0][:, 0] * e[1][:, 1] - e[0][:, 1] * e[1][:, 0])
+    height = area2[:, None] / np.stack([np.linalg.norm(ei, axis=1) for ei in e], axis=1)
+    return _barycentric(X, point) * height
+
+
 def _contains(X: np.ndarray, point: np.ndarray, tol: float) -> np.ndarray:
     """Whether each closed triangle of X contains the point (barycentric, within tol)."""
     return np.all(_barycentric(X, point) >= -tol, axis=1)
@@ -228,13 +238,10 @@ def cut_cells(X: np.ndarray, crack: CrackSegment, snap: float) -> CutCells:
     cut = has & inside & (~on_edge | plus_side)
     tip = touches & ~inside
     tip_nodes = np.zeros((len(X), 3), dtype=bool)
-    # each vertex's height over its opposite edge: a tip within ``snap`` of an edge or a node
-    # is on it, as a node within ``snap`` of the crack's line is
-    e = [X[:, (i + 2) % 3] - X[:, (i + 1) % 3] for i in range(3)]
-    area2 = np.abs(e[0][:, 0] * e[1][:, 1] - e[0][:, 1] * e[1][:, 0])
-    height = area2[:, None] / np.stack([np.linalg.norm(ei, axis=1) for ei in e], axis=1)
+    # a tip within ``snap`` of an edge or a node is on it, as a node within ``snap`` of the
+    # crack's line is
     for t in crack.tips():
-        dist = _barycentric(X, np.asarray(t, float)) * height
+        dist = vertex_distances(X, np.asarray(t, float))
         holds = np.all(dist >= -max(snap, 1e-10 * a), axis=1)
         # (a cell along the crack, cut or the -side's twin of an edge piece, is not a tip cell)
         tip |= holds & ~(has & inside)

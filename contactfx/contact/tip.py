@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from contactfx.contact.cut import vertex_distances
+
 __all__ = ["STAR_POINTS", "branch", "snapped_point", "star_rule", "tip_split"]
 
 #: the collapsed Gauss rule's points per direction: n x n points per triangle, three triangles
@@ -75,17 +77,14 @@ def snapped_point(X: np.ndarray, point: np.ndarray, snap: float) -> np.ndarray:
     """The point put on the edge or node of the first triangle of X (cells, 3, 2) that holds
     it, when it lies within ``snap`` of them (its barycentric coordinates there set to zero);
     NaN if no triangle holds it."""
-    e = [X[:, (i + 2) % 3] - X[:, (i + 1) % 3] for i in range(3)]
-    area2 = np.abs(e[0][:, 0] * e[1][:, 1] - e[0][:, 1] * e[1][:, 0])
-    height = area2[:, None] / np.stack([np.linalg.norm(ei, axis=1) for ei in e], axis=1)
-    A = np.stack([X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]], axis=2)
-    mu = np.linalg.solve(A, (point - X[:, 0])[:, :, None])[:, :, 0]
-    bary = np.column_stack([1.0 - mu.sum(axis=1), mu])
-    holds = np.flatnonzero(np.all(bary * height >= -snap, axis=1))
+    dist = vertex_distances(X, point)
+    holds = np.flatnonzero(np.all(dist >= -snap, axis=1))
     if len(holds) == 0:
         return np.full(2, np.nan)
     c = holds[0]
-    b = np.where(bary[c] * height[c] < snap, 0.0, bary[c])
+    # the barycentric coordinates are the distances times the opposite edges (over 2 |K|)
+    edges = np.linalg.norm(X[c, [2, 0, 1]] - X[c, [1, 2, 0]], axis=1)
+    b = np.where(dist[c] < snap, 0.0, dist[c]) * edges
     return b @ X[c] / b.sum()
 
 

@@ -211,8 +211,8 @@ class _TipFields:
     enrichment is Heaviside only. ``tags`` (cells,): crack k's star cells get k."""
 
     def __init__(self, mesh, X, area, cracks, n_owned: int) -> None:
-        self.slots = len(_compat.quadrature_rule(mesh, STAR_DEGREE)[1])
         ref_w = _compat.quadrature_rule(mesh, STAR_DEGREE)[1]
+        self.slots = len(ref_w)
         Qb = _compat.quadrature_space(mesh, STAR_DEGREE)
         Qs = _compat.quadrature_space(mesh, QUADRATURE_DEGREE)
         DG0 = _compat.function_space(mesh, "DG", 0)
@@ -222,8 +222,8 @@ class _TipFields:
         def functions(space, n):
             return [dolfinx.fem.Function(space) for _ in range(n)]
 
-        # the star rule: points (2), weight ratio, side, F, grad F (2), L, P (2)
-        self.Y, self.ratio, self.side = functions(Qb, 2), *functions(Qb, 2)
+        # the star rule: weight ratio, side, F, grad F (2), L, P (2)
+        self.ratio, self.side = functions(Qb, 2)
         self.F, self.gF = dolfinx.fem.Function(Qb), functions(Qb, 2)
         self.L, self.P = dolfinx.fem.Function(Qb), functions(Qb, 2)
         # the Gauss points (crack) and the midpoints (law): sqrt(r), grad sqrt(r), L, P
@@ -290,7 +290,6 @@ class _TipFields:
             Lm, Pm = Lm * cut[:, None], Pm * cut[:, None, None]
             ratio = w / (ref_w[None, :] * 2.0 * area[star, None])
             for f, v in ((self.ratio, ratio), (self.side, sides), (self.F, F), (self.L, L),
-                         *zip(self.Y, np.moveaxis(pts, 2, 0), strict=True),
                          *zip(self.gF, np.moveaxis(gF, 2, 0), strict=True),
                          *zip(self.P, np.moveaxis(P, 2, 0), strict=True)):  # fmt: skip
                 f.x.array[qb[star]] = v
@@ -328,8 +327,7 @@ class _TipFields:
         """The strain of w at the star rule's points, crack's enrichment split into its
         Heaviside part (with ``side``) and its tip part (with F); ``others``: the other
         cracks' (sign, enrichment) (constant sides here)."""
-        d = len(self.Y)
-        u = ufl.as_vector([X[i] for i in range(d)])
+        u = ufl.as_vector([X[i] for i in range(2)])
         a = crack.enrichment(X)
         gT = self.part_grad(a)
         aT = self.part(a, self.L, self.P)
@@ -579,7 +577,6 @@ class UnfittedProblem(InterfaceProblem):
                 return f + ufl.dot(ufl.grad(f), M - x)
 
             t, K = self.tip, len(self.cracks)
-            crack.at_crack = at_crack
             crack.ds = WeightedMeasure(dx((k + 1, K + 1 + k), metadata=rule), crack.weight)
             crack.s_coord = crack.coordinate(Y)
             self.surfaces.append(CutSurface(
@@ -778,9 +775,10 @@ class CutPost(InterfacePost):
         scale = np.ones(len(node))
         x = _compat.dof_coordinates(V1)[:, :2]
         ends, ahead, normal = frame
-        for i in np.flatnonzero(node):
-            t = int(np.argmin(np.linalg.norm(ends - x[i], axis=1)))
-            scale[i] = abs(float(branch(x[i], ends[t], ahead[t], normal)[0]))
+        nearest = np.argmin(np.linalg.norm(x[:, None] - ends[None], axis=2), axis=1)
+        for t in range(2):
+            on = node & (nearest == t)
+            scale[on] = np.abs(branch(x[on], ends[t], ahead[t], normal)[0])
         return scale
 
     def _evaluate_points(self) -> dict[str, np.ndarray]:
