@@ -593,13 +593,17 @@ class ContactSNES:
     def _more_mumps_workspace(self, attempt: int) -> bool:
         """After a SNES solve: whether its linear solve failed for MUMPS's workspace (in
         parallel the delayed pivots, and so the workspace a factorisation needs, differ from
-        run to run) with retries left; then ICNTL(14) of the factor is doubled."""
+        run to run) with retries left; then ICNTL(14) is doubled in the options of this
+        solver's prefix and the preconditioner reset, so that the next set-up makes a new
+        factor with it (ICNTL set on the failed factor itself is not read again)."""
         ksp = self.snes.getKSP()
         failed = self.snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
         if not failed or attempt == self.MUMPS_RETRIES or _mumps_error(ksp) not in _MUMPS_WORKSPACE:
             return False
-        factor = ksp.getPC().getFactorMatrix()
-        factor.setMumpsIcntl(14, 2 * max(int(factor.getMumpsIcntl(14)), 20))
+        pc = ksp.getPC()
+        workspace = 2 * max(int(pc.getFactorMatrix().getMumpsIcntl(14)), 20)
+        PETSc.Options()[self.prefix + "mat_mumps_icntl_14"] = workspace
+        pc.reset()
         return True
 
     def _snes_solve(self, x: PETSc.Vec, before: SolveStats, max_it: int | None) -> SolveStats:
