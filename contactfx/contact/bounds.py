@@ -6,7 +6,7 @@ The linearised (vertical) gap at the contact surface's dofs gives the upper boun
 u_d <= height(x_t + u_t - offset_t) - x_d + offset_d, evaluated at the reference position
 (x_t without u_t: small deformation), re-evaluated whenever the load program moves the
 obstacle. No contact term enters the residual; the contact pressure is the reaction
-K u - b at the bounded dofs, lumped by the surface's nodal mass.
+-R(u) = f_ext - f_int(u) at the bounded dofs, lumped by the surface's nodal mass.
 """
 
 from __future__ import annotations
@@ -54,12 +54,10 @@ class BoundConstraints(MethodBase):
 
     @staticmethod
     def reaction_pressure(solver, u, mass: np.ndarray, target) -> float:
-        """The nodal contact pressure from the reaction r = b - K u at the bounded component
-        (lumped by the surface's nodal ``mass`` of ``target``'s space) into ``target``; returns
-        the total contact force."""
-        r = solver.K.createVecLeft()
-        solver.K.mult(_compat.petsc_vec(u), r)
-        r.axpy(-1.0, solver.b)
+        """The nodal contact pressure from the reaction -R(u) = f_ext - f_int(u) of the bulk at
+        the bounded component (lumped by the surface's nodal ``mass`` of ``target``'s space)
+        into ``target``; returns the total contact force. ``u`` is the solver's state."""
+        r = solver.bulk_residual()
         gdim = u.function_space.mesh.geometry.dim
         reac = -r.getArray()[gdim - 1 :: gdim]
         vec = _compat.petsc_vec(target)

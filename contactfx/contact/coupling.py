@@ -7,9 +7,12 @@ A :class:`Coupling` is what a two-body method gives the nonlinear solver
 
 * ``update(u)``: the search at the current configuration (once per load step, or at every
   residual evaluation with ``--search-update newton``);
-* ``residual(u, F)``: on entry F holds the bulk residual K u - b (owned rows, before the
-  Dirichlet rows); the coupling adds to it or transforms it in place;
-* ``jacobian(u, K, J)``: J receives the Jacobian of that residual; K is the bulk stiffness;
+* ``residual(u, F)``: on entry F holds the bulk residual R(u) = f_int(u) - f_ext (owned rows,
+  before the Dirichlet rows; :mod:`contactfx.solvers.bulk`); the coupling adds to it or
+  transforms it in place;
+* ``jacobian(u, K, J, bulk_changed=...)``: J receives the Jacobian of that residual; K is the
+  bulk's Jacobian K(u), ``bulk_changed`` whether it may differ from the last call's (a
+  nonlinear bulk: products with K cached by the coupling are formed again);
 * ``missed(u)``: how many contact points a search at u would find that the last search did
   not (the solver searches again and continues Newton while there are any: a step's search
   at its start only reaches points about a facet size apart).
@@ -41,7 +44,9 @@ class Coupling(Protocol):
 
     def residual(self, u: PETSc.Vec, F: PETSc.Vec) -> None: ...
 
-    def jacobian(self, u: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None: ...
+    def jacobian(
+        self, u: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat, *, bulk_changed: bool = False
+    ) -> None: ...
 
     def missed(self, u) -> int: ...
 

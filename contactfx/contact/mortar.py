@@ -491,9 +491,15 @@ class MortarCoupling:
             CT = self._fric[0]
             out[rows[self.tmask]] = (self.D[:, None] * CT)[self.tmask]
 
-    def jacobian(self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None:
-        """At the x of the last residual (SNES evaluates F(x) before J(x))."""
+    def jacobian(
+        self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat, *, bulk_changed: bool = False
+    ) -> None:
+        """At the x of the last residual (SNES evaluates F(x) before J(x)); T K is formed
+        again after a search or when the bulk's Jacobian K changed."""
         da, db = self._da, self._db
+        if bulk_changed and self.TK is not None:
+            self.TK.destroy()
+            self.TK = None
         if self.TK is None:
             self.TK = self.T.matMult(K)
             union = self.TK.copy()

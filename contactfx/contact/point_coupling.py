@@ -336,7 +336,9 @@ class PointCoupling:
         F.assemblyBegin()
         F.assemblyEnd()
 
-    def jacobian(self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None:
+    def jacobian(
+        self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat, *, bulk_changed: bool = False
+    ) -> None:
         vals = self._gather(x)
         J.zeroEntries()
         J.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)

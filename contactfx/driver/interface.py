@@ -284,12 +284,12 @@ class InterfaceProblem(Problem):
             # absolute tolerance a little above the round-off of the loads: the start (bonded,
             # or the load-step predictor) can already be the solution, e.g. of a uniformly
             # compressed joint, and rtol then cannot be met
-            solver.snes.setTolerances(atol=1e-11 * solver.b.norm())
+            solver.set_tolerances(atol=1e-11 * solver.bulk.load.norm())
         if self.method.multiplier != "field" and not solver.user_sets("snes_stol"):
             # and a Newton step below 1e-12 of the displacement is converged too (the
             # residual's round-off floor grows with the conditioning, e.g. P2 on graded tips);
             # not for a multiplier field, whose unknown mixes displacements and multipliers
-            solver.snes.setTolerances(stol=1e-12)
+            solver.set_tolerances(stol=1e-12)
 
     def post_processor(self) -> InterfacePost:
         return InterfacePost(self)

@@ -22,8 +22,8 @@ from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json
 from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog
-from contactfx.solvers.loadstep import StepRecord, run_load_program
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
+from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 
 __all__ = ["run", "setup", "prepare_output"]
 
@@ -151,15 +151,20 @@ class _Run:
 
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem, forms) -> ContactSNES:
-        a, L, F_c, J_c = forms
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
         options.update(self.method.snes_options())
-        return ContactSNES(
-            problem.state, stiffness=a, load=L, contact_residual=F_c, contact_jacobian=J_c,
-            bcs=problem.bcs, prefix=self.prefix, options=options,
-            user_options=self.petsc_options, near_nullspace=self.num.solver == "gamg",
-            coupling=problem.coupling(), confined=problem.confined, iterate=problem.iterate,
+        t0 = time.perf_counter()
+        bulk = forms.bulk()
+        assembly = time.perf_counter() - t0
+        solver = ContactSNES(
+            problem.state, bulk=bulk, contact_residual=forms.contact_residual,
+            contact_jacobian=forms.contact_jacobian, bcs=problem.bcs, prefix=self.prefix,
+            options=options, user_options=self.petsc_options,
+            near_nullspace=self.num.solver == "gamg", coupling=problem.coupling(),
+            confined=problem.confined, iterate=problem.iterate,
         )  # fmt: skip
+        solver.timer.assembly += assembly
+        return solver
 
     # -- load program ----------------------------------------------------------------------
     def load_program(self, problem, solver, post) -> list[StepLog]:
@@ -175,14 +180,14 @@ class _Run:
 
             def on_step(rec: StepRecord) -> None:
                 quantities = post.evaluate(solver)
-                self.scene.on_step(problem, solver, rec.load, quantities)
+                self.scene.on_step(problem, solver, rec.time, quantities)
                 s = rec.stats
-                steps.append(StepLog(rec.step, rec.load, s.newton, s.ksp, s.outer,
+                steps.append(StepLog(rec.step, rec.time, s.newton, s.ksp, s.outer,
                                      rec.cutbacks, s.reason, s.coarse_newton,
                                      quantities))  # fmt: skip
                 if writer is not None:
                     with self.timed("output"):
-                        writer.write(rec.load, post.fields())
+                        writer.write(rec.time, post.fields())
                 problem.converged()
                 if isinstance(solver, NestedSolver):
                     solver.converged()
@@ -190,7 +195,7 @@ class _Run:
 
             t0 = time.perf_counter()
             a0 = solver.timer.assembly
-            run_load_program(solver, problem.apply_load, steps=self.num.steps, on_step=on_step)
+            march(QuasiStatic(self.num.steps), solver, problem.apply_load, on_step=on_step)
             total = time.perf_counter() - t0
         self.timings["assembly"] = solver.timer.assembly + self.timings.pop("chain_assembly", 0.0)
         if problem.coupling() is not None:  # two bodies: the coupling's share of the assembly

@@ -13,6 +13,9 @@ post-processing.
 from __future__ import annotations
 
 import dataclasses
+import functools
+from collections.abc import Callable
+from typing import NamedTuple
 
 import dolfinx
 import numpy as np
@@ -22,9 +25,19 @@ from mpi4py import MPI
 from contactfx import _compat
 from contactfx.contact.laws import reversal
 from contactfx.driver.fields import NodalProjection, at_nodes, confine, surface_mask, vertex_rule
+from contactfx.solvers.bulk import Bulk, LinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
-__all__ = ["Problem"]
+__all__ = ["Forms", "Problem"]
+
+
+class Forms(NamedTuple):
+    """What the solver is built from: the bulk (a callable that builds and assembles it), the
+    compiled contact residual and its Jacobian (None without contact terms in UFL)."""
+
+    bulk: Callable[[], Bulk]
+    contact_residual: object = None
+    contact_jacobian: object = None
 
 
 class Problem:
@@ -159,10 +172,9 @@ class Problem:
         return {"quadrature_degree": 2 * self.num.degree + 2}
 
     # -- forms ---------------------------------------------------------------------------
-    def forms(self):
-        """Compiled: the bulk bilinear form, the load, the contact residual and its consistent
-        Jacobian (None, None for a method without contact terms)."""
-        a = self.bulk_form()
+    def forms(self) -> Forms:
+        """The bulk (its compiled forms, assembled when called), the compiled contact residual
+        and its consistent Jacobian (None, None for a method without contact terms)."""
         L = self.scene.load(self.v_load, self.ds, self.tload)
         if L is None:
             L = (
@@ -172,11 +184,19 @@ class Problem:
         L = self.extra_load(L)
         # two bodies: no UFL surface, the contact terms are the solver's coupling
         F = None if self.surface is None else self.contact_residual()
-        compiled = [dolfinx.fem.form(a), dolfinx.fem.form(L)]
+        bulk = self.bulk(dolfinx.fem.form(L))
         if F is None:
-            return (*compiled, None, None)
+            return Forms(bulk, None, None)
         J = ufl.derivative(F, self.state, self.trial)
-        return (*compiled, dolfinx.fem.form(F), dolfinx.fem.form(J))
+        return Forms(bulk, dolfinx.fem.form(F), dolfinx.fem.form(J))
+
+    def bulk(self, load) -> Callable[[], Bulk]:
+        """The kind's bulk for the compiled load form ``load``, built (and assembled) when
+        called: a :class:`contactfx.solvers.bulk.LinearBulk` of :meth:`bulk_form`, the
+        bilinear form of small-strain elasticity. A kind with a nonlinear body returns a
+        :class:`contactfx.solvers.bulk.NonlinearBulk` of its residual form."""
+        return functools.partial(LinearBulk, stiffness=dolfinx.fem.form(self.bulk_form()),
+                                 load=load)  # fmt: skip
 
     def contact_residual(self):
         """The method's contact residual on the kind's surface (Newton's: ``newton_surface``)."""

@@ -257,16 +257,15 @@ class TwoBodyPost:
 
     def tangential_nodal_force(self, solver, local: np.ndarray) -> float:
         """sum_j |f_j - (n_j . f_j) n_j| / sum_j |n_j . f_j| over the slave contact nodes j
-        (nodes with a support left out: they carry its reaction too), with f_j = -(K u - b)_j
-        the force the contact exerts on node j, from the bulk residual, independent of the
-        multiplier. Frictionless contact transmits no tangential nodal force: this is the
-        solver's tolerance. nan without nodal normals (the Gauss-point couplings)."""
+        (nodes with a support left out: they carry its reaction too), with f_j = -R(u)_j the
+        force the contact exerts on node j, from the bulk residual R(u) = f_int(u) - f_ext,
+        independent of the multiplier. Frictionless contact transmits no tangential nodal
+        force: this is the solver's tolerance. nan without nodal normals (the Gauss-point
+        couplings)."""
         normals = getattr(self.pb.coupling(), "normal", None)
         if normals is None or solver is None:
             return float("nan")
-        R = solver.K.createVecLeft()
-        solver.K.mult(_compat.petsc_vec(solver.u), R)
-        R.axpy(-1.0, solver.b)
+        R = solver.bulk_residual()
         bs = self.pb.layout.bs
         f = -R.getArray().reshape(-1, bs)[local, : self.gdim]
         R.destroy()

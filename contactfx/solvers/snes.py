@@ -1,13 +1,15 @@
-"""PETSc SNES wrapper for contact problems with a linear bulk and a nonlinear contact boundary.
+"""PETSc SNES wrapper for contact problems: a bulk and a nonlinear contact boundary.
 
-The residual is split into the bulk part, linear in u for small-strain elasticity, and the
-contact part, which lives on the contact facets only:
+The residual is split into the bulk part (:mod:`contactfx.solvers.bulk`: the bodies' own
+equations) and the contact part, which lives on the contact facets only:
 
-    F(u) = K u - b + F_c(u),        J(u) = K + dF_c/du(u).
+    F(u) = R(u) + F_c(u),        J(u) = K(u) + dF_c/du(u),
 
-K is assembled once per run; every Newton iteration assembles only the boundary integrals,
-which makes an iteration cheap compared with a linear-elastic solve on the same mesh.
-Dirichlet conditions are imposed on the rows and columns of J (identity) and F (u - g).
+with R(u) = f_int(u) - f_ext and K(u) = d f_int / du. For a linear bulk K is assembled once per
+run and every Newton iteration assembles only the boundary integrals, which makes an iteration
+cheap compared with a linear-elastic solve on the same mesh; a nonlinear bulk is assembled at
+every iteration. Dirichlet conditions are imposed on the rows and columns of J (identity) and F
+(u - g).
 Bound constraints (SNES-VI, ``vinewtonrsls``) are supported for the reference solutions.
 
 Options live in PETSc's database under a deterministic prefix (``contactfx_<scene>_``); the
@@ -28,6 +30,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.solvers.bulk import Bulk
 
 __all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "ContactSNES",
            "time_limit", "owned_size", "owned_bc_dofs", "rigid_body_modes", "DEFAULT_OPTIONS",
@@ -201,10 +204,11 @@ def rigid_body_modes(V) -> PETSc.NullSpace:
 
 
 class ContactSNES:
-    """Newton (or SNES-VI) for F(u) = K u - b + F_c(u) = 0 with Dirichlet conditions.
+    """Newton (or SNES-VI) for F(u) = R(u) + F_c(u) = 0 with Dirichlet conditions.
 
-    Parameters are keyword-only: ``stiffness`` (bilinear form, compiled), ``load`` (linear
-    form, compiled), ``contact_residual`` / ``contact_jacobian`` (compiled forms, or None),
+    Parameters are keyword-only: ``bulk`` (a :class:`contactfx.solvers.bulk.Bulk` over u's
+    space: R(u) and K(u); the solver destroys it with itself), ``contact_residual`` /
+    ``contact_jacobian`` (compiled forms, or None),
     ``bcs`` (dolfinx DirichletBCs), ``prefix`` (PETSc options prefix), ``options`` (defaults,
     overridden by the command line), ``user_options`` (from the command line), ``confined``
     (those of ``bcs`` that confine a field to a surface: a multiplier or an interface
@@ -221,8 +225,7 @@ class ContactSNES:
         self,
         u: dolfinx.fem.Function,
         *,
-        stiffness,
-        load,
+        bulk: Bulk,
         contact_residual=None,
         contact_jacobian=None,
         bcs=(),
@@ -246,10 +249,9 @@ class ContactSNES:
         self.timer = Timer()
 
         t0 = time.perf_counter()
-        self.K = _compat.assemble_matrix(_compat.create_matrix(stiffness), stiffness)
-        self.load_form = load
-        self.b = _compat.create_vector(load)
-        self.J = self.K.duplicate(copy=True)
+        self.bulk = bulk
+        K = bulk.jacobian(_compat.petsc_vec(u))
+        self.J = K.duplicate(copy=True)
         if coupling is not None:  # couplings between the bodies' dofs appear with the search
             self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
         self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
@@ -262,7 +264,7 @@ class ContactSNES:
         if confined and coupling is None and not near_nullspace:
             keep = np.ones(n_owned, dtype=bool)
             keep[owned_bc_dofs(confined, n_owned)] = False
-            self.reduced = _Reduced(self.K, np.flatnonzero(keep), self._bc_rows)
+            self.reduced = _Reduced(K, np.flatnonzero(keep), self._bc_rows)
             self.J.destroy()
             self.J = self.reduced.K.duplicate(copy=True)
 
@@ -298,6 +300,14 @@ class ContactSNES:
         """Whether the user's options give ``key`` (a PETSc option name without the
         prefix), with or without this solver's prefix."""
         return bool({key, self.prefix + key} & set(self.user_options))
+
+    def tolerances(self) -> dict[str, float]:
+        """SNES's tolerances: ``rtol``, ``atol``, ``stol``, ``max_it``."""
+        return dict(zip(("rtol", "atol", "stol", "max_it"), self.snes.getTolerances(), strict=True))
+
+    def set_tolerances(self, **tolerances: float) -> None:
+        """Set some of SNES's tolerances (``rtol``, ``atol``, ``stol``, ``max_it``)."""
+        self.snes.setTolerances(**tolerances)
 
     def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
         opts = PETSc.Options()
@@ -338,10 +348,13 @@ class ContactSNES:
         """Keep an iterative solver's preconditioner (the AMG hierarchy, whose Galerkin
         products cost most of a Newton step) across Newton iterations: rebuild it at the
         first iteration of every solve, after a failed Krylov solve and after one that needed
-        more than AMG_REBUILD_IT iterations. The contact rows change between Newton
-        iterations, the bulk does not, so an earlier Jacobian's hierarchy still preconditions
-        well. No-op with a direct solver."""
+        more than AMG_REBUILD_IT iterations. With a bulk of constant Jacobian only the contact
+        rows change between Newton iterations, so an earlier Jacobian's hierarchy still
+        preconditions well. No-op with a direct solver or a bulk whose Jacobian changes (the
+        hierarchy is rebuilt at every iteration)."""
         if self.snes.getKSP().getPC().getType() in ("lu", "cholesky"):
+            return
+        if not self.bulk.constant_jacobian:
             return
         self._keep_preconditioner(self.AMG_REBUILD_IT)
 
@@ -381,9 +394,10 @@ class ContactSNES:
         uvec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     def assemble_load(self) -> None:
-        """Assemble b for the current load (call after the load program changed constants)."""
+        """Assemble f_ext for the current load (call after the load program changed
+        constants)."""
         t0 = time.perf_counter()
-        _compat.assemble_vector(self.b, self.load_form)
+        self.bulk.assemble_load()
         self.timer.assembly += time.perf_counter() - t0
 
     def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
@@ -406,9 +420,8 @@ class ContactSNES:
         self.timer.assembly += time.perf_counter() - t0
 
     def _unconstrained_residual(self, x: PETSc.Vec, F: PETSc.Vec, search: bool) -> None:
-        """F = K x - b + F_c(x), every row (the Dirichlet rows not replaced)."""
-        self.K.mult(x, F)
-        F.axpy(-1.0, self.b)
+        """F = R(x) + F_c(x), every row (the Dirichlet rows not replaced)."""
+        self.bulk.residual(x, F)
         if self._F_c is not None:
             _compat.assemble_vector(self.fc, self._F_c)
             F.axpy(1.0, self.fc)
@@ -421,12 +434,21 @@ class ContactSNES:
 
     def reactions(self) -> PETSc.Vec:
         """The forces the supports exert at the current (converged) u: at a solution
-        K u - b + F_c(u) vanishes on the free rows, and on a supported row it is the reaction.
+        R(u) + F_c(u) vanishes on the free rows, and on a supported row it is the reaction.
         Collective; the caller destroys the vector."""
         x = _compat.petsc_vec(self.u)
         self._sync(x)
-        R = self.K.createVecLeft()
+        R = self.bulk.create_vector()
         self._unconstrained_residual(x, R, search=False)
+        return R
+
+    def bulk_residual(self) -> PETSc.Vec:
+        """The bulk's residual R(u) = f_int(u) - f_ext at the current u, without the contact
+        terms: minus the force the contact (and the supports) exert on each dof. Collective;
+        the caller destroys the vector."""
+        x = _compat.petsc_vec(self.u)
+        R = self.bulk.create_vector()
+        self.bulk.residual(x, R)
         return R
 
     def _search(self) -> None:
@@ -441,12 +463,14 @@ class ContactSNES:
         t0 = time.perf_counter()
         self._sync(x)
         red = self.reduced
+        K = self.bulk.jacobian(_compat.petsc_vec(self.u))
         if self.coupling is not None:
             t1 = time.perf_counter()
-            self.coupling.jacobian(x, self.K, J)
+            self.coupling.jacobian(x, K, J, bulk_changed=not self.bulk.constant_jacobian)
             self.timer.contact += time.perf_counter() - t1
         else:
-            K = self.K if red is None else red.K
+            if red is not None:
+                K = red.K if self.bulk.constant_jacobian else red.bulk_block(K)
             K.copy(J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         if self._a_c is not None:
             _compat.assemble_matrix(self.Jc, self._a_c)
@@ -468,12 +492,15 @@ class ContactSNES:
             self.iterate.x.array[:] = self.u.x.array
 
     def solve_linear(self, free: np.ndarray, extra=None) -> None:
-        """u = the solution of (K + extra) u = b with the owned dofs not marked ``free`` (and
-        the Dirichlet dofs) fixed to zero, by this solver's linear solver (its options prefix
-        and the command line apply): a linear start for the Newton solve."""
+        """u = the solution of (K + extra) u = f_ext with the owned dofs not marked ``free``
+        (and the Dirichlet dofs) fixed to zero, by this solver's linear solver (its options
+        prefix and the command line apply): a linear start for the Newton solve (a linear bulk
+        only: K is the bulk's constant Jacobian)."""
+        if not self.bulk.constant_jacobian:
+            raise NotImplementedError("a linear start needs a linear bulk")
         rows = np.flatnonzero(~free).astype(np.int32)
         rows = np.union1d(rows, self._bc_rows).astype(np.int32)
-        A = self.K.copy()
+        A = self.bulk.jacobian(_compat.petsc_vec(self.u)).copy()
         if extra is not None:
             S = _compat.assemble_matrix(_compat.create_matrix(extra), extra)
             A.axpy(1.0, S, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
@@ -481,7 +508,7 @@ class ContactSNES:
         A.zeroRowsColumnsLocal(rows, diag=1.0)
         if self.nullspace is not None:
             A.setNearNullSpace(self.nullspace)
-        b = self.b.copy()
+        b = self.bulk.load.copy()
         b.getArray()[rows] = 0.0
         x = _compat.petsc_vec(self.u)
         opts = PETSc.Options()
@@ -690,7 +717,7 @@ class ContactSNES:
         return missed == 0
 
     def destroy(self) -> None:
-        for obj in (self.snes, self.K, self.J, self.P, self.Jc, self.b, self.fc, self.residual_vec):
+        for obj in (self.snes, self.bulk, self.J, self.P, self.Jc, self.fc, self.residual_vec):
             if obj is not None:
                 obj.destroy()
         if self.reduced is not None:
@@ -732,6 +759,11 @@ class _Reduced:
         """Set the owned kept entries of ``full`` (its confined entries stay zero)."""
         self.scatter.scatter(kept, full, addv=PETSc.InsertMode.INSERT,
                              mode=PETSc.ScatterMode.REVERSE)  # fmt: skip
+
+    def bulk_block(self, K: PETSc.Mat) -> PETSc.Mat:
+        """The kept rows and columns of a bulk Jacobian that changed (into ``self.K``)."""
+        self.K = K.createSubMatrix(self.rows, self.rows, submat=self.K)
+        return self.K
 
     def kept_block(self, A: PETSc.Mat) -> PETSc.Mat:
         """The kept rows and columns of A (a matrix of A's pattern, reused from call to

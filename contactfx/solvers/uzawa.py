@@ -59,14 +59,13 @@ class Uzawa:
         bs = self.multiplier.function_space.dofmap.index_map_bs
         mask = np.repeat(self.mask, bs) if bs > 1 else self.mask.copy()
         mask[imap.size_local * bs :] = False  # owned dofs decide; ghosts follow
-        snes = self.inner.snes
-        stol = snes.getTolerances()[2]
+        stol = self.inner.tolerances()["stol"]
         if not self.inner.user_sets("snes_stol"):
-            snes.setTolerances(stol=max(stol, self.STEP_TOL))
+            self.inner.set_tolerances(stol=max(stol, self.STEP_TOL))
         try:
             return self._iterate(lam, saved, mask, total)
         finally:
-            snes.setTolerances(stol=stol)
+            self.inner.set_tolerances(stol=stol)
 
     def _iterate(self, lam, saved, mask, total) -> SolveStats:
         for k in range(1, self.max_it + 1):

@@ -268,6 +268,7 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
     import dolfinx
 
     from contactfx import _compat
+    from contactfx.solvers.bulk import LinearBulk
     from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, owned_size
 
     mesh, facet_tags = scene.build_mesh(comm)
@@ -280,7 +281,7 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
     bcs = scene.dirichlet(V, facet_tags)
     comm.barrier()
     t0 = time.perf_counter()
-    linear = ContactSNES(dolfinx.fem.Function(V), stiffness=a, load=L, bcs=bcs,
+    linear = ContactSNES(dolfinx.fem.Function(V), bulk=LinearBulk(stiffness=a, load=L), bcs=bcs,
                          prefix="contactfx_linear_", near_nullspace=solver == "gamg",
                          options=GAMG_OPTIONS if solver == "gamg" else {})  # fmt: skip
     linear.assemble_load()

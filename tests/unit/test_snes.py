@@ -13,7 +13,8 @@ the first step the full residual is g(u_L) in the end row only): the iteration c
 predicted by a scalar Newton loop with the SNES stopping test of DEFAULT_OPTIONS.
 
 Tested: the root, the iteration count, ConvergenceError with the SNES reason, destroy()
-removing the prefixed options, and run_load_program (steps, secant predictor, cut-back).
+removing the prefixed options, and run_load_program (:mod:`contactfx.solvers.stepper`'s
+quasi-static program: steps, secant predictor, cut-back).
 Run at 1 and 2 ranks (values compared at the dof coordinates, reductions with allreduce).
 """
 
@@ -28,8 +29,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
-from contactfx.solvers.loadstep import run_load_program
+from contactfx.solvers.bulk import LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import DEFAULT_OPTIONS, ContactSNES, ConvergenceError
+from contactfx.solvers.stepper import run_load_program
 
 COMM = MPI.COMM_WORLD
 L, N, E, F, K = 1.0, 4, 1.0, 3.0, 4.0
@@ -75,8 +77,10 @@ def tolerance(f0):
     return L / E * np.sqrt(N + 1) * max(ATOL, RTOL * f0) + 1e-14
 
 
-def make_solver(prefix, **kwargs):
-    """(ContactSNES, u, load factor Constant) of the bar; kwargs go to ContactSNES."""
+def make_solver(prefix, bulk="linear", **kwargs):
+    """(ContactSNES, u, load factor Constant) of the bar; kwargs go to ContactSNES. ``bulk``:
+    its linear part as a LinearBulk (``"linear"``) or as the residual form of a NonlinearBulk,
+    assembled at every iteration (``"nonlinear"``) or once (``"constant"``)."""
     mesh = _compat.create_interval(COMM, N, L)
     V = _compat.function_space(mesh, "Lagrange", 1)
     u, v, du = dolfinx.fem.Function(V), ufl.TestFunction(V), ufl.TrialFunction(V)
@@ -87,10 +91,18 @@ def make_solver(prefix, **kwargs):
     bc = _compat.dirichletbc(PETSc.ScalarType(0.0), _compat.locate_dofs_topological(V, 0, left), V)
     t = dolfinx.fem.Constant(mesh, PETSc.ScalarType(1.0))
     Fc = K * u**3 * v * ds(2)
+    load = dolfinx.fem.form(t * F * v * ufl.dx)
+    if bulk == "linear":
+        a = E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx
+        bulk = LinearBulk(stiffness=dolfinx.fem.form(a), load=load)
+    else:
+        f_int = E * ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx
+        bulk = NonlinearBulk(internal=dolfinx.fem.form(f_int),
+                             tangent=dolfinx.fem.form(ufl.derivative(f_int, u, du)), load=load,
+                             constant_jacobian=bulk == "constant")  # fmt: skip
     solver = ContactSNES(
         u,
-        stiffness=dolfinx.fem.form(E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx),
-        load=dolfinx.fem.form(t * F * v * ufl.dx),
+        bulk=bulk,
         contact_residual=dolfinx.fem.form(Fc),
         contact_jacobian=dolfinx.fem.form(ufl.derivative(Fc, u, du)),
         bcs=[bc],
@@ -110,13 +122,24 @@ def nodal_error(u, t):
     return COMM.allreduce(err.max(initial=0.0), op=MPI.MAX)
 
 
-def test_root_and_newton_count():
-    solver, u, t = make_solver("cfx_unit_root_")
+@pytest.mark.parametrize("bulk", ["linear", "nonlinear", "constant"])
+def test_root_and_newton_count(bulk):
+    """The same root and counts whether the bulk is assembled once or at every iteration."""
+    solver, u, t = make_solver(f"cfx_unit_root_{bulk}_", bulk)
     solver.assemble_load()
     stats = solver.solve()
+    R = solver.reactions()
+    n = u.function_space.dofmap.index_map.size_local
+    at_support = np.isclose(_compat.dof_coordinates(u.function_space)[:n, 0], 0.0)
+    reaction = COMM.allreduce(float(R.getArray()[at_support].sum()), op=MPI.SUM)
+    R.destroy()
     solver.destroy()
     assert stats.reason.startswith("CONVERGED_FNORM")
     assert nodal_error(u, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+    # the support carries the load F L less the spring's K u_L^3 (equilibrium of the whole
+    # bar): the sum of all rows of the residual, the free ones each below the SNES tolerance
+    f0 = f0_from_zero(1.0)
+    assert abs(reaction + F * L - K * root(1.0) ** 3) < np.sqrt(N) * max(ATOL, RTOL * f0) + 1e-14
     # Newton on g from 0: the first step gives the spring-free u_L = 1.5, then g is convex and
     # increasing, so the iterates fall monotonically onto the root (0.607), the error shrinking
     # by >= 1/3 a step and quadratically at the end: the scalar loop needs 7 steps (<= 8), and
@@ -262,8 +285,10 @@ def test_confined_field_leaves_the_system():
     Fc = lam * v[0] * ds(2) + (lam - K * u[0] ** 3) * mu * ds(2)
     solver = ContactSNES(
         w,
-        stiffness=dolfinx.fem.form(E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx),
-        load=dolfinx.fem.form(F * v[0] * ufl.dx),
+        bulk=LinearBulk(
+            stiffness=dolfinx.fem.form(E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx),
+            load=dolfinx.fem.form(F * v[0] * ufl.dx),
+        ),
         contact_residual=dolfinx.fem.form(Fc),
         contact_jacobian=dolfinx.fem.form(ufl.derivative(Fc, w, dw)),
         bcs=[bc, *confined],

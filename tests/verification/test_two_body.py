@@ -286,8 +286,8 @@ def _jacobian_check(scene, num, displace):
     from contactfx.solvers.snes import ContactSNES
 
     pb = setup(scene, num)
-    a, L, _, _ = pb.forms()
-    solver = ContactSNES(pb.state, stiffness=a, load=L, bcs=[], prefix=f"fd_{num.method}_",
+    forms = pb.forms()
+    solver = ContactSNES(pb.state, bulk=forms.bulk(), bcs=[], prefix=f"fd_{num.method}_",
                          coupling=pb.coupling())  # fmt: skip
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     rng = np.random.default_rng(7)
@@ -500,8 +500,8 @@ def test_mortar_slip_is_objective_under_translation():
 
     scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
     pb = setup(scene, Numerics(method="mortar", friction="coulomb", mu=0.3))
-    a, L, _, _ = pb.forms()
-    solver = ContactSNES(pb.state, stiffness=a, load=L, bcs=[], prefix="objective_",
+    forms = pb.forms()
+    solver = ContactSNES(pb.state, bulk=forms.bulk(), bcs=[], prefix="objective_",
                          coupling=pb.coupling())  # fmt: skip
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     X = pb.layout.X.getArray().reshape(-1, 2)

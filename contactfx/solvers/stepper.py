@@ -1,0 +1,250 @@
+"""Steppers: the program over time that calls the nonlinear solver once per step.
+
+:func:`march` is the one stepping loop: ask the stepper for the next time, let it predict the
+step's start, set the loads for that time, solve, and on success let the stepper accept the
+step (its history moves on), on failure let it cut the step back (it restores everything it
+owns) or give up. What a step's history is belongs to the stepper:
+
+* :class:`QuasiStatic`: the load factors t = 1/steps, ..., 1 (a quasi-static run's time is its
+  load factor), a secant predictor through the last two converged states, cut-back by
+  halving;
+* a dynamic stepper (Newmark, HHT-alpha, generalised-alpha) holds (u, v, a), predicts from
+  them, restores all three on a cut-back, and asks the solver's bulk to assemble again when
+  its step size changes (the effective stiffness K + c M depends on it).
+
+The state a stepper restores is a :class:`Snapshot` of PETSc vectors (the unknown and any
+other field: velocities, accelerations, multipliers): one copy per field, taken at each
+accepted step.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
+
+__all__ = ["StepRecord", "Snapshot", "Stepper", "QuasiStatic", "march", "run_load_program"]
+
+
+@dataclass
+class StepRecord:
+    """A converged step: its number (from 1), the time it ends at (a quasi-static run: the
+    load factor), its size, the solve's counts and the cut-backs it needed."""
+
+    step: int
+    time: float
+    dt: float
+    stats: SolveStats
+    cutbacks: int
+
+    @property
+    def load(self) -> float:
+        """The load factor of a quasi-static step (its time)."""
+        return self.time
+
+
+class Snapshot:
+    """Copies of ``fields`` (the ghosted PETSc vectors of Functions): :meth:`save` takes them,
+    :meth:`restore` puts them back (ghosts updated, so every rank sees the same state)."""
+
+    def __init__(self, fields: Sequence[PETSc.Vec]) -> None:
+        self.fields = list(fields)
+        self.copies = [f.copy() for f in self.fields]
+
+    def save(self) -> None:
+        for field, copy in zip(self.fields, self.copies, strict=True):
+            field.copy(copy)
+
+    def restore(self) -> None:
+        for field, copy in zip(self.fields, self.copies, strict=True):
+            copy.copy(field)
+            _ghost_update(field)
+
+    def destroy(self) -> None:
+        for copy in self.copies:
+            copy.destroy()
+
+
+class Stepper(Protocol):
+    """What :func:`march` asks of a program over time (see the module docstring)."""
+
+    #: accepted steps so far
+    step: int
+
+    def start(self, x: PETSc.Vec) -> None:
+        """Before the first step: ``x`` is the unknown (its value the starting iterate)."""
+
+    def done(self) -> bool:
+        """Whether the program has reached its end."""
+
+    def next_time(self) -> float:
+        """The time the next step ends at (with the current step size)."""
+
+    def predict(self) -> None:
+        """Set the unknown (and the stepper's other fields) to the next step's start."""
+
+    def accept(self, stats: SolveStats) -> StepRecord:
+        """The step converged: it becomes the history of the next."""
+
+    def cut_back(self) -> bool:
+        """The step failed: a smaller step (True) or no more cut-backs (False)."""
+
+    def restore(self) -> None:
+        """Put back the state of the last accepted step (before an error propagates)."""
+
+    def describe(self, t: float) -> str:
+        """Where the program is at time t, for messages ('load factor 0.5')."""
+
+    def destroy(self) -> None: ...
+
+
+class QuasiStatic:
+    """Load factors t = 1/steps, 2/steps, ..., 1.
+
+    Each step but the first starts from the secant extrapolation of the last two converged
+    states, the unloaded state u = 0 at t = 0 being the first of them (not the starting
+    iterate: that is a guess of the first step's solution, and a secant through it can carry a
+    stiffly enforced contact off its obstacle everywhere, where the Jacobian is singular). A
+    failed step is retried with half the increment, up to ``max_cutbacks`` halvings in a row,
+    and never below 1 / (steps 4^max_cutbacks) (the increment grows back only after a step
+    that needed no cut-back, so without a floor steps that each fail once would shrink it
+    without end). ``fields``: other (ghosted) vectors restored with the unknown on a cut-back (each
+    step starts them from their last converged value).
+    """
+
+    def __init__(
+        self, steps: int, *, max_cutbacks: int = 6, fields: Sequence[PETSc.Vec] = ()
+    ) -> None:
+        if steps < 1:
+            raise ValueError(f"load steps must be >= 1, got {steps}")
+        self.steps, self.max_cutbacks, self.fields = steps, max_cutbacks, list(fields)
+        self.step = 0
+
+    def start(self, x: PETSc.Vec) -> None:
+        self.x = x
+        self.previous = Snapshot([x, *self.fields])  # the last converged state
+        self.older = x.duplicate()  # the one before, for the secant predictor: u = 0 at t = 0
+        self.older.set(0.0)
+        self.t_prev = self.t_older = 0.0
+        self.dt = 1.0 / self.steps
+        self.dt_min = self.dt / 4**self.max_cutbacks
+        self.cutbacks = 0
+        self.step = 0
+
+    def done(self) -> bool:
+        return self.t_prev >= 1.0 - 1e-12
+
+    def next_time(self) -> float:
+        self.t = min(1.0, self.t_prev + self.dt)
+        return self.t
+
+    def predict(self) -> None:
+        """x = previous + factor (previous - older): the secant extrapolation of the last two
+        converged states (previous alone, factor 0, in the first step: before it, previous
+        is the starting iterate); the other fields at their last converged values."""
+        t, t_prev = self.t, self.t_prev
+        factor = (t - t_prev) / (t_prev - self.t_older) if self.step > 0 else 0.0
+        x, previous = self.x, self.previous.copies[0]
+        previous.copy(x)
+        if factor != 0.0:
+            x.axpy(factor, previous)
+            x.axpy(-factor, self.older)
+        _ghost_update(x)
+        for field, copy in zip(self.fields, self.previous.copies[1:], strict=True):
+            copy.copy(field)
+            _ghost_update(field)
+
+    def accept(self, stats: SolveStats) -> StepRecord:
+        if self.step > 0:
+            self.previous.copies[0].copy(self.older)
+        self.step += 1
+        self.previous.save()
+        self.t_older, self.t_prev = self.t_prev, self.t
+        record = StepRecord(
+            step=self.step,
+            time=self.t,
+            dt=self.t - self.t_older,
+            stats=stats,
+            cutbacks=self.cutbacks,
+        )
+        if self.cutbacks == 0:
+            self.dt = min(1.0 / self.steps, 2.0 * self.dt)
+        self.cutbacks = 0
+        return record
+
+    def cut_back(self) -> bool:
+        self.cutbacks += 1
+        if self.cutbacks > self.max_cutbacks or 0.5 * self.dt < self.dt_min * (1.0 - 1e-12):
+            return False
+        self.dt *= 0.5
+        return True
+
+    def restore(self) -> None:
+        self.previous.restore()
+
+    def describe(self, t: float) -> str:
+        return f"load factor {t:.6g}"
+
+    def destroy(self) -> None:
+        self.previous.destroy()
+        self.older.destroy()
+
+
+def march(
+    stepper: Stepper,
+    solver,
+    apply_load: Callable[[float], None],
+    *,
+    on_step: Callable[[StepRecord], None] | None = None,
+) -> list[StepRecord]:
+    """Run ``stepper``'s program with ``solver`` (any solver of the :class:`ContactSNES`
+    shape: ``u``, ``assemble_load()``, ``solve()``); ``apply_load(t)`` sets the loads'
+    constants (obstacle position, tractions) for time t, ``on_step`` sees each converged
+    step. When the stepper gives up, ``ConvergenceError`` names the SNES reason, the step
+    and the time, with the last converged state restored."""
+    records: list[StepRecord] = []
+    stepper.start(_compat.petsc_vec(solver.u))
+    try:
+        while not stepper.done():
+            t = stepper.next_time()
+            stepper.predict()
+            apply_load(t)
+            solver.assemble_load()
+            try:
+                stats = solver.solve()
+            except TimeLimitExceeded:
+                stepper.restore()
+                raise TimeLimitExceeded(f" at {stepper.describe(t)}") from None
+            except ConvergenceError as err:
+                if not stepper.cut_back():
+                    stepper.restore()
+                    raise ConvergenceError(err.reason, stepper.step + 1, t) from None
+                continue
+            record = stepper.accept(stats)
+            records.append(record)
+            if on_step is not None:
+                on_step(record)
+    finally:
+        stepper.destroy()
+    return records
+
+
+def run_load_program(
+    solver,
+    apply_load: Callable[[float], None],
+    *,
+    steps: int,
+    on_step: Callable[[StepRecord], None] | None = None,
+    max_cutbacks: int = 6,
+) -> list[StepRecord]:
+    """:func:`march` over the :class:`QuasiStatic` load factors 1/steps, ..., 1."""
+    return march(QuasiStatic(steps, max_cutbacks=max_cutbacks), solver, apply_load, on_step=on_step)
+
+
+def _ghost_update(x: PETSc.Vec) -> None:
+    x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
