@@ -170,7 +170,7 @@ class InterfaceSurface(SurfaceData):
     def effective_pressure(self):
         """s' = -(n . sigma n + p_f): the normal stress the faces (or the joint) carry."""
         n = self.normal()
-        return -self.sigma_n(self.stress, n)
+        return -self.traction_n(n)
 
     def gap(self, w=None):
         """opening - proppant floor (+ joint closure psi(s'))."""

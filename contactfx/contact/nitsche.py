@@ -15,8 +15,8 @@ the threshold for Tresca) and the traction on the body t(u) = -P_n n + P_T, the 
 (Chouly, Hild & Renard 2015, doi:10.1090/S0025-5718-2014-02913-X, frictionless; Chouly 2014,
 doi:10.1016/j.jmaa.2013.10.046, Tresca; Chouly, Hild, Lleras & Renard 2022,
 doi:10.1016/j.cam.2022.114557, Coulomb). theta = 1 symmetric, 0 incomplete, -1 skew.
-sigma(u) and sigma(v) are the stresses of the state and of the test functions
-(``ContactSurface.stress`` / ``stress_test``): in the mixed u-p formulation sigma(u, p) =
+sigma(u) n and sigma(v) n are the tractions of the state and of the test functions
+(``Surface.traction`` / ``traction_test``): in the mixed u-p formulation sigma(u, p) =
 2 mu eps(u) - p I and sigma(v, q) with the pressure test function q, which keeps the method
 consistent (the exact (u, p) satisfies R = 0 for every theta).
 Without friction only the normal terms are built. Here gamma_N = gamma0 E / h with gamma0
@@ -61,29 +61,29 @@ class Nitsche(TrialFriction, MethodBase):
 
     def pressure(self, s: Surface):
         n = s.normal()
-        return positive_part(-s.sigma_n(s.stress, n) - self.gamma(s) * s.gap())
+        return positive_part(-s.traction_n(n) - self.gamma(s) * s.gap())
 
     def _trial_t(self, s: Surface):
         """The trial tangential traction sigma_T(u) - gamma_N du_T."""
         n = s.normal()
-        return s.sigma_t(s.stress, n) - self.gamma(s) * s.slip_increment(n)
+        return s.traction_t(n) - self.gamma(s) * s.slip_increment(n)
 
     def residual(self, s: Surface):
         n = s.normal()
         gamma = self.gamma(s)
-        sn_u = s.sigma_n(s.stress, n)
-        sn_v = s.sigma_n(s.stress_test, n)
+        sn_u = s.traction_n(n)
+        sn_v = s.traction_n(n, test=True)
         p = self.pressure(s)
         form = p * (ufl.dot(s.v, n) - self.theta / gamma * sn_v) * s.ds
         if self.theta != 0:
             form -= self.theta / gamma * sn_u * sn_v * s.ds
         if s.friction is not None:
-            st_v = s.sigma_t(s.stress_test, n)
+            st_v = s.traction_t(n, test=True)
             t_T = self.tangential_traction(s)
             # t_T is tangential: t_T . v = t_T . (I - n n) v
             form -= ufl.dot(t_T, s.v - self.theta / gamma * st_v) * s.ds
             if self.theta != 0:
-                form -= self.theta / gamma * ufl.dot(s.sigma_t(s.stress, n), st_v) * s.ds
+                form -= self.theta / gamma * ufl.dot(s.traction_t(n), st_v) * s.ds
         return form
 
     def coupling(self, pair):

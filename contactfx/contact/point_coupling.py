@@ -41,6 +41,7 @@ from petsc4py import PETSc
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
 from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
+from contactfx.mechanics.elasticity import basis_tractions
 
 __all__ = ["PointCoupling", "Law"]
 
@@ -177,8 +178,9 @@ class PointCoupling:
                             axis=1).reshape(len(xq), (d + 1 + d) * gdim)  # fmt: skip
         E, lmbda, mu = (dr.lame[facet, i] for i in range(3))
         grads = dr.grads[facet]  # (P, d + 1, gdim)
-        gn = np.einsum("pag,pg->pa", grads, n)
-        S = lmbda[:, None, None] * grads + 2.0 * mu[:, None, None] * gn[:, :, None] * n[:, None, :]
+        # sigma(N_a e_c) n of the slave cell's basis (the material's Hooke's law)
+        traction = basis_tractions(grads, n, lmbda, mu)  # (P, d + 1, gdim, gdim)
+        S = np.einsum("pacg,pg->pac", traction, n)  # n . sigma(N_a e_c) n
         S = np.concatenate([S, np.zeros((len(xq), d, gdim))], axis=1).reshape(
             len(xq), (d + 1 + d) * gdim
         )
@@ -194,15 +196,8 @@ class PointCoupling:
             Jvec = (Nfull[:, :, None, None] * np.eye(gdim)[None, None]).reshape(
                 len(xq), (d + 1 + d) * gdim, gdim
             )
-            # sigma(N_a e_c) n = lambda d_c N_a n + mu ((grad N_a . n) e_c + grad N_a n_c),
-            # tangential part (I - n n) of it; zero on the master's rows
-            sn = lmbda[:, None, None, None] * grads[:, :, :, None] * n[:, None, None, :] + mu[
-                :, None, None, None
-            ] * (
-                gn[:, :, None, None] * np.eye(gdim)[None, None]
-                + n[:, None, :, None] * grads[:, :, None, :]
-            )
-            ST = np.einsum("pacg,phg->pach", sn, P_T).reshape(len(xq), (d + 1) * gdim, gdim)
+            # the tangential part (I - n n) sigma(N_a e_c) n; zero on the master's rows
+            ST = np.einsum("pacg,phg->pach", traction, P_T).reshape(len(xq), (d + 1) * gdim, gdim)
             ST = np.concatenate([ST, np.zeros((len(xq), d * gdim, gdim))], axis=1)
             extra = dict(Jvec=Jvec, ST=ST, P_T=P_T)
         # a tie (the law's argument at round-off, as on coinciding flat surfaces at the start)

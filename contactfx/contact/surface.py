@@ -18,36 +18,27 @@ import ufl
 
 from contactfx.contact.laws import Friction, tangential
 
-__all__ = ["Expr", "Surface", "SurfaceData", "sigma_n", "sigma_t"]
+__all__ = ["Expr", "Surface", "SurfaceData"]
 
 #: a UFL expression (a Function, a component of a mixed one, a test function, a Constant)
 Expr = ufl.core.expr.Expr
 
 
-def sigma_n(stress, n):
-    """Normal stress n . stress n (< 0 in compression)."""
-    return ufl.dot(n, ufl.dot(stress, n))
-
-
-def sigma_t(stress, n):
-    """Tangential traction (I - n n) stress n."""
-    return tangential(ufl.dot(stress, n), n)
-
-
 @runtime_checkable
 class Surface(Protocol):
     """u, v: relative motion of the state and of the test functions; ds: the contact measure
-    (``ds_nodal`` the same with the vertex rule); stress / stress_test: the stress of the state
-    and of the test functions at the surface; E: modulus scaling the method parameters; h: local
-    mesh size; friction: the friction law or None; multiplier / multiplier_test: a method's
-    multiplier (None without one)."""
+    (``ds_nodal`` the same with the vertex rule); traction(n) / traction_test(n): the traction
+    of the state on a plane of unit normal n at the surface and its directional derivative in
+    the direction of the test functions (the material's :meth:`contactfx.mechanics.material.
+    Material.traction` and ``traction_derivative``; ``traction_n`` / ``traction_t`` their
+    normal and tangential parts); E: modulus scaling the method parameters; h: local mesh size;
+    friction: the friction law or None; multiplier / multiplier_test: a method's multiplier
+    (None without one)."""
 
     u: Any
     v: Any
     ds: ufl.Measure
     ds_nodal: ufl.Measure | None
-    stress: Any
-    stress_test: Any
     E: float
     h: Any
     friction: Friction | None
@@ -57,6 +48,14 @@ class Surface(Protocol):
     def gap(self, w=None) -> Any: ...
 
     def normal(self, w=None) -> Any: ...
+
+    def traction(self, n) -> Any: ...
+
+    def traction_test(self, n) -> Any: ...
+
+    def traction_n(self, n, test: bool = False) -> Any: ...
+
+    def traction_t(self, n, test: bool = False) -> Any: ...
 
     def slip_increment(self, n) -> Any: ...
 
@@ -98,8 +97,28 @@ class SurfaceData:
     #: jitter of the cell sizes at every refinement
     h_nodal: Expr | None = None
 
-    sigma_n = staticmethod(sigma_n)
-    sigma_t = staticmethod(sigma_t)
+    # the stress tensors of the state and of the test functions (``stress`` / ``stress_test``:
+    # fields or properties of each surface, from its kind's material) are the surface's own
+    # business; the methods read tractions
+    def traction(self, n):
+        """The traction of the state on a plane of unit normal n: S(u) n (small strain
+        sigma(u) n; finite strain the first Piola traction P(F) N, n the reference normal)."""
+        return ufl.dot(self.stress, n)
+
+    def traction_test(self, n):
+        """The directional derivative of :meth:`traction` in the direction of the test
+        functions (small strain: sigma(v) n, linear in v)."""
+        return ufl.dot(self.stress_test, n)
+
+    def traction_n(self, n, test: bool = False):
+        """Normal traction n . t (< 0 in compression), of the state or (``test``) of the test
+        functions."""
+        return ufl.dot(n, self.traction_test(n) if test else self.traction(n))
+
+    def traction_t(self, n, test: bool = False):
+        """Tangential traction (I - n n) t, of the state or (``test``) of the test
+        functions."""
+        return tangential(self.traction_test(n) if test else self.traction(n), n)
 
     @property
     def mesh(self):

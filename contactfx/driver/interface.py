@@ -125,9 +125,10 @@ class InterfaceProblem(Problem):
         self.s_coord = scene.coordinate(ufl.SpatialCoordinate(mesh))
         self.fluid_value = scene.fluid_pressure()
         self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
-        sigma = self.material.sigma
+        mat = self.material
         return InterfaceSurface(
-            self.w, self.v_load, self.H, self.dSc, sigma(self.w), sigma(self.v_load),
+            self.w, self.v_load, self.H, self.dSc, mat.weak_stress(self.w),
+            mat.weak_stress_derivative(self.w, None, self.v_load),
             scene.contact_modulus(), self.h, floor=scene.floor(self.s_coord), fluid=self.fluid,
             joint=scene.joint(), friction=self.friction,
             u_prev=None if self.prev is None else self.total(self.previous()),
@@ -261,7 +262,7 @@ class InterfaceProblem(Problem):
         """The multipliers' start on the surface s: the traction (with friction) or the
         compressive normal stress of the start's state."""
         if self.mult_shape:
-            return ufl.dot(s.stress, s.normal())
+            return s.traction(s.normal())
         return positive_part(s.effective_pressure())
 
     def _start_multiplier(self) -> None:

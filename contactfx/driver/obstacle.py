@@ -39,6 +39,7 @@ class ObstacleProblem(Problem):
     """A body against a rigid obstacle (see the module docstring)."""
 
     nested = True
+    nonlinear_bulk = True
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
@@ -67,7 +68,7 @@ class ObstacleProblem(Problem):
         return supports + self.confine_multiplier(supports=supports)
 
     def make_surface(self) -> ContactSurface:
-        mesh, scene = self.mesh, self.scene
+        mesh, scene, mat = self.mesh, self.scene, self.material
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
         self.dsc = self.ds(scene.contact_tag, metadata=self.contact_rule())
         self.dsc_fine = self.ds(scene.contact_tag, metadata={"quadrature_degree": 12})
@@ -78,7 +79,8 @@ class ObstacleProblem(Problem):
         self.v_load = self.V_test
         return ContactSurface(
             self.U, self.V_test, self.dsc, self.obstacle, self.offset,
-            self.sigma(self.U, self.p), self.sigma(self.V_test, self.q),
+            mat.weak_stress(self.U, self.p),
+            mat.weak_stress_derivative(self.U, self.p, self.V_test, self.q),
             scene.contact_modulus(), self.h, friction=self.friction,
             u_prev=None if self.prev is None else self.previous(),
             offset_prev=self.offset_prev, traction_prev=self.t_prev,
@@ -89,16 +91,27 @@ class ObstacleProblem(Problem):
     def nodal_rule(self):
         return self.ds(self.scene.contact_tag, metadata=vertex_rule(self.fdim)), None
 
-    def sigma(self, u, p):
-        return self.material.sigma(u, p)
-
     def bulk_form(self):
-        a = ufl.inner(self.sigma(self.dU, self.dp), ufl.sym(ufl.grad(self.V_test))) * ufl.dx
+        eps_v = ufl.sym(ufl.grad(self.V_test))
+        a = ufl.inner(self.material.sigma(self.dU, self.dp), eps_v) * ufl.dx
         if self.up:
             a += self.material.pressure_law(self.dU, self.dp, self.q) * ufl.dx
-        if self.method.multiplier == "field":
-            a += zero_pattern(self.mesh, self.trial, self.test, [(ufl.dx, lambda f: f)])
-        return a
+        pattern = self.tangent_pattern()
+        return a if pattern is None else a + pattern
+
+    def internal_form(self):
+        """int S(u, p) : grad v dx (+ the pressure's law, mixed u-p): the material's weak
+        stress."""
+        f = ufl.inner(self.material.weak_stress(self.U, self.p), ufl.grad(self.V_test)) * ufl.dx
+        if self.up:
+            f += self.material.pressure_law(self.U, self.p, self.q) * ufl.dx
+        return f
+
+    def tangent_pattern(self):
+        """A multiplier field's couplings with every cell's dofs (zero)."""
+        if self.method.multiplier != "field":
+            return None
+        return zero_pattern(self.mesh, self.trial, self.test, [(ufl.dx, lambda f: f)])
 
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property

@@ -53,6 +53,9 @@ def _checked_method(scene, numerics):
     collective); the scene reads the numerics' physical choices."""
     method = numerics.method_object()
     scene.problem.check(scene, numerics, method)
+    if not scene.material().linear and not scene.problem.nonlinear_bulk:
+        raise ValueError(f"scene '{scene.name}': its problem kind needs a linear material "
+                         f"(small-strain elasticity)")  # fmt: skip
     if numerics.nested:
         if not scene.problem.nested:
             raise ValueError(f"--nested: nested iteration is offered for obstacle scenes, not "

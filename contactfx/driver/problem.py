@@ -25,7 +25,7 @@ from mpi4py import MPI
 from contactfx import _compat
 from contactfx.contact.laws import reversal
 from contactfx.driver.fields import NodalProjection, at_nodes, confine, surface_mask, vertex_rule
-from contactfx.solvers.bulk import Bulk, LinearBulk
+from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
 __all__ = ["Forms", "Problem"]
@@ -50,6 +50,8 @@ class Problem:
     #: whether nested iteration (``--nested``) can start this kind from a coarser mesh's
     #: solution (:mod:`contactfx.driver.nested`)
     nested = False
+    #: whether the kind writes its bulk for a material that is not linear (``internal_form``)
+    nonlinear_bulk = False
 
     @classmethod
     def check(cls, scene, numerics, method) -> None:
@@ -192,11 +194,34 @@ class Problem:
 
     def bulk(self, load) -> Callable[[], Bulk]:
         """The kind's bulk for the compiled load form ``load``, built (and assembled) when
-        called: a :class:`contactfx.solvers.bulk.LinearBulk` of :meth:`bulk_form`, the
-        bilinear form of small-strain elasticity. A kind with a nonlinear body returns a
-        :class:`contactfx.solvers.bulk.NonlinearBulk` of its residual form."""
-        return functools.partial(LinearBulk, stiffness=dolfinx.fem.form(self.bulk_form()),
-                                 load=load)  # fmt: skip
+        called: for a linear material a :class:`contactfx.solvers.bulk.LinearBulk` of
+        :meth:`bulk_form` (bilinear, assembled once), else a
+        :class:`contactfx.solvers.bulk.NonlinearBulk` of :meth:`internal_form` and its
+        ``ufl.derivative`` (plus :meth:`tangent_pattern`), assembled at every iteration."""
+        if self.material.linear:
+            a = dolfinx.fem.form(self.bulk_form())
+            return functools.partial(LinearBulk, stiffness=a, load=load)
+        f_int = self.internal_form()
+        tangent = ufl.derivative(f_int, self.state, self.trial)
+        pattern = self.tangent_pattern()
+        if pattern is not None:
+            tangent = tangent + pattern
+        return functools.partial(NonlinearBulk, internal=dolfinx.fem.form(f_int),
+                                 tangent=dolfinx.fem.form(tangent), load=load)  # fmt: skip
+
+    def bulk_form(self):
+        """The bulk's bilinear form a(du, v) of a linear material (trial ``trial``)."""
+        raise NotImplementedError(f"{type(self).__name__} has no bulk form")
+
+    def internal_form(self):
+        """The bulk's internal virtual work f_int(u; v), linear in ``test``, of the state (a
+        kind with ``nonlinear_bulk``)."""
+        raise NotImplementedError(f"{type(self).__name__} has no nonlinear bulk")
+
+    def tangent_pattern(self):
+        """Zero terms (bilinear in ``trial``, ``test``) that give the bulk's tangent the
+        sparsity of the contact terms, or None."""
+        return None
 
     def contact_residual(self):
         """The method's contact residual on the kind's surface (Newton's: ``newton_surface``)."""

@@ -27,6 +27,7 @@ from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
 from contactfx.driver.problem import Problem
+from contactfx.mechanics.elasticity import lame
 from contactfx.results import Friction, Quantities
 
 __all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
@@ -107,7 +108,7 @@ class TwoBodyProblem(Problem):
         dofs = np.array([fields[0].function_space.dofmap.cell_dofs(c)[0] for c in side.cell],
                         dtype=np.int64)  # fmt: skip
         E, nu = (f.x.array[dofs] for f in fields)
-        return np.stack([E, E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))], axis=1)
+        return np.stack([E, *lame(E, nu)], axis=1)
 
     def coupling(self):
         if not hasattr(self, "_coupling"):

@@ -21,11 +21,41 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 import ufl
 
 from contactfx.references import oedometric_modulus
 
-__all__ = ["Elastic"]
+__all__ = ["Elastic", "lame", "hooke", "basis_tractions"]
+
+
+def lame(E, nu):
+    """(lambda, mu) of Young's modulus E and Poisson's ratio nu: numbers, NumPy arrays (a
+    modulus per cell) or UFL expressions alike."""
+    return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
+
+
+def hooke(eps, lmbda, mu, trace, identity):
+    """Hooke's law sigma = 2 mu eps + lambda tr(eps) I, for UFL (``trace`` = ufl.tr,
+    ``identity`` = ufl.Identity(d)) or NumPy arrays of strains (..., d, d) (``trace`` over the
+    last two axes, keeping them; ``identity`` = np.eye(d)): the one Hooke's law of the code
+    base."""
+    return 2.0 * mu * eps + lmbda * trace(eps) * identity
+
+
+def basis_tractions(grads: np.ndarray, n: np.ndarray, lmbda: np.ndarray,
+                    mu: np.ndarray) -> np.ndarray:  # fmt: skip
+    """sigma(N_a e_c) n: the traction on the plane of normal n of the displacement N_a e_c of
+    each P1 basis function N_a and direction c, by :func:`hooke` with eps = sym(e_c grad N_a).
+    grads (P, A, d): the basis gradients at P points; n (P, d); lmbda, mu (P,). Returns
+    (P, A, d, d): [p, a, c, :] the traction vector (NumPy, for the two-body couplings)."""
+    d = grads.shape[-1]
+    unit = np.eye(d)
+    grad_u = unit[None, None, :, :, None] * grads[:, :, None, None, :]  # e_c (x) grad N_a
+    eps = 0.5 * (grad_u + np.swapaxes(grad_u, -1, -2))
+    sigma = hooke(eps, lmbda[:, None, None, None, None], mu[:, None, None, None, None],
+                  lambda e: np.trace(e, axis1=-2, axis2=-1)[..., None, None], unit)  # fmt: skip
+    return np.einsum("pacij,pj->paci", sigma, n)
 
 
 @dataclass(frozen=True)
@@ -36,27 +66,37 @@ class Elastic:
     field of Young's modulus over the mesh (a UFL expression, e.g. a DG0 Function) that replaces
     E in the stress of a heterogeneous (layered) body; E stays the reference modulus of the
     closed forms, and the properties mu, lmbda, E_star, M are its floats. poisson: optional field
-    of Poisson's ratio (bodies of different materials in one mesh), likewise.
+    of Poisson's ratio (bodies of different materials in one mesh), likewise. density: mass per
+    unit volume (None: a static body).
+
+    A :class:`contactfx.mechanics.material.Material`: small strain, so the weak form's stress is
+    the Cauchy stress sigma, linear in (u, p).
     """
 
     E: float
     nu: float
     modulus: object = None
     poisson: object = None
+    density: float | None = None
+
+    #: sigma is linear in (u, p): the bulk is assembled once
+    linear = True
 
     def __post_init__(self) -> None:
         if not self.E > 0.0:
             raise ValueError(f"Young's modulus E must be > 0, got {self.E}")
         if not -1.0 < self.nu < 0.5:
             raise ValueError(f"Poisson's ratio nu must lie in (-1, 0.5), got {self.nu}")
+        if self.density is not None and not self.density > 0.0:
+            raise ValueError(f"density must be > 0, got {self.density}")
 
     @property
     def mu(self) -> float:
-        return self.E / (2.0 * (1.0 + self.nu))
+        return lame(self.E, self.nu)[1]
 
     @property
     def lmbda(self) -> float:
-        return self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        return lame(self.E, self.nu)[0]
 
     @property
     def E_star(self) -> float:
@@ -72,7 +112,8 @@ class Elastic:
         """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""
         E = self.E if self.modulus is None else self.modulus
         nu = self.nu if self.poisson is None else self.poisson
-        return E, E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+        lmbda, mu = lame(E, nu)
+        return E, mu, lmbda
 
     def sigma(self, u, p=None):
         """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
@@ -82,12 +123,33 @@ class Elastic:
             return 2.0 * self._moduli()[1] * eps - p * ufl.Identity(ufl.shape(eps)[0])
         return self.stress(eps)
 
+    # -- the Material protocol -----------------------------------------------------------------
+    def weak_stress(self, u, p=None):
+        """sigma(u, p): small strain, the weak form's stress is the Cauchy stress."""
+        return self.sigma(u, p)
+
+    def weak_stress_derivative(self, u, p, v, q=None):
+        """sigma(v, q): the stress is linear, its derivative in the direction (v, q) is the
+        stress of (v, q)."""
+        return self.sigma(v, q)
+
+    def traction(self, u, p, N):
+        """sigma(u, p) N."""
+        return ufl.dot(self.sigma(u, p), N)
+
+    def traction_derivative(self, u, p, v, q, N):
+        """sigma(v, q) N."""
+        return ufl.dot(self.sigma(v, q), N)
+
+    def cauchy(self, u, p=None):
+        return self.sigma(u, p)
+
     def stress(self, eps):
         """Stress of the strain eps (a UFL tensor)."""
         E, mu, lmbda = self._moduli()
         if ufl.shape(eps) == (1, 1):
             return E * eps
-        return 2.0 * mu * eps + lmbda * ufl.tr(eps) * ufl.Identity(ufl.shape(eps)[0])
+        return hooke(eps, lmbda, mu, ufl.tr, ufl.Identity(ufl.shape(eps)[0]))
 
     def pressure_law(self, u, p, q):
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u
