@@ -20,6 +20,7 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 from contactfx.contact.method import MethodBase, Supports
+from contactfx.solvers.base import SolverWrapper
 from contactfx.solvers.snes import owned_size
 
 __all__ = ["BoundConstraints"]
@@ -73,11 +74,11 @@ class BoundConstraints(MethodBase):
         return force
 
 
-class _Bounded:
+class _Bounded(SolverWrapper):
     """The solver with the bounds of the current obstacle position (updated with the load)."""
 
     def __init__(self, solver, V, facets, obstacle, offset) -> None:
-        self.inner, self.u, self.timer = solver, solver.u, solver.timer
+        super().__init__(solver)
         mesh = V.mesh
         gdim = mesh.geometry.dim
         self.obstacle, self.offset, self.gdim = obstacle, offset, gdim
@@ -100,9 +101,6 @@ class _Bounded:
         self.upper.getArray()[self.dofs] = np.where(np.isfinite(bound), bound, PETSc.INFINITY)
         self.inner.set_bounds(self.lower, self.upper)
         self.inner.assemble_load()
-
-    def solve(self):
-        return self.inner.solve()
 
     def destroy(self) -> None:
         self.lower.destroy()

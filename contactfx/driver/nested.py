@@ -25,13 +25,8 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx import _compat
-from contactfx.solvers.snes import (
-    ConvergenceError,
-    SolveStats,
-    TimeLimitExceeded,
-    owned_bc_dofs,
-    owned_size,
-)
+from contactfx.solvers.base import ConvergenceError, SolverWrapper, SolveStats, TimeLimitExceeded
+from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
 __all__ = ["NestedSolver", "Transfer", "transfer", "nested_levels", "MIN_DOFS"]
 
@@ -134,24 +129,19 @@ def transfer(coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function, split: bo
     return Transfer(coarse, fine, split)()
 
 
-def _innermost(solver):
-    """The ContactSNES inside a method's wrapper (Uzawa, bounds)."""
-    while hasattr(solver, "inner"):
-        solver = solver.inner
-    return solver
-
-
-class NestedSolver:
+class NestedSolver(SolverWrapper):
     """The fine solver started, at every load step, from the coarse chain's solution.
 
     ``coarse`` is the coarse problem's solver (itself a NestedSolver further down the chain);
     ``problem`` / ``coarse_problem`` the two problem kinds, whose ``nested_fields()`` name the
-    Functions carried from coarse to fine. Other attributes are the fine solver's."""
+    Functions carried from coarse to fine. The other members of the solver protocol are the
+    fine solver's."""
 
     def __init__(self, fine, problem, coarse, coarse_problem) -> None:
+        super().__init__(fine)
         self.fine, self.problem = fine, problem
         self.coarse, self.coarse_problem = coarse, coarse_problem
-        _innermost(fine).reuse_factorisation()
+        fine.reuse_factorisation()
         self.fields = coarse_problem.nested_fields()
         self._saved = [f.x.array.copy() for f in self.fields]
         # the state is mixed when the problem is split; a nodal multiplier never is
@@ -163,9 +153,6 @@ class NestedSolver:
         self.coarse_newton = 0
         #: wall time of the coarse chain's solves
         self.coarse_time = 0.0
-
-    def __getattr__(self, name):
-        return getattr(self.fine, name)
 
     def solve(self) -> SolveStats:
         t0 = time.perf_counter()
@@ -190,10 +177,14 @@ class NestedSolver:
 
     def converged(self) -> None:
         """The fine step converged: the coarse chain's step becomes its history too."""
+        self.fine.converged()
         self.coarse_problem.converged()
-        if isinstance(self.coarse, NestedSolver):
-            self.coarse.converged()
+        self.coarse.converged()
         self._saved = [f.x.array.copy() for f in self.fields]
+
+    def phase_timings(self) -> dict[str, float]:
+        """Within the solve: the coarse chain's share (``nested``)."""
+        return {**self.fine.phase_timings(), "nested": self.coarse_time}
 
     def _restore(self) -> None:
         """The coarse chain back at its last converged state."""

@@ -209,7 +209,7 @@ class ObstaclePost:
             self.nodal(self.p_form, self.pressure)
         else:
             proj, pk = self.reaction
-            force = self.pb.method.reaction_pressure(solver.inner, self.pb.state, proj.mass, pk)
+            force = self.pb.method.reaction_pressure(solver, self.pb.state, proj.mass, pk)
             self.pressure.interpolate(pk)
         self.gap.interpolate(self.gap_expr)
         peak, closed, penetration, complementarity = nodal_contact(

@@ -28,15 +28,27 @@ from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 __all__ = ["run", "setup", "prepare_output"]
 
 
-def run(scene, numerics, *, comm=MPI.COMM_WORLD, out=None, petsc_options=None,
-        verbose: bool = True) -> RunSummary:  # fmt: skip
+def run(
+    scene,
+    numerics,
+    *,
+    comm=MPI.COMM_WORLD,
+    out=None,
+    petsc_options=None,
+    verbose: bool = True,
+    time_limit: float | None = None,
+) -> RunSummary:
     """Solve ``scene`` with ``numerics``; write the ParaView files, run.json (and the kind's
     extra output) into ``out`` when given. Raises ValueError on a request the method or the
     problem kind does not support (before any collective), ConvergenceError when the solve
-    fails."""
+    fails, TimeLimitExceeded when the solves run past ``time_limit`` seconds of wall time
+    from the start of the first (checked collectively at every residual)."""
     method = _checked_method(scene, numerics)
-    run_ = _Run(scene, numerics, method, comm, None if out is None else Path(out),
-                dict(petsc_options or {}), verbose)  # fmt: skip
+    run_ = _Run(
+        scene, numerics, method, comm, None if out is None else Path(out),
+        dict(petsc_options or {}), verbose,
+    )  # fmt: skip
+    run_.time_limit = time_limit
     return run_.execute()
 
 
@@ -90,6 +102,9 @@ class _Run:
         self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
         self.timings: dict[str, float] = {}
         self.prefix = f"contactfx_{scene.name.replace('-', '_')}_"
+        #: seconds of wall time the solves may take, or None (see run)
+        self.time_limit: float | None = None
+        self.deadline: float | None = None
 
     @contextmanager
     def timed(self, phase: str):
@@ -103,6 +118,8 @@ class _Run:
 
     def execute(self) -> RunSummary:
         reset_peak_memory()
+        if self.time_limit is not None:
+            self.deadline = time.perf_counter() + self.time_limit
         if self.out is not None:
             prepare_output(self.out, self.comm)
         problem, post, solver = self.build()
@@ -144,6 +161,7 @@ class _Run:
         method = _checked_method(scene, num)
         coarse = _Run(scene, num, method, self.comm, None, self.petsc_options, False)
         coarse.prefix = self.prefix + f"coarse{num.nested + 1}_"
+        coarse.deadline = self.deadline
         c_problem, _, c_solver = coarse.build()
         for phase in ("mesh", "compile", "initial_guess", "chain_assembly"):
             self.timings[phase] = self.timings.get(phase, 0.0) + coarse.timings.get(phase, 0.0)
@@ -164,7 +182,7 @@ class _Run:
             contact_jacobian=forms.contact_jacobian, bcs=problem.bcs, prefix=self.prefix,
             options=options, user_options=self.petsc_options,
             near_nullspace=self.num.solver == "gamg", coupling=problem.coupling(),
-            confined=problem.confined, iterate=problem.iterate,
+            confined=problem.confined, iterate=problem.iterate, deadline=self.deadline,
         )  # fmt: skip
         solver.timer.assembly += assembly
         return solver
@@ -192,8 +210,7 @@ class _Run:
                     with self.timed("output"):
                         writer.write(rec.time, post.fields())
                 problem.converged()
-                if isinstance(solver, NestedSolver):
-                    solver.converged()
+                solver.converged()
                 self.say(_progress(steps[-1], problem.method.multiplier == "nodal"))
 
             t0 = time.perf_counter()
@@ -205,8 +222,7 @@ class _Run:
             self.timings["contact"] = solver.timer.contact
         output = self.timings.get("output", 0.0)
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
-        if isinstance(solver, NestedSolver):  # within the solve: the coarse chain's share
-            self.timings["nested"] = solver.coarse_time
+        self.timings.update(solver.phase_timings())  # within the solve (nested: the coarse chain)
         return steps
 
     def _output(self, suffix: str) -> str | None:

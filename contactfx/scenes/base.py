@@ -134,14 +134,28 @@ class Scene:
         """The scene's default numerics (what the command line starts from), overridden."""
         return Numerics(**{**cls.numerics_defaults, **overrides})
 
-    def run(self, numerics: Numerics, *, comm: MPI.Comm = MPI.COMM_WORLD,
-            out: Path | None = None, petsc_options: dict | None = None,
-            verbose: bool = True) -> RunSummary:  # fmt: skip
+    def run(
+        self,
+        numerics: Numerics,
+        *,
+        comm: MPI.Comm = MPI.COMM_WORLD,
+        out: Path | None = None,
+        petsc_options: dict | None = None,
+        verbose: bool = True,
+        time_limit: float | None = None,
+    ) -> RunSummary:
         """Solve with ``numerics`` (see :func:`contactfx.driver.run`)."""
         from contactfx.driver import run
 
-        return run(self, numerics, comm=comm, out=out, petsc_options=petsc_options,
-                   verbose=verbose)  # fmt: skip
+        return run(
+            self,
+            numerics,
+            comm=comm,
+            out=out,
+            petsc_options=petsc_options,
+            verbose=verbose,
+            time_limit=time_limit,
+        )
 
 
 class ObstacleScene(Scene):

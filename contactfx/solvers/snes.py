@@ -19,10 +19,9 @@ user are copied under the prefix as well).
 
 from __future__ import annotations
 
-import contextlib
+import itertools
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import dolfinx
 import numpy as np
@@ -30,72 +29,25 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.solvers.base import ConvergenceError, SolveStats, TimeLimitExceeded, Timer
 from contactfx.solvers.bulk import Bulk
+from contactfx.solvers.mumps import MumpsWorkspace
+from contactfx.solvers.options import OptionsDB
+from contactfx.solvers.reduced import ReducedSystem
 
-__all__ = ["ConvergenceError", "TimeLimitExceeded", "SolveStats", "Timer", "ContactSNES",
-           "time_limit", "owned_size", "owned_bc_dofs", "rigid_body_modes", "DEFAULT_OPTIONS",
-           "GAMG_OPTIONS"]  # fmt: skip
-
-
-#: MUMPS's errors of a workspace too small for the factorisation (INFOG(1); MUMPS users'
-#: guide, section "Error diagnostics": -8, -9, -11, -14, -15, -17, -20 ask for a larger ICNTL(14))
-_MUMPS_WORKSPACE = (-8, -9, -11, -14, -15, -17, -20)
-
-
-def _mumps_error(ksp) -> int | None:
-    """MUMPS's INFOG(1) of the factorisation behind ``ksp``'s preconditioner, None without
-    MUMPS."""
-    pc = ksp.getPC()
-    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
-        return None
-    try:
-        return int(pc.getFactorMatrix().getMumpsInfog(1))
-    except PETSc.Error:  # no factor (the preconditioner's set-up failed before it)
-        return None
-
-
-def _reason_name(reason: int) -> str:
-    names = {v: k for k, v in vars(PETSc.KSP.ConvergedReason).items() if isinstance(v, int)}
-    return names.get(reason, str(reason))
-
-
-class ConvergenceError(RuntimeError):
-    """The nonlinear solve failed; names the SNES reason, the load step and the load factor."""
-
-    def __init__(self, reason: str, step: int | None = None, load: float | None = None,
-                 stats: SolveStats | None = None):  # fmt: skip
-        self.reason = reason
-        #: the iteration counts up to the failure, when known
-        self.stats = stats
-        self.step = step
-        self.load = load
-        where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
-        super().__init__(f"nonlinear solve diverged{where}: {reason}")
-
-
-class TimeLimitExceeded(ConvergenceError):
-    """The solve ran past the deadline set by :func:`time_limit` (not retried by cut-back)."""
-
-    def __init__(self, where: str = "") -> None:
-        RuntimeError.__init__(self, f"time limit exceeded{where}")
-        self.reason, self.step, self.load = "time limit", None, None
-
-
-_DEADLINE: list[float] = []  # perf_counter deadlines, innermost last
-
-
-@contextlib.contextmanager
-def time_limit(seconds: float | None):
-    """Solves started inside stop with :class:`TimeLimitExceeded` once ``seconds`` of wall
-    time have passed (checked collectively at every residual evaluation: no rank hangs)."""
-    if seconds is None:
-        yield
-        return
-    _DEADLINE.append(time.perf_counter() + seconds)
-    try:
-        yield
-    finally:
-        _DEADLINE.pop()
+__all__ = [
+    "ContactSNES",
+    "ConvergenceError",
+    "DEFAULT_OPTIONS",
+    "GAMG_OPTIONS",
+    "SolveStats",
+    "TimeLimitExceeded",
+    "Timer",
+    "owned_bc_dofs",
+    "owned_size",
+    "rigid_body_modes",
+    "snes_reason_name",
+]
 
 
 #: Newton with a backtracking line search, MUMPS LU.
@@ -141,26 +93,6 @@ def snes_reason_name(reason: int) -> str:
     return _REASONS.get(reason, str(reason))
 
 
-@dataclass
-class SolveStats:
-    """Iterations of one nonlinear solve and the SNES reason."""
-
-    newton: int = 0
-    ksp: int = 0
-    reason: str = ""
-    outer: int = 1  # augmented Lagrangian (Uzawa) outer iterations
-    coarse_newton: int = 0  # nested iteration: Newton iterations on the coarser meshes
-
-
-@dataclass
-class Timer:
-    """Accumulated wall time (s) of the assembly (bulk, loads, contact terms) and, within it,
-    of the two-body coupling (its searches, residual and Jacobian terms)."""
-
-    assembly: float = 0.0
-    contact: float = 0.0
-
-
 def owned_size(space) -> int:
     """Number of owned (unrolled) dofs of a function space on this rank."""
     return space.dofmap.index_map.size_local * space.dofmap.index_map_bs
@@ -203,23 +135,95 @@ def rigid_body_modes(V) -> PETSc.NullSpace:
     return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)
 
 
+class _KeptPreconditioner:
+    """A preconditioner kept across Newton iterations: its own matrix P, refreshed from the
+    Jacobian J only at the first iteration of a solve, after a failed Krylov solve and after
+    one that needed ``rebuild_it`` iterations or more (an unchanged P is not set up again:
+    PCSetUp compares the matrix state). ``coupled``: J's pattern may grow between refreshes
+    (a two-body coupling's search)."""
+
+    def __init__(self, J: PETSc.Mat, nullspace, rebuild_it: int, coupled: bool) -> None:
+        self.rebuild_it, self.coupled = rebuild_it, coupled
+        self.P = J.duplicate(copy=True)
+        if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
+            self.P.setNearNullSpace(nullspace)
+
+    def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
+        ksp = snes.getKSP()
+        fresh = (
+            snes.getIterationNumber() == 0
+            or ksp.getConvergedReason() < 0
+            or ksp.getIterationNumber() >= self.rebuild_it
+        )
+        if fresh:
+            S = PETSc.Mat.Structure
+            J.copy(
+                self.P,
+                structure=S.DIFFERENT_NONZERO_PATTERN if self.coupled else S.SAME_NONZERO_PATTERN,
+            )
+
+    def destroy(self) -> None:
+        self.P.destroy()
+
+
+class _ReversalGuard:
+    """Newton's previous iterate for the friction law's reversal guard
+    (:func:`contactfx.contact.laws.reversal`): ``iterate`` (a Function of u's space that the
+    contact forms read) becomes u at every Jacobian; ``active`` False makes the residual the
+    law's own (the iterate follows u at every residual too); ``initial_norm`` the residual norm
+    at the start of the last SNES solve (its relative tolerance's reference)."""
+
+    def __init__(
+        self, iterate: dolfinx.fem.Function, u: dolfinx.fem.Function, snes: PETSc.SNES
+    ) -> None:
+        self.iterate, self.u = iterate, u
+        self.active = True
+        self.initial_norm = 0.0
+        snes.setMonitor(self._monitor)
+
+    def remember(self) -> None:
+        self.iterate.x.array[:] = self.u.x.array
+
+    def _monitor(self, snes, its: int, norm: float) -> None:
+        if its == 0:
+            self.initial_norm = norm
+
+
 class ContactSNES:
     """Newton (or SNES-VI) for F(u) = R(u) + F_c(u) = 0 with Dirichlet conditions.
 
     Parameters are keyword-only: ``bulk`` (a :class:`contactfx.solvers.bulk.Bulk` over u's
     space: R(u) and K(u); the solver destroys it with itself), ``contact_residual`` /
-    ``contact_jacobian`` (compiled forms, or None),
-    ``bcs`` (dolfinx DirichletBCs), ``prefix`` (PETSc options prefix), ``options`` (defaults,
-    overridden by the command line), ``user_options`` (from the command line), ``confined``
+    ``contact_jacobian`` (compiled forms, or None), ``bcs`` (dolfinx DirichletBCs), ``prefix``
+    (PETSc options prefix), ``options`` (defaults, overridden by the command line),
+    ``user_options`` (from the command line), ``near_nullspace`` (the rigid-body modes for
+    AMG), ``coupling`` (a two-body :class:`contactfx.contact.coupling.Coupling`), ``confined``
     (those of ``bcs`` that confine a field to a surface: a multiplier or an interface
     enrichment that the unknown carries on the whole mesh), ``iterate`` (a Function of u's
     space that the contact forms read as Newton's previous iterate: the friction law's
-    reversal guard, :func:`contactfx.contact.laws.reversal`).
+    reversal guard), ``deadline`` (a ``time.perf_counter()`` value past which a solve stops
+    with :class:`TimeLimitExceeded`, checked collectively at every residual).
 
-    The confined dofs are not unknowns of Newton's linear systems: SNES works on the other dofs
-    only (:class:`_Reduced`), so that a field living on a surface costs its surface dofs, not
-    a copy of the mesh. Not with a two-body coupling or the AMG near-nullspace.
+    Its collaborators: the options database (:class:`contactfx.solvers.options.OptionsDB`),
+    the reduced system on the kept dofs (:class:`contactfx.solvers.reduced.ReducedSystem`:
+    the confined dofs are not unknowns of Newton's linear systems; not with a two-body
+    coupling or the AMG near-nullspace), a kept preconditioner, the reversal guard, and the
+    MUMPS workspace policy (:class:`contactfx.solvers.mumps.MumpsWorkspace`) for every linear
+    solve. A :class:`contactfx.solvers.base.Solver`.
     """
+
+    #: Krylov iterations at most with a reused factorisation (then it is refactorised)
+    REUSE_MAX_IT = 20
+    #: Krylov iterations above which a kept AMG preconditioner is rebuilt at the next Jacobian
+    AMG_REBUILD_IT = 30
+    #: continued solves with the reversal guard before one without it (see _newton)
+    GUARD_ROUNDS = 3
+    #: searches per load step at most (``--search-update step``)
+    SEARCH_ROUNDS = 5
+    #: Newton iterations at most when continuing from a solution with a new pairing (a
+    #: converging continuation takes a few; a cycling one is solved again from the step's
+    #: start)
+    CONTINUE_MAX_IT = 15
 
     def __init__(
         self,
@@ -235,17 +239,18 @@ class ContactSNES:
         near_nullspace: bool = False,
         coupling=None,
         confined=(),
-        iterate=None,
+        iterate: dolfinx.fem.Function | None = None,
+        deadline: float | None = None,
     ) -> None:
         self.u = u
-        self.iterate = iterate
         self.comm = u.function_space.mesh.comm
         self.bcs = list(bcs)
         self._a_c = contact_jacobian
         self._F_c = contact_residual
         self.coupling = coupling
-        self.prefix = prefix
-        self.user_options = dict(user_options or {})
+        self.deadline = deadline
+        self.options = OptionsDB(prefix, user_options)
+        self.mumps = MumpsWorkspace(self.options)
         self.timer = Timer()
 
         t0 = time.perf_counter()
@@ -260,11 +265,11 @@ class ContactSNES:
 
         n_owned = owned_size(u.function_space)
         self._bc_rows = owned_bc_dofs(self.bcs, n_owned)
-        self.reduced = None
+        self.reduced: ReducedSystem | None = None
         if confined and coupling is None and not near_nullspace:
             keep = np.ones(n_owned, dtype=bool)
             keep[owned_bc_dofs(confined, n_owned)] = False
-            self.reduced = _Reduced(K, np.flatnonzero(keep), self._bc_rows)
+            self.reduced = ReducedSystem(K, np.flatnonzero(keep), self._bc_rows)
             self.J.destroy()
             self.J = self.reduced.K.duplicate(copy=True)
 
@@ -282,24 +287,25 @@ class ContactSNES:
             # linear there, removes it. It is no merit function, so no divergence test on it
             # (max_it still bounds a solve). Not -1: PETSc >= 3.22 reads it as "the default"
             defaults.setdefault("snes_divergence_tolerance", 1e300)
-        self._set_options(defaults, user_options or {})
+        self.options.apply(defaults)
         self.residual_vec = self.J.createVecLeft()
         self.snes.setFunction(self._residual, self.residual_vec)
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
-        self._initial_norm = 0.0
-        self._guard = True  # the reversal guard compares with the remembered iterate
-        if iterate is not None:
-            self.snes.setMonitor(self._record_initial_norm)
-        self.P = None  # the preconditioner's own matrix: see _keep_preconditioner
+        self.guard = None if iterate is None else _ReversalGuard(iterate, u, self.snes)
+        self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
 
     # -- options -------------------------------------------------------------------------
+    @property
+    def prefix(self) -> str:
+        return self.options.prefix
+
     def user_sets(self, key: str) -> bool:
         """Whether the user's options give ``key`` (a PETSc option name without the
         prefix), with or without this solver's prefix."""
-        return bool({key, self.prefix + key} & set(self.user_options))
+        return self.options.user_sets(key)
 
     def tolerances(self) -> dict[str, float]:
         """SNES's tolerances: ``rtol``, ``atol``, ``stol``, ``max_it``."""
@@ -309,23 +315,7 @@ class ContactSNES:
         """Set some of SNES's tolerances (``rtol``, ``atol``, ``stol``, ``max_it``)."""
         self.snes.setTolerances(**tolerances)
 
-    def _set_options(self, defaults: Mapping[str, object], user: Mapping[str, object]) -> None:
-        opts = PETSc.Options()
-        for key, value in defaults.items():
-            opts[self.prefix + key] = _option_value(value)
-        for key, value in user.items():
-            name = key if key.startswith("contactfx_") else self.prefix + key
-            opts[name] = _option_value(value)
-
-    #: the linear start's and the SNES solves again with a larger MUMPS workspace (ICNTL(14)
-    #: doubled), at most this many times
-    MUMPS_RETRIES = 3
-
-    #: Krylov iterations at most with a reused factorisation (then it is refactorised)
-    REUSE_MAX_IT = 20
-    #: Krylov iterations above which a kept AMG preconditioner is rebuilt at the next Jacobian
-    AMG_REBUILD_IT = 30
-
+    # -- preconditioner reuse --------------------------------------------------------------
     def reuse_factorisation(self) -> None:
         """From the second Newton iteration of a solve on, keep the LU factorisation of an
         earlier Jacobian as GMRES's preconditioner while GMRES converges with it within
@@ -359,22 +349,12 @@ class ContactSNES:
         self._keep_preconditioner(self.AMG_REBUILD_IT)
 
     def _keep_preconditioner(self, rebuild_it: int) -> None:
-        # the preconditioner's own matrix, updated only when rebuilding (an unchanged matrix
-        # is not set up again: PCSetUp compares the matrix state)
-        self._rebuild_it = rebuild_it
-        self.P = self.J.duplicate(copy=True)
-        if self.nullspace is not None:  # AMG reads the near-nullspace from its own matrix
-            self.P.setNearNullSpace(self.nullspace)
-        self.snes.setJacobian(self._jacobian, self.J, self.P)
-
-    def _update_preconditioner(self, snes, J: PETSc.Mat) -> None:
-        ksp = snes.getKSP()
-        fresh = (snes.getIterationNumber() == 0 or ksp.getConvergedReason() < 0
-                 or ksp.getIterationNumber() >= self._rebuild_it)  # fmt: skip
-        if fresh:  # a two-body coupling's search may add couplings to J's pattern
-            S = PETSc.Mat.Structure
-            J.copy(self.P, structure=S.SAME_NONZERO_PATTERN if self.coupling is None
-                   else S.DIFFERENT_NONZERO_PATTERN)  # fmt: skip
+        if self.kept is not None:
+            self.kept.destroy()
+        self.kept = _KeptPreconditioner(
+            self.J, self.nullspace, rebuild_it, coupled=self.coupling is not None
+        )
+        self.snes.setJacobian(self._jacobian, self.J, self.kept.P)
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
@@ -402,15 +382,15 @@ class ContactSNES:
 
     def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
         t0 = time.perf_counter()
-        if _DEADLINE and self.comm.allreduce(t0 > _DEADLINE[-1], op=MPI.LOR):
+        if self.deadline is not None and self.comm.allreduce(t0 > self.deadline, op=MPI.LOR):
             # stop SNES through its own divergence test (a NaN residual): raising here would
             # leave x read-locked on PETSc >= 3.20
             self._late = True
             F.set(np.nan)
             return
         self._sync(x)
-        if not self._guard:  # the law's own residual (see _newton)
-            self._remember()
+        if self.guard is not None and not self.guard.active:  # the law's own residual
+            self.guard.remember()
         uvec = _compat.petsc_vec(self.u)  # = x on all dofs
         full = F if self.reduced is None else self.reduced.F
         self._unconstrained_residual(uvec, full, search=True)
@@ -480,16 +460,16 @@ class ContactSNES:
             J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
         else:
             J.zeroRowsColumns(red.bc_rows, diag=1.0)
-        if self.P is not None:
-            self._update_preconditioner(snes, J)
+        if self.kept is not None:
+            self.kept.update(snes, J)
         self._remember()
         self.timer.assembly += time.perf_counter() - t0
 
     def _remember(self) -> None:
         """The iterate the contact forms compare with becomes the current u (at every Jacobian,
         so the next residual and Jacobian see the step just taken)."""
-        if self.iterate is not None:
-            self.iterate.x.array[:] = self.u.x.array
+        if self.guard is not None:
+            self.guard.remember()
 
     def solve_linear(self, free: np.ndarray, extra=None) -> None:
         """u = the solution of (K + extra) u = f_ext with the owned dofs not marked ``free``
@@ -511,37 +491,26 @@ class ContactSNES:
         b = self.bulk.load.copy()
         b.getArray()[rows] = 0.0
         x = _compat.petsc_vec(self.u)
-        opts = PETSc.Options()
-        workspace = self.prefix + "mat_mumps_icntl_14"
-        user_workspace = opts.getString(workspace) if opts.hasName(workspace) else None
         try:
-            for attempt in range(self.MUMPS_RETRIES + 1):
+            for attempt in itertools.count():
                 ksp = PETSc.KSP().create(self.comm)
                 ksp.setOptionsPrefix(self.prefix)
                 ksp.setOperators(A)
                 ksp.setFromOptions()
                 ksp.solve(b, x)
-                reason, infog = ksp.getConvergedReason(), _mumps_error(ksp)
-                ksp.destroy()
-                if reason >= 0:
-                    break
-                if infog not in _MUMPS_WORKSPACE or attempt == self.MUMPS_RETRIES:
-                    mumps = "" if infog is None else f", MUMPS INFOG(1) = {infog}"
-                    raise ConvergenceError(f"the linear start's solve failed: KSP reason "
-                                           f"{_reason_name(reason)}{mumps}")  # fmt: skip
-                # MUMPS ran out of its estimated workspace (its estimate holds for the pivots
-                # of the analysis; in parallel the delayed pivots differ from run to run):
-                # again with MUMPS's advice, a larger relative workspace ICNTL(14)
-                opts[workspace] = 2 ** (attempt + 1) * int(user_workspace or 20)
+                try:
+                    if ksp.getConvergedReason() >= 0:
+                        break
+                    if not self.mumps.enlarge(ksp, attempt):  # else again, a new factor
+                        raise ConvergenceError(
+                            f"the linear start's solve failed: {self.mumps.describe(ksp)}"
+                        )
+                finally:
+                    ksp.destroy()
         finally:
-            if user_workspace is None:
-                if opts.hasName(workspace):
-                    opts.delValue(workspace)
-            else:
-                opts[workspace] = user_workspace
+            for obj in (A, b):
+                obj.destroy()
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        for obj in (A, b):
-            obj.destroy()
 
     # -- solve ---------------------------------------------------------------------------
     def solve(self) -> SolveStats:
@@ -565,6 +534,10 @@ class ContactSNES:
             if self.coupling is not None:
                 self._timed_search()
             return self._newton(x, stats)
+        return self._search_rounds(x, stats)
+
+    def _search_rounds(self, x: PETSc.Vec, stats: SolveStats) -> SolveStats:
+        """Newton with a search at the step's start and again at each solution (solve())."""
         start = x.copy()
         try:
             self._timed_search()
@@ -583,8 +556,9 @@ class ContactSNES:
                     self._sync(x)
                     stats = self._newton(x, stats)
             if not self._searched_all():
-                raise ConvergenceError("the search found new contact points after "
-                                       f"{self.SEARCH_ROUNDS} rounds")  # fmt: skip
+                raise ConvergenceError(
+                    f"the search found new contact points after {self.SEARCH_ROUNDS} rounds"
+                )
             return stats
         finally:
             start.destroy()
@@ -592,7 +566,7 @@ class ContactSNES:
     def _newton(self, x: PETSc.Vec, before: SolveStats, max_it: int | None = None) -> SolveStats:
         """SNES solves from x (each at most ``max_it`` iterations when given and below the
         SNES's own limit); the counts added to ``before``. Raises ConvergenceError (with the
-        counts) on divergence, TimeLimitExceeded past the time limit.
+        counts) on divergence, TimeLimitExceeded past the deadline.
 
         With the reversal guard, a solve converged on the guarded residual is continued while
         the law's own residual is not converged (a point that reversed in the last step), up
@@ -600,7 +574,7 @@ class ContactSNES:
         converged iterates (a 2-cycle of the guard itself) then gets one last solve with the
         guard off, the law's plain semi-smooth Newton from there."""
         stats = self._snes_solve(x, before, max_it)
-        if self.iterate is None:
+        if self.guard is None:
             return stats
         for _ in range(self.GUARD_ROUNDS):
             if self._law_converged(x):
@@ -608,44 +582,31 @@ class ContactSNES:
             stats = self._snes_solve(x, stats, max_it)  # from the law's own residual
         if self._law_converged(x):
             return stats
-        self._guard = False
+        self.guard.active = False
         try:
             return self._snes_solve(x, stats, max_it)
         finally:
-            self._guard = True
-
-    #: continued solves with the reversal guard before one without it (see _newton)
-    GUARD_ROUNDS = 3
-
-    def _more_mumps_workspace(self, attempt: int) -> bool:
-        """After a SNES solve: whether its linear solve failed for MUMPS's workspace (in
-        parallel the delayed pivots, and so the workspace a factorisation needs, differ from
-        run to run) with retries left; then ICNTL(14) is doubled in the options of this
-        solver's prefix and the preconditioner reset, so that the next set-up makes a new
-        factor with it (ICNTL set on the failed factor itself is not read again)."""
-        ksp = self.snes.getKSP()
-        failed = self.snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
-        if not failed or attempt == self.MUMPS_RETRIES or _mumps_error(ksp) not in _MUMPS_WORKSPACE:
-            return False
-        pc = ksp.getPC()
-        workspace = 2 * max(int(pc.getFactorMatrix().getMumpsIcntl(14)), 20)
-        PETSc.Options()[self.prefix + "mat_mumps_icntl_14"] = workspace
-        pc.reset()
-        return True
+            self.guard.active = True
 
     def _snes_solve(self, x: PETSc.Vec, before: SolveStats, max_it: int | None) -> SolveStats:
-        """One SNES solve from x; the counts added to ``before``; raises on failure."""
+        """One SNES solve from x (again from x with a larger MUMPS workspace, by the
+        workspace policy); the counts added to ``before``; raises on failure."""
         limit = self.snes.getTolerances()[3]
         if max_it is not None and max_it < limit:
             self.snes.setTolerances(max_it=max_it)
         xs = x if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
         start = xs.copy()
+        ksp = self.snes.getKSP()
+        linear_failure = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
         try:
-            for attempt in range(self.MUMPS_RETRIES + 1):
+            for attempt in itertools.count():
                 self.snes.solve(None, xs)
-                if not self._more_mumps_workspace(attempt):
+                if self.snes.getConvergedReason() != linear_failure or not self.mumps.enlarge(
+                    ksp, attempt
+                ):
                     break
-                start.copy(xs)  # again from the start, with a larger workspace
+                ksp.getPC().reset()  # the next set-up makes a new factor with the workspace
+                start.copy(xs)
         except PETSc.Error as err:  # e.g. a singular factorisation: a failed step
             raise ConvergenceError(f"linear solver failed (PETSc error {err.ierr})") from None
         finally:
@@ -657,17 +618,15 @@ class ContactSNES:
             raise TimeLimitExceeded()
         self._sync(x)
         reason = self.snes.getConvergedReason()
-        stats = SolveStats(newton=before.newton + self.snes.getIterationNumber(),
-                           ksp=before.ksp + self.snes.getLinearSolveIterations(),
-                           reason=snes_reason_name(reason))  # fmt: skip
+        stats = SolveStats(
+            newton=before.newton + self.snes.getIterationNumber(),
+            ksp=before.ksp + self.snes.getLinearSolveIterations(),
+            reason=snes_reason_name(reason),
+        )
         if reason <= 0:
             message = stats.reason
-            if reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
-                ksp = self.snes.getKSP()
-                infog = _mumps_error(ksp)
-                message += f" (KSP {_reason_name(ksp.getConvergedReason())}" + (
-                    ")" if infog is None else f", MUMPS INFOG(1) = {infog})"
-                )
+            if reason == linear_failure:
+                message += f" ({self.mumps.describe(ksp)})"
             raise ConvergenceError(message, stats=stats)
         return stats
 
@@ -682,22 +641,9 @@ class ContactSNES:
         try:
             self._residual(self.snes, xs, F)
             rtol, atol = self.snes.getTolerances()[:2]
-            return F.norm() <= max(atol, rtol * self._initial_norm)
+            return F.norm() <= max(atol, rtol * self.guard.initial_norm)
         finally:
             F.destroy()
-
-    def _record_initial_norm(self, snes, its: int, norm: float) -> None:
-        """SNES monitor: the residual norm at a solve's start (its relative tolerance's
-        reference)."""
-        if its == 0:
-            self._initial_norm = norm
-
-    #: searches per load step at most (``--search-update step``)
-    SEARCH_ROUNDS = 5
-    #: Newton iterations at most when continuing from a solution with a new pairing (a
-    #: converging continuation takes a few; a cycling one is solved again from the step's
-    #: start)
-    CONTINUE_MAX_IT = 15
 
     def _timed_search(self) -> None:
         t0 = time.perf_counter()
@@ -716,70 +662,17 @@ class ContactSNES:
         self.timer.contact += dt
         return missed == 0
 
+    # -- the Solver protocol's other members ---------------------------------------------------
+    def converged(self) -> None:
+        """Nothing to move on: the load program keeps the state's history."""
+
+    def phase_timings(self) -> dict[str, float]:
+        return {}
+
     def destroy(self) -> None:
-        for obj in (self.snes, self.bulk, self.J, self.P, self.Jc, self.fc, self.residual_vec):
+        for obj in (self.snes, self.bulk, self.J, self.kept, self.Jc, self.fc, self.residual_vec):
             if obj is not None:
                 obj.destroy()
         if self.reduced is not None:
             self.reduced.destroy()
-        opts = PETSc.Options()
-        for key in list(opts.getAll()):
-            if key.startswith(self.prefix):
-                opts.delValue(key)
-
-
-class _Reduced:
-    """The system on the kept dofs: the rows and columns of the confined dofs dropped.
-
-    A confined dof is fixed to zero and its column is zero in every Jacobian (Dirichlet rows
-    and columns), so the kept rows of F(x) and J(x) at x with the confined entries zero are
-    exactly the system of the kept unknowns. ``keep``: the owned kept dofs (local indices);
-    ``bc_rows``: the owned Dirichlet rows (local indices, confined ones included)."""
-
-    def __init__(self, K: PETSc.Mat, keep: np.ndarray, bc_rows: np.ndarray) -> None:
-        rstart = K.getOwnershipRange()[0]
-        self.rows = PETSc.IS().createGeneral((rstart + keep).astype(PETSc.IntType),
-                                             comm=K.getComm())  # fmt: skip
-        self.K = K.createSubMatrix(self.rows, self.rows)
-        kept_bc = np.flatnonzero(np.isin(keep, bc_rows))  # positions among the kept dofs
-        self.bc_rows = (self.K.getOwnershipRange()[0] + kept_bc).astype(PETSc.IntType)
-        self.x = self.K.createVecRight()
-        self.F = K.createVecLeft()  # a residual on all dofs
-        self.scatter = PETSc.Scatter().create(self.F, self.rows, self.x, None)
-        self.Jc = None
-
-    def restrict(self, full: PETSc.Vec, out: PETSc.Vec | None = None) -> PETSc.Vec:
-        """The kept entries of ``full`` (into ``out``, a new vector if None)."""
-        out = self.x.duplicate() if out is None else out
-        self.scatter.scatter(full, out, addv=PETSc.InsertMode.INSERT,
-                             mode=PETSc.ScatterMode.FORWARD)  # fmt: skip
-        return out
-
-    def extend(self, kept: PETSc.Vec, full: PETSc.Vec) -> None:
-        """Set the owned kept entries of ``full`` (its confined entries stay zero)."""
-        self.scatter.scatter(kept, full, addv=PETSc.InsertMode.INSERT,
-                             mode=PETSc.ScatterMode.REVERSE)  # fmt: skip
-
-    def bulk_block(self, K: PETSc.Mat) -> PETSc.Mat:
-        """The kept rows and columns of a bulk Jacobian that changed (into ``self.K``)."""
-        self.K = K.createSubMatrix(self.rows, self.rows, submat=self.K)
-        return self.K
-
-    def kept_block(self, A: PETSc.Mat) -> PETSc.Mat:
-        """The kept rows and columns of A (a matrix of A's pattern, reused from call to
-        call)."""
-        self.Jc = A.createSubMatrix(self.rows, self.rows, submat=self.Jc)
-        return self.Jc
-
-    def destroy(self) -> None:
-        for obj in (self.rows, self.K, self.x, self.F, self.scatter, self.Jc):
-            if obj is not None:
-                obj.destroy()
-
-
-def _option_value(value: object) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return str(value)
+        self.options.clear()

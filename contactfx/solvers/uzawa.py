@@ -6,12 +6,13 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from contactfx.solvers.snes import ContactSNES, ConvergenceError, SolveStats, TimeLimitExceeded
+from contactfx.solvers.base import ConvergenceError, SolverWrapper, SolveStats, TimeLimitExceeded
+from contactfx.solvers.snes import ContactSNES
 
 __all__ = ["Uzawa"]
 
 
-class Uzawa:
+class Uzawa(SolverWrapper):
     """Wraps a :class:`ContactSNES` whose contact residual reads ``multiplier``.
 
     ``update`` fills the Function it is given with the multiplier's next nodal values;
@@ -31,11 +32,10 @@ class Uzawa:
     #: the Newton step, relative to the state, below which an inner solve has converged
     STEP_TOL = 1e-12
 
-    def __init__(self, inner: ContactSNES, multiplier, update, mask: np.ndarray, *, tol: float,
-                 max_it: int) -> None:  # fmt: skip
-        self.inner = inner
-        self.u = inner.u
-        self.timer = inner.timer
+    def __init__(
+        self, inner: ContactSNES, multiplier, update, mask: np.ndarray, *, tol: float, max_it: int
+    ) -> None:
+        super().__init__(inner)
         self.multiplier = multiplier
         self.update = update
         self.mask = mask
@@ -43,9 +43,6 @@ class Uzawa:
         self.max_it = max_it
         self._next = multiplier.copy()
         self.comm = inner.comm
-
-    def assemble_load(self) -> None:
-        self.inner.assemble_load()
 
     def _max(self, values: np.ndarray) -> float:
         local = float(np.max(np.abs(values), initial=0.0))
@@ -93,6 +90,3 @@ class Uzawa:
             f"augmented Lagrangian (Uzawa) not converged in {self.max_it} iterations "
             f"(multiplier change {change:.3e}, tolerance {self.tol:.1e} x {size:.3e})"
         )
-
-    def destroy(self) -> None:
-        self.inner.destroy()

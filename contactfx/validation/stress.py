@@ -229,15 +229,14 @@ def _row(case: StressCase, res: RunSummary | None, error: str, wall: float) -> d
 
 
 def run_in_process(case: StressCase, comm, limit: float) -> dict:
-    from contactfx.solvers.snes import ConvergenceError, time_limit
+    from contactfx.solvers.snes import ConvergenceError
 
     scene_cls = _scene(case.scene)
     t0 = time.perf_counter()
     try:
         scene = scene_cls(scene_cls.Params(**case.params))
         num = scene_cls.default_numerics(**case.numerics)
-        with time_limit(limit):
-            res = scene.run(num, comm=comm, verbose=False)
+        res = scene.run(num, comm=comm, verbose=False, time_limit=limit)
     except ValueError as err:
         row = _row(case, None, str(err), time.perf_counter() - t0)
         return {**row, "status": "refused"} if case.refused else row

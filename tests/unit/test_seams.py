@@ -235,3 +235,44 @@ def test_stepper_restores_every_field_on_cutback():
 def test_stepper_rejects_no_steps():
     with pytest.raises(ValueError, match="load steps must be >= 1"):
         QuasiStatic(0)
+
+
+@pytest.mark.parametrize("gdim", [2, 3])
+def test_one_hookes_law_for_ufl_and_the_couplings(gdim):
+    """The two-body couplings' tractions of the P1 basis, sigma(N_a e_c) n, come from the
+    material's Hooke's law: equal (to round-off) to UFL's Elastic.sigma of the same
+    displacement interpolated on one cell, and zero for n = 0 (a Gauss point with no master
+    facet: its Nitsche terms vanish; a shortcut that assumed |n| = 1 once left
+    lambda d_c N_a there)."""
+    from contactfx.mechanics.elasticity import basis_tractions, lame
+
+    E, nu = 3.0, 0.3
+    lmbda, mu = lame(E, nu)
+    mesh = (
+        dolfinx.mesh.create_unit_square(MPI.COMM_SELF, 1, 1)
+        if gdim == 2
+        else dolfinx.mesh.create_unit_cube(MPI.COMM_SELF, 1, 1, 1)
+    )
+    V = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
+    x = _compat.dof_coordinates(V)[:, :gdim]
+    cell_nodes = np.asarray(V.dofmap.cell_dofs(0))
+    X = x[cell_nodes]
+    # P1 gradients of the cell's basis: rows of the inverse of [1 x]
+    grads = np.linalg.inv(np.hstack([np.ones((gdim + 1, 1)), X]))[1:].T  # (A, d)
+    rng = np.random.default_rng(3)
+    n = rng.normal(size=gdim)
+    n /= np.linalg.norm(n)
+    T = basis_tractions(grads[None], np.stack([n, np.zeros(gdim)]), np.full(2, lmbda),
+                        np.full(2, mu))  # fmt: skip
+    assert np.all(T[1] == 0.0)
+    material = Elastic(E, nu)
+    w = dolfinx.fem.Function(V)
+    for a, node in enumerate(cell_nodes):
+        for c in range(gdim):
+            w.x.array[:] = 0.0
+            w.x.array[node * gdim + c] = 1.0
+            # sigma is constant on the cell: its traction at the cell's first point
+            expr = _compat.expression(ufl.dot(material.sigma(w), ufl.as_vector(n)), V)
+            t = _compat.eval_expression(expr, mesh, np.array([0], dtype=np.int32))
+            t = np.asarray(t).reshape(-1)[:gdim]
+            np.testing.assert_allclose(T[0, a, c], t, rtol=1e-13, atol=1e-13)  # round-off
