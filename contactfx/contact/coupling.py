@@ -34,13 +34,17 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["Coupling", "NodeLayout", "aij", "blocked_rows"]
+__all__ = ["Coupling", "PairCoupling", "NodeLayout", "aij", "blocked_rows"]
 
 
 class Coupling(Protocol):
+    """What the solver calls (module docstring): ``u`` in ``update`` and ``missed`` is the
+    state's local array (owned and ghost entries), in ``residual`` and ``jacobian`` its PETSc
+    vector."""
+
     search_each_newton: bool
 
-    def update(self, u: PETSc.Vec) -> None: ...
+    def update(self, u: np.ndarray) -> None: ...
 
     def residual(self, u: PETSc.Vec, F: PETSc.Vec) -> None: ...
 
@@ -48,7 +52,28 @@ class Coupling(Protocol):
         self, u: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat, *, bulk_changed: bool = False
     ) -> None: ...
 
-    def missed(self, u) -> int: ...
+    def missed(self, u: np.ndarray) -> int: ...
+
+
+class PairCoupling(Coupling, Protocol):
+    """A two-body coupling also gives the two-body kind's post-processing its nodal state at
+    the last converged solve: ``nodal()`` (the slave contact nodes, their weights, pressure
+    and gap), ``nodal_friction()`` and ``friction_state()`` (with friction), ``force()`` (the
+    total normal force), ``slave_force()`` (the force vector on the slave body) and
+    ``search_gaps()`` (the gaps the last search measured); a coupling with nodal normals
+    (mortar) has them as ``normal``."""
+
+    def nodal(self) -> tuple: ...
+
+    def nodal_friction(self) -> tuple: ...
+
+    def friction_state(self) -> dict: ...
+
+    def force(self) -> float: ...
+
+    def slave_force(self) -> np.ndarray: ...
+
+    def search_gaps(self) -> np.ndarray: ...
 
 
 def aij(comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:

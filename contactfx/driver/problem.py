@@ -1,13 +1,14 @@
-"""Problem kinds: what the pipeline asks of a rigid-obstacle problem, a fitted interface and
-(next) two bodies.
+"""Problem kinds: what the pipeline asks of a body against a rigid obstacle, a fitted or
+unfitted interface, and two meshed bodies.
 
 :class:`Problem` builds what every kind shares: the unknown (the kind's displacement field,
 extended by a multiplier field for a ``"field"`` method or by the pressure of the mixed u-p
 formulation), the friction history (the last converged state, and the last tangential traction
-for a method that keeps it), the nodal multiplier of a ``"nodal"`` method, and the forms
-(bulk, load, contact residual). A kind adds its unknowns' meaning, its boundary conditions and
-measures, its :class:`contactfx.contact.surface.Surface`, its load program and its
-post-processing.
+for a method that keeps it), the nodal multiplier of a ``"nodal"`` method, and the forms (the
+bulk, :mod:`contactfx.solvers.bulk`, linear or not as the material is; the load; the contact
+residual). A kind adds its unknowns' meaning, its boundary conditions and measures, its
+:class:`contactfx.contact.surface.Surface`, its load program and its post-processing; the hooks
+are listed in docs/architecture.md ("Adding a problem kind").
 """
 
 from __future__ import annotations

@@ -1,6 +1,8 @@
 """The package's import structure (docs/architecture.md, "Layers"): no import circle between
 modules, no private name imported from another module, and no module importing from a layer
-above its own. Every import counts, also those inside functions."""
+above its own. Every import counts, also those inside functions. The gmsh builders of the
+top-level meshes/ folder are the subpackage contactfx.meshes (pyproject.toml) and are scanned
+with it."""
 
 from __future__ import annotations
 
@@ -10,6 +12,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).parents[2] / "contactfx"
+#: installed as contactfx.meshes
+MESHES = Path(__file__).parents[2] / "meshes"
 
 #: layers from the top; a module may import from its own layer and the ones below
 LAYERS = [
@@ -25,10 +29,11 @@ LAYERS = [
 
 def _modules() -> dict[str, Path]:
     out = {}
-    for path in ROOT.rglob("*.py"):
-        parts = path.relative_to(ROOT.parent).with_suffix("").parts
-        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-        out[name] = path
+    for folder, package in ((ROOT, ("contactfx",)), (MESHES, ("contactfx", "meshes"))):
+        for path in folder.rglob("*.py"):
+            parts = package + path.relative_to(folder).with_suffix("").parts
+            name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+            out[name] = path
     return out
 
 
