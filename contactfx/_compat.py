@@ -204,8 +204,7 @@ def quadrature_space(mesh, degree: int, shape: tuple[int, ...] = ()):
         return dolfinx.fem.functionspace(mesh, element)
     cell = mesh.ufl_cell()
     if shape:
-        element = ufl.VectorElement("Quadrature", cell, degree, dim=shape[0],
-                                    quad_scheme="default")  # fmt: skip
+        element = ufl.VectorElement("Quadrature", cell, degree, dim=shape[0], quad_scheme="default")
     else:
         element = ufl.FiniteElement("Quadrature", cell, degree, quad_scheme="default")
     return dolfinx.fem.FunctionSpace(mesh, element)
@@ -241,10 +240,16 @@ def entity_coordinates(mesh, dim: int, entities: np.ndarray) -> np.ndarray:
 
 # Math namespaces (sqrt, atan2, cos, sin) for closed forms written once for numpy arrays and UFL
 # expressions (contactfx.references). numpy < 2 has no atan2 alias, UFL < 2023 names it atan_2.
-numpy_math = SimpleNamespace(sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin,
-                             maximum=np.maximum)  # fmt: skip
-ufl_math = SimpleNamespace(sqrt=ufl.sqrt, atan2=getattr(ufl, "atan2", None) or ufl.atan_2,
-                           cos=ufl.cos, sin=ufl.sin, maximum=ufl.max_value)  # fmt: skip
+numpy_math = SimpleNamespace(
+    sqrt=np.sqrt, atan2=np.arctan2, cos=np.cos, sin=np.sin, maximum=np.maximum
+)
+ufl_math = SimpleNamespace(
+    sqrt=ufl.sqrt,
+    atan2=getattr(ufl, "atan2", None) or ufl.atan_2,
+    cos=ufl.cos,
+    sin=ufl.sin,
+    maximum=ufl.max_value,
+)
 
 
 class FacetTree:

@@ -28,16 +28,26 @@ class _General:
     friction: str = param("none", "friction law", choices=FRICTION_LAWS)
     mu: float = param(0.0, "Coulomb friction coefficient", nonnegative=True)
     threshold: float = param(0.0, "Tresca friction threshold (stress)", nonnegative=True)
-    quadrature: str = param("gauss", "contact integrals of nitsche / penalty: gauss (degree "
-                            "2k + 2) or nodal (at the vertices, P1 only)",
-                            choices=("gauss", "nodal"))  # fmt: skip
+    quadrature: str = param(
+        "gauss",
+        "contact integrals of nitsche / penalty: gauss (degree "
+        "2k + 2) or nodal (at the vertices, P1 only)",
+        choices=("gauss", "nodal"),
+    )
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
-    formulation: str = param("displacement", "bulk unknowns: displacement, or mixed-up "
-                             "(Taylor-Hood P2 displacement / P1 pressure, near-incompressible "
-                             "materials; needs --degree 2)", choices=FORMULATIONS)  # fmt: skip
+    formulation: str = param(
+        "displacement",
+        "bulk unknowns: displacement, or mixed-up "
+        "(Taylor-Hood P2 displacement / P1 pressure, near-incompressible "
+        "materials; needs --degree 2)",
+        choices=FORMULATIONS,
+    )
     steps: int = param(1, "load steps", positive=True)
-    solver: str = param("lu", "linear solver: MUMPS LU, or GMRES + GAMG in an inexact "
-                        "Newton method (large 3D meshes)", choices=("lu", "gamg"))  # fmt: skip
+    solver: str = param(
+        "lu",
+        "linear solver: MUMPS LU, or GMRES + GAMG in an inexact Newton method (large 3D meshes)",
+        choices=("lu", "gamg"),
+    )
     nested: int = param(
         0,
         "nested iteration: solve every load step first on this many "
@@ -45,8 +55,11 @@ class _General:
         "of the next finer Newton solve (obstacle scenes)",
         nonnegative=True,
     )
-    search_update: str = param("step", "two-body contact search: once per load step, or at "
-                               "every Newton iteration", choices=("step", "newton"))  # fmt: skip
+    search_update: str = param(
+        "step",
+        "two-body contact search: once per load step, or at every Newton iteration",
+        choices=("step", "newton"),
+    )
 
 
 def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
@@ -56,8 +69,7 @@ def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
         for f in dataclasses.fields(method_class(name)):
             key = option_name(f)
             meta = {**f.metadata, "option": None}
-            out.setdefault(key, (key, f.type, dataclasses.field(default=f.default,
-                                                                metadata=meta)))  # fmt: skip
+            out.setdefault(key, (key, f.type, dataclasses.field(default=f.default, metadata=meta)))
     return list(out.values())
 
 
@@ -65,8 +77,11 @@ def _unsupported(what: str, test, reason_key: str, method: str) -> str:
     cls = method_class(method)
     reason = cls.supports.why_not.get(reason_key)
     others = methods_supporting(test)
-    return (f"{what} is not supported by method '{method}'" + (f" ({reason})" if reason else "")
-            + ("; use " + ", ".join(others) if others else ""))  # fmt: skip
+    return (
+        f"{what} is not supported by method '{method}'"
+        + (f" ({reason})" if reason else "")
+        + ("; use " + ", ".join(others) if others else "")
+    )
 
 
 class _Checks:
@@ -76,9 +91,14 @@ class _Checks:
         validate(self)
         s = method_class(self.method).supports
         if self.friction not in s.friction:
-            raise ValueError(_unsupported(f"friction law '{self.friction}'",
-                                          lambda c: self.friction in c.friction, "friction",
-                                          self.method))  # fmt: skip
+            raise ValueError(
+                _unsupported(
+                    f"friction law '{self.friction}'",
+                    lambda c: self.friction in c.friction,
+                    "friction",
+                    self.method,
+                )
+            )
         if self.mu > 0.0 and self.friction != "coulomb":
             raise ValueError(f"--mu needs --friction coulomb (got --friction {self.friction})")
         if self.threshold > 0.0 and self.friction != "tresca":
@@ -93,7 +113,7 @@ class _Checks:
                     f" (method {self.method}: {s.why_not['nodal_quadrature']})"
                     if "nodal_quadrature" in s.why_not
                     else ""
-                )  # fmt: skip
+                )
             )
         if self.solver != "lu" and not s.iterative:
             raise ValueError(f"method {self.method} is {s.why_not['iterative']}: use --solver lu")
@@ -101,8 +121,11 @@ class _Checks:
             if self.degree != 2:
                 raise ValueError("formulation mixed-up is Taylor-Hood P2/P1: use --degree 2")
             if not s.mixed_up:
-                raise ValueError(_unsupported("formulation mixed-up", lambda c: c.mixed_up,
-                                              "mixed_up", self.method))  # fmt: skip
+                raise ValueError(
+                    _unsupported(
+                        "formulation mixed-up", lambda c: c.mixed_up, "mixed_up", self.method
+                    )
+                )
             if self.solver != "lu":
                 raise ValueError("formulation mixed-up is a saddle-point system: use --solver lu")
 
@@ -116,13 +139,18 @@ class _Checks:
 
 Numerics = dataclasses.make_dataclass(
     "Numerics",
-    [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
-     for f in dataclasses.fields(_General)][:1] + _method_fields()
-    + [(f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
-       for f in dataclasses.fields(_General)][1:],
+    [
+        (f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+        for f in dataclasses.fields(_General)
+    ][:1]
+    + _method_fields()
+    + [
+        (f.name, f.type, dataclasses.field(default=f.default, metadata=f.metadata))
+        for f in dataclasses.fields(_General)
+    ][1:],
     bases=(_Checks,),
     frozen=True,
-)  # fmt: skip
+)
 Numerics.__module__ = __name__
 Numerics.__doc__ = """The numerics of a run (see the module docstring); validated on
 construction against the chosen method's declared support."""

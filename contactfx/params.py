@@ -24,8 +24,13 @@ def param(
     """A parameter with its help text and validation rule. ``option``: the name it has on the
     command line and in :class:`contactfx.numerics.Numerics` when it differs from the field's
     (a method's ``kappa0`` is the option ``penalty``)."""
-    meta = {"help": help, "positive": positive, "nonnegative": nonnegative, "choices": choices,
-            "option": option}  # fmt: skip
+    meta = {
+        "help": help,
+        "positive": positive,
+        "nonnegative": nonnegative,
+        "choices": choices,
+        "option": option,
+    }
     return field(default=default, metadata=meta)
 
 

@@ -197,8 +197,9 @@ def penny_shear_slip(r, a, tau, E, nu, m: Any = numpy_math):
     of K_II = 4 tau sqrt(a / pi) cos(phi) / (2 - nu) where the front normal is along the shear
     (phi = 0), and the mode III jump of K_III = 4 (1 - nu) tau sqrt(a / pi) sin(phi) / (2 - nu)
     where it is across (phi = 90 degrees)."""
-    return 16.0 * tau * (1.0 - nu**2) / (np.pi * (2.0 - nu) * E) * m.sqrt(m.maximum(a**2 - r**2,
-                                                                                  0.0))  # fmt: skip
+    return (
+        16.0 * tau * (1.0 - nu**2) / (np.pi * (2.0 - nu) * E) * m.sqrt(m.maximum(a**2 - r**2, 0.0))
+    )
 
 
 def crack_plane_tractions(sigma, beta_deg, m: Any = numpy_math):

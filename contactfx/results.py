@@ -15,8 +15,15 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["StepLog", "Friction", "InterfaceQuantities", "Quantities", "RunSummary",
-           "MEASURES", "measure"]  # fmt: skip
+__all__ = [
+    "StepLog",
+    "Friction",
+    "InterfaceQuantities",
+    "Quantities",
+    "RunSummary",
+    "MEASURES",
+    "measure",
+]
 
 
 @dataclass(frozen=True)
@@ -67,8 +74,13 @@ class Quantities:
         if self.interface is None:
             return {**_keys(self, _OBSTACLE), **_keys(self.friction, _FRICTION)}
         i = self.interface
-        return {**_keys(self, _INTERFACE), **_keys(i, _INTERFACE_PARTS), **i.extra,
-                "force": self.force, "peak_pressure": self.peak_pressure}  # fmt: skip
+        return {
+            **_keys(self, _INTERFACE),
+            **_keys(i, _INTERFACE_PARTS),
+            **i.extra,
+            "force": self.force,
+            "peak_pressure": self.peak_pressure,
+        }
 
     def step_json(self) -> dict[str, Any]:
         """The per-step subset written into run.json's ``steps``."""
@@ -82,26 +94,45 @@ class Quantities:
         if "normal_force" not in d:
             friction = Friction(**_attrs(d, _FRICTION)) if "friction_bound" in d else None
             return cls(**_attrs(d, _OBSTACLE), friction=friction)
-        known = {f.name for f in dataclasses.fields(RunSummary)} | set(_OBSTACLE) | set(
-            _INTERFACE) | set(_INTERFACE_PARTS) | {"status", "newton_iterations",
-            "ksp_iterations", "outer_iterations", "plot"}  # fmt: skip
+        known = (
+            {f.name for f in dataclasses.fields(RunSummary)}
+            | set(_OBSTACLE)
+            | set(_INTERFACE)
+            | set(_INTERFACE_PARTS)
+            | {"status", "newton_iterations", "ksp_iterations", "outer_iterations", "plot"}
+        )
         extra = {k: v for k, v in d.items() if k not in known}
         interface = InterfaceQuantities(**_attrs(d, _INTERFACE_PARTS), extra=extra)
         return cls(**_attrs(d, _INTERFACE), interface=interface)
 
 
 #: run.json key -> attribute, for each part of the state (the keys the README documents)
-_OBSTACLE = {"force": "force", "contact_half_width": "contact_size",
-             "peak_pressure": "peak_pressure", "max_penetration": "max_penetration",
-             "complementarity": "complementarity"}  # fmt: skip
-_FRICTION = {"tangential_force": "tangential_force", "stick_size": "stick_size",
-             "friction_bound": "bound", "slip_fraction": "slip_fraction",
-             "friction_excess": "excess"}  # fmt: skip
-_INTERFACE = {"normal_force": "force", "closed_length": "contact_size",
-              "max_pressure": "peak_pressure", "max_penetration": "max_penetration",
-              "complementarity": "complementarity"}  # fmt: skip
-_INTERFACE_PARTS = {"tangential_force": "tangential_force", "proppant_force": "proppant_force",
-                    "min_aperture_propped": "min_aperture_propped"}  # fmt: skip
+_OBSTACLE = {
+    "force": "force",
+    "contact_half_width": "contact_size",
+    "peak_pressure": "peak_pressure",
+    "max_penetration": "max_penetration",
+    "complementarity": "complementarity",
+}
+_FRICTION = {
+    "tangential_force": "tangential_force",
+    "stick_size": "stick_size",
+    "friction_bound": "bound",
+    "slip_fraction": "slip_fraction",
+    "friction_excess": "excess",
+}
+_INTERFACE = {
+    "normal_force": "force",
+    "closed_length": "contact_size",
+    "max_pressure": "peak_pressure",
+    "max_penetration": "max_penetration",
+    "complementarity": "complementarity",
+}
+_INTERFACE_PARTS = {
+    "tangential_force": "tangential_force",
+    "proppant_force": "proppant_force",
+    "min_aperture_propped": "min_aperture_propped",
+}
 
 
 def _keys(obj, table: dict[str, str], n: int | None = None) -> dict:
@@ -215,24 +246,47 @@ class RunSummary:
         """The summary of a run.json written by :meth:`to_json` (a child process's run; the
         steps keep their iterations, their quantities are the final state's)."""
         q = Quantities.from_json(d)
-        steps = [StepLog(*(s.get(f.name, 0) for f in dataclasses.fields(StepLog)[:-1]), q)
-                 for s in d["steps"]]  # fmt: skip
-        names = [f.name for f in dataclasses.fields(cls)
-                 if f.name not in ("steps", "quantities") and f.name in d]  # fmt: skip
+        steps = [
+            StepLog(*(s.get(f.name, 0) for f in dataclasses.fields(StepLog)[:-1]), q)
+            for s in d["steps"]
+        ]
+        names = [
+            f.name
+            for f in dataclasses.fields(cls)
+            if f.name not in ("steps", "quantities") and f.name in d
+        ]
         return cls(steps=steps, quantities=q, **{k: d[k] for k in names})
 
     def to_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {"status": "completed"}
-        for name in ("scene", "parameters", "numerics", "petsc_options", "petsc_prefix",
-                     "versions", "ranks", "dofs", "cells", "h_contact"):  # fmt: skip
+        for name in (
+            "scene",
+            "parameters",
+            "numerics",
+            "petsc_options",
+            "petsc_prefix",
+            "versions",
+            "ranks",
+            "dofs",
+            "cells",
+            "h_contact",
+        ):
             out[name] = getattr(self, name)
-        out.update(newton_iterations=self.newton_iterations,
-                   ksp_iterations=self.ksp_iterations, outer_iterations=self.outer_iterations,
-                   steps=[s.to_json() for s in self.steps], timings=dict(self.timings))  # fmt: skip
+        out.update(
+            newton_iterations=self.newton_iterations,
+            ksp_iterations=self.ksp_iterations,
+            outer_iterations=self.outer_iterations,
+            steps=[s.to_json() for s in self.steps],
+            timings=dict(self.timings),
+        )
         out.update(self.quantities.to_json())
-        out.update(paraview=self.paraview, paraview_surface=self.paraview_surface,
-                   reference=self.reference, scores=self.scores,
-                   errors=self.errors)  # fmt: skip
+        out.update(
+            paraview=self.paraview,
+            paraview_surface=self.paraview_surface,
+            reference=self.reference,
+            scores=self.scores,
+            errors=self.errors,
+        )
         if self.interface is not None or self.plot is not None:
             out["plot"] = self.plot
         return out
@@ -258,9 +312,16 @@ MEASURES: dict[str, tuple[str, str, str]] = {
 }
 
 #: stress's primary error, most specific first, with the short name it prints
-PRIMARY = (("K", "err_K"), ("settlement", "err_settlement"), ("opening L2", "err_opening"),
-           ("stick c", "err_c"), ("p L2", "err_p_L2"), ("punch p", "err_punch"),
-           ("Q = mu P", "err_Q"), ("force", "err_force"))  # fmt: skip
+PRIMARY = (
+    ("K", "err_K"),
+    ("settlement", "err_settlement"),
+    ("opening L2", "err_opening"),
+    ("stick c", "err_c"),
+    ("p L2", "err_p_L2"),
+    ("punch p", "err_punch"),
+    ("Q = mu P", "err_Q"),
+    ("force", "err_force"),
+)
 
 
 def measure(summary: RunSummary, column: str) -> float:

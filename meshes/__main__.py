@@ -151,8 +151,11 @@ def _parser() -> argparse.ArgumentParser:
     penny.add_argument("--h-crack", type=float, required=True, metavar="H")
     penny.add_argument("--h-far", type=float, required=True, metavar="H")
     _add_grading(penny)
-    penny.add_argument("--half", action="store_true", help="the half block y >= 0 (one "
-                       "symmetry plane) instead of the quarter")  # fmt: skip
+    penny.add_argument(
+        "--half",
+        action="store_true",
+        help="the half block y >= 0 (one symmetry plane) instead of the quarter",
+    )
     _add_output(penny)
 
     joint = geometries.add_parser(
@@ -208,32 +211,55 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.geometry == "rectangle":
         builder = partial(
             rectangle,
-            x0=args.x0, x1=args.x1, y0=args.y0, y1=args.y1,
-            refine_x0=args.refine_x0, refine_x1=args.refine_x1,
-            h_contact=args.h_contact, h_far=args.h_far, grading=args.grading,
-        )  # fmt: skip
+            x0=args.x0,
+            x1=args.x1,
+            y0=args.y0,
+            y1=args.y1,
+            refine_x0=args.refine_x0,
+            refine_x1=args.refine_x1,
+            h_contact=args.h_contact,
+            h_far=args.h_far,
+            grading=args.grading,
+        )
     elif args.geometry == "box":
         gdim, cells = 3, "tetrahedra"
         builder = partial(
             box,
-            x0=args.x0, x1=args.x1, y0=args.y0, y1=args.y1, z0=args.z0, z1=args.z1,
-            refine_center=tuple(args.refine_center), refine_radius=args.refine_radius,
-            h_contact=args.h_contact, h_far=args.h_far, grading=args.grading,
-        )  # fmt: skip
+            x0=args.x0,
+            x1=args.x1,
+            y0=args.y0,
+            y1=args.y1,
+            z0=args.z0,
+            z1=args.z1,
+            refine_center=tuple(args.refine_center),
+            refine_radius=args.refine_radius,
+            h_contact=args.h_contact,
+            h_far=args.h_far,
+            grading=args.grading,
+        )
     elif args.geometry == "crack-plate":
         builder = partial(
             crack_plate,
-            half_width=args.half_width, crack_half_length=args.crack_half_length,
-            angle=args.angle, h_crack=args.h_crack, h_far=args.h_far, grading=args.grading,
+            half_width=args.half_width,
+            crack_half_length=args.crack_half_length,
+            angle=args.angle,
+            h_crack=args.h_crack,
+            h_far=args.h_far,
+            grading=args.grading,
             split_at=tuple(args.split_at),
-        )  # fmt: skip
+        )
     elif args.geometry == "penny-block":
         gdim, cells = 3, "tetrahedra"
         builder = partial(
             penny_block,
-            half_width=args.half_width, crack_radius=args.crack_radius, h_front=args.h_front,
-            h_crack=args.h_crack, h_far=args.h_far, grading=args.grading, half=args.half,
-        )  # fmt: skip
+            half_width=args.half_width,
+            crack_radius=args.crack_radius,
+            h_front=args.h_front,
+            h_crack=args.h_crack,
+            h_far=args.h_far,
+            grading=args.grading,
+            half=args.half,
+        )
     elif args.geometry == "joint-column":
         builder = partial(joint_column, width=args.width, block_height=args.block_height, h=args.h)
     elif args.geometry in ("stacked-blocks", "stacked-boxes"):
@@ -241,32 +267,59 @@ def main(argv: Sequence[str] | None = None) -> int:
             gdim, cells = 3, "tetrahedra"
         builder = partial(
             stacked_blocks if gdim == 2 else stacked_boxes,
-            width=args.width, h_lower=args.h_lower, h_upper=args.h_upper, h1=args.h1,
-            ratio=args.ratio, offset=args.offset, upper_width=args.upper_width,
-        )  # fmt: skip
+            width=args.width,
+            h_lower=args.h_lower,
+            h_upper=args.h_upper,
+            h1=args.h1,
+            ratio=args.ratio,
+            offset=args.offset,
+            upper_width=args.upper_width,
+        )
     elif args.geometry in ("cylinders", "spheres"):
         if args.geometry == "spheres":
             gdim, cells = 3, "tetrahedra"
         builder = partial(
             cylinders if gdim == 2 else spheres,
-            radius_lower=args.radius_lower, radius_upper=args.radius_upper,
-            h_contact=args.h_contact, h_far=args.h_far, refine=args.refine,
-            ratio=args.ratio, offset=args.offset, grading=args.grading,
-        )  # fmt: skip
+            radius_lower=args.radius_lower,
+            radius_upper=args.radius_upper,
+            h_contact=args.h_contact,
+            h_far=args.h_far,
+            refine=args.refine,
+            ratio=args.ratio,
+            offset=args.offset,
+            grading=args.grading,
+        )
     elif args.geometry == "rounded-on-block":
         builder = partial(
             rounded_on_block,
-            radius=args.radius, height=args.height, left=args.left, right=args.right,
-            depth=args.depth, track=args.track, h_contact=args.h_contact, h_far=args.h_far,
-            refine=args.refine, ratio=args.ratio, offset=args.offset, grading=args.grading,
-        )  # fmt: skip
+            radius=args.radius,
+            height=args.height,
+            left=args.left,
+            right=args.right,
+            depth=args.depth,
+            track=args.track,
+            h_contact=args.h_contact,
+            h_far=args.h_far,
+            refine=args.refine,
+            ratio=args.ratio,
+            offset=args.offset,
+            grading=args.grading,
+        )
     else:
         builder = partial(
             punch_foundation,
-            width=args.width, depth=args.depth, b=args.b, rho=args.rho, h_punch=args.h_punch,
-            h_contact=args.h_contact, h_far=args.h_far, refine=args.refine,
-            ratio=args.ratio, offset=args.offset, grading=args.grading,
-        )  # fmt: skip
+            width=args.width,
+            depth=args.depth,
+            b=args.b,
+            rho=args.rho,
+            h_punch=args.h_punch,
+            h_contact=args.h_contact,
+            h_far=args.h_far,
+            refine=args.refine,
+            ratio=args.ratio,
+            offset=args.offset,
+            grading=args.grading,
+        )
     try:
         info = write_msh(builder, gdim, args.out, args.name or args.out.stem)
     except (ValueError, OSError) as exc:

@@ -195,8 +195,9 @@ def build(comm: MPI.Comm, builder: Builder, gdim: int, name: str) -> MeshData:
     return MeshData(mesh, cell_tags, facet_tags)
 
 
-def write_msh(builder: Builder, gdim: int, path: str | os.PathLike[str], name: str,
-              binary: bool = False) -> MshInfo:  # fmt: skip
+def write_msh(
+    builder: Builder, gdim: int, path: str | os.PathLike[str], name: str, binary: bool = False
+) -> MshInfo:
     """Run ``builder`` with gmsh alone and write the mesh to ``path`` (gmsh format 4.1).
 
     Only the elements of physical groups are written, with their physical tags (gmsh's default
@@ -343,8 +344,15 @@ def set_graded_size(
     return size
 
 
-def refine_near(model: type[gmsh.model], size: int, distance: str, *, size_min: float,
-                size_max: float, grading: float) -> int:  # fmt: skip
+def refine_near(
+    model: type[gmsh.model],
+    size: int,
+    distance: str,
+    *,
+    size_min: float,
+    size_max: float,
+    grading: float,
+) -> int:
     """Combine the size field ``size`` with a finer zone: the size ``size_min`` at distance 0
     of it (``distance``, a MathEval expression) growing by ``grading`` per unit distance up to
     ``size_max``; the smaller of the two holds (a gmsh Min field, the background mesh).
@@ -382,8 +390,10 @@ class Group:
 def _collect_groups(model: type[gmsh.model], groups: list[Group], where: str) -> None:
     """Append the model's named physical groups (with their element counts) to ``groups``."""
     if not model.getPhysicalGroups():
-        raise ValueError(f"{where}: the mesh has no physical group (name the bodies and "
-                         "the boundaries with Physical Curve / Surface / Volume)")  # fmt: skip
+        raise ValueError(
+            f"{where}: the mesh has no physical group (name the bodies and "
+            "the boundaries with Physical Curve / Surface / Volume)"
+        )
     for dim, tag in model.getPhysicalGroups():
         name = model.getPhysicalName(dim, tag) or str(tag)
         count = 0
@@ -427,8 +437,9 @@ def file_groups(path: str | os.PathLike[str], size_factor: float = 1.0):
     return builder, groups
 
 
-def build_file(comm: MPI.Comm, path: str | os.PathLike[str], size_factor: float,
-               name: str) -> tuple[MeshData, list[Group]]:  # fmt: skip
+def build_file(
+    comm: MPI.Comm, path: str | os.PathLike[str], size_factor: float, name: str
+) -> tuple[MeshData, list[Group]]:
     """:func:`build` for a mesh file (:func:`file_groups`): the distributed mesh and, on every
     rank, the file's physical groups. The dimension is the file's (a 2D mesh in the plane z = 0
     gives a 2D mesh). Collective; a missing file raises FileNotFoundError on every rank."""
@@ -441,8 +452,9 @@ def build_file(comm: MPI.Comm, path: str | os.PathLike[str], size_factor: float,
     return build_grouped(comm, builder, groups, name)
 
 
-def build_grouped(comm: MPI.Comm, builder: Builder, groups: list[Group],
-                  name: str) -> tuple[MeshData, list[Group]]:  # fmt: skip
+def build_grouped(
+    comm: MPI.Comm, builder: Builder, groups: list[Group], name: str
+) -> tuple[MeshData, list[Group]]:
     """:func:`build` for a builder that fills ``groups`` on the gmsh rank
     (:func:`builder_groups`, :func:`file_groups`): the distributed mesh and, on every rank, the
     named physical groups; the dimension is the highest of a group. Collective; an error of the

@@ -84,10 +84,18 @@ def box(
         raise ValueError(f"refine_center must be (cx, cy), got {refine_center}")
     cx, cy = refine_center
     check_finite(
-        x0=x0, x1=x1, y0=y0, y1=y1, z0=z0, z1=z1, refine_radius=refine_radius,
-        h_contact=h_contact, h_far=h_far, grading=grading,
+        x0=x0,
+        x1=x1,
+        y0=y0,
+        y1=y1,
+        z0=z0,
+        z1=z1,
+        refine_radius=refine_radius,
+        h_contact=h_contact,
+        h_far=h_far,
+        grading=grading,
         **{"refine_center[0]": cx, "refine_center[1]": cy},
-    )  # fmt: skip
+    )
     check_less("x0", x0, "x1", x1)
     check_less("y0", y0, "y1", y1)
     check_less("z0", z0, "z1", z1)

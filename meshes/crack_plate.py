@@ -101,13 +101,20 @@ def crack_plate(
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
     check_finite(
-        half_width=half_width, crack_half_length=crack_half_length, angle=angle,
-        h_crack=h_crack, h_far=h_far, grading=grading,
-    )  # fmt: skip
+        half_width=half_width,
+        crack_half_length=crack_half_length,
+        angle=angle,
+        h_crack=h_crack,
+        h_far=h_far,
+        grading=grading,
+    )
     check_positive(
-        half_width=half_width, crack_half_length=crack_half_length,
-        h_crack=h_crack, h_far=h_far, grading=grading,
-    )  # fmt: skip
+        half_width=half_width,
+        crack_half_length=crack_half_length,
+        h_crack=h_crack,
+        h_far=h_far,
+        grading=grading,
+    )
     # a < half_width keeps the crack inside the plate's inscribed circle, whatever the angle:
     # the tips' distance to the edges, half_width - a * max(|cos|, |sin|), is then > 0.
     check_less("crack_half_length", crack_half_length, "half_width", half_width)
@@ -132,8 +139,7 @@ def crack_plate(
     if embed:
         stations = sorted((-crack_half_length, *split_at, crack_half_length))
         points = [model.occ.addPoint(s * cos, s * sin, 0.0) for s in stations]
-        lines = [(1, model.occ.addLine(p, q))
-                 for p, q in zip(points[:-1], points[1:], strict=True)]  # fmt: skip
+        lines = [(1, model.occ.addLine(p, q)) for p, q in zip(points[:-1], points[1:], strict=True)]
         # The square comes out as one surface with the crack lines embedded in it (they do
         # not cut it in two); children[1:] are the crack lines' images.
         _, children = model.occ.fragment([(2, surface)], lines)
@@ -167,8 +173,14 @@ def crack_plate(
         grading=grading,
     )
     if h_tip < h_crack:  # the smaller of that size and h_tip + grading * (distance to a tip)
-        refine_near(model, size, f"Sqrt((Fabs({along})-{a})^2+{across}^2)", size_min=h_tip,
-                    size_max=h_far, grading=grading)  # fmt: skip
+        refine_near(
+            model,
+            size,
+            f"Sqrt((Fabs({along})-{a})^2+{across}^2)",
+            size_min=h_tip,
+            size_max=h_far,
+            grading=grading,
+        )
     import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
@@ -280,10 +292,22 @@ def crack_set_plate(
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
-    check_finite(half_width=half_width, crack_half_length=crack_half_length, h_crack=h_crack,
-                 h_tip=h_tip, h_far=h_far, grading=grading)  # fmt: skip
-    check_positive(half_width=half_width, crack_half_length=crack_half_length, h_crack=h_crack,
-                   h_tip=h_tip, h_far=h_far, grading=grading)  # fmt: skip
+    check_finite(
+        half_width=half_width,
+        crack_half_length=crack_half_length,
+        h_crack=h_crack,
+        h_tip=h_tip,
+        h_far=h_far,
+        grading=grading,
+    )
+    check_positive(
+        half_width=half_width,
+        crack_half_length=crack_half_length,
+        h_crack=h_crack,
+        h_tip=h_tip,
+        h_far=h_far,
+        grading=grading,
+    )
     check_less_equal("h_tip", h_tip, "h_crack", h_crack)
     check_less_equal("h_crack", h_crack, "h_far", h_far)
     if not cracks:
@@ -311,15 +335,26 @@ def crack_set_plate(
         beyond_tips = f"(Fabs({along}-{a})+Fabs({along}+{a})-2*{a})/2"
         distance = f"Sqrt(({beyond_tips})^2+{across}^2)"
         if size is None:
-            size = set_graded_size(model, distance, size_min=h_crack, size_max=h_far,
-                                   dist_min=0.5 * crack_half_length, grading=grading)  # fmt: skip
+            size = set_graded_size(
+                model,
+                distance,
+                size_min=h_crack,
+                size_max=h_far,
+                dist_min=0.5 * crack_half_length,
+                grading=grading,
+            )
         else:
             zone = f"({distance}-{matheval_number(0.5 * crack_half_length)})"
-            size = refine_near(model, size, zone, size_min=h_crack, size_max=h_far,
-                               grading=grading)  # fmt: skip
+            size = refine_near(model, size, zone, size_min=h_crack, size_max=h_far, grading=grading)
         if h_tip < h_crack:
-            size = refine_near(model, size, f"Sqrt((Fabs({along})-{a})^2+{across}^2)",
-                               size_min=h_tip, size_max=h_far, grading=grading)  # fmt: skip
+            size = refine_near(
+                model,
+                size,
+                f"Sqrt((Fabs({along})-{a})^2+{across}^2)",
+                size_min=h_tip,
+                size_max=h_far,
+                grading=grading,
+            )
     import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)

@@ -92,10 +92,22 @@ def penny_block(
     Raises:
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
-    check_finite(half_width=half_width, crack_radius=crack_radius, h_front=h_front,
-                 h_crack=h_crack, h_far=h_far, grading=grading)  # fmt: skip
-    check_positive(half_width=half_width, crack_radius=crack_radius, h_front=h_front,
-                   h_crack=h_crack, h_far=h_far, grading=grading)  # fmt: skip
+    check_finite(
+        half_width=half_width,
+        crack_radius=crack_radius,
+        h_front=h_front,
+        h_crack=h_crack,
+        h_far=h_far,
+        grading=grading,
+    )
+    check_positive(
+        half_width=half_width,
+        crack_radius=crack_radius,
+        h_front=h_front,
+        h_crack=h_crack,
+        h_far=h_far,
+        grading=grading,
+    )
     check_less("crack_radius", crack_radius, "half_width", half_width)
     check_less_equal("h_front", h_front, "h_crack", h_crack)
     check_less_equal("h_crack", h_crack, "h_far", h_far)
@@ -120,19 +132,32 @@ def penny_block(
         PennyBlockFacets.BOTTOM: (2, -w),
         PennyBlockFacets.TOP: (2, w),
     }
-    add_physical_groups(model, PennyBlockCells.DOMAIN, sides,
-                        interior={PennyBlockFacets.CRACK: crack})  # fmt: skip
+    add_physical_groups(
+        model, PennyBlockCells.DOMAIN, sides, interior={PennyBlockFacets.CRACK: crack}
+    )
 
     # Distances: to the crack disk, sqrt(max(r - a, 0)^2 + z^2) = sqrt(((|r - a| + r - a) / 2)^2
     # + z^2), and to the front circle, sqrt((r - a)^2 + z^2), with r = sqrt(x^2 + y^2).
     am = matheval_number(a)
     r = "Sqrt(x^2+y^2)"
     beyond = f"((Fabs({r}-{am})+{r}-{am})/2)"
-    size = set_graded_size(model, f"Sqrt({beyond}^2+z^2)", size_min=h_crack, size_max=h_far,
-                           dist_min=0.5 * a, grading=grading)  # fmt: skip
+    size = set_graded_size(
+        model,
+        f"Sqrt({beyond}^2+z^2)",
+        size_min=h_crack,
+        size_max=h_far,
+        dist_min=0.5 * a,
+        grading=grading,
+    )
     if h_front < h_crack:  # the smaller of that size and h_front + grading * (distance to front)
-        refine_near(model, size, f"Sqrt(({r}-{am})^2+z^2)", size_min=h_front, size_max=h_far,
-                    grading=grading)  # fmt: skip
+        refine_near(
+            model,
+            size,
+            f"Sqrt(({r}-{am})^2+z^2)",
+            size_min=h_front,
+            size_max=h_far,
+            grading=grading,
+        )
     import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)

@@ -84,9 +84,16 @@ def rectangle(
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
     check_finite(
-        x0=x0, x1=x1, y0=y0, y1=y1, refine_x0=refine_x0, refine_x1=refine_x1,
-        h_contact=h_contact, h_far=h_far, grading=grading,
-    )  # fmt: skip
+        x0=x0,
+        x1=x1,
+        y0=y0,
+        y1=y1,
+        refine_x0=refine_x0,
+        refine_x1=refine_x1,
+        h_contact=h_contact,
+        h_far=h_far,
+        grading=grading,
+    )
     check_less("x0", x0, "x1", x1)
     check_less("y0", y0, "y1", y1)
     check_less_equal("x0", x0, "refine_x0", refine_x0)
@@ -123,8 +130,10 @@ def rectangle(
         cells = [tag for _, tag in model.getEntities(2)]
         upper = [c for c in cells if model.getBoundingBox(2, c)[1] >= top - tol]
         model.removePhysicalGroups([(2, RectangleCells.DOMAIN.value)])
-        for group, members in ((RectangleCells.DOMAIN, [c for c in cells if c not in upper]),
-                               (RectangleCells.LAYER, upper)):  # fmt: skip
+        for group, members in (
+            (RectangleCells.DOMAIN, [c for c in cells if c not in upper]),
+            (RectangleCells.LAYER, upper),
+        ):
             model.addPhysicalGroup(2, members, group.value)
             model.setPhysicalName(2, group.value, group.name.lower())
 

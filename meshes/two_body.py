@@ -464,16 +464,24 @@ def stacked_blocks(
         {
             StackedBlocksCells.LOWER: (
                 lower,
-                {f.LOWER_BOTTOM: [bottom], f.LOWER_RIGHT: [right], f.LOWER_TOP: [top],
-                 f.LOWER_LEFT: [left]},
+                {
+                    f.LOWER_BOTTOM: [bottom],
+                    f.LOWER_RIGHT: [right],
+                    f.LOWER_TOP: [top],
+                    f.LOWER_LEFT: [left],
+                },
             ),
             StackedBlocksCells.UPPER: (
                 upper,
-                {f.UPPER_BOTTOM: upper_bottom, f.UPPER_RIGHT: [upper_right],
-                 f.UPPER_TOP: [upper_top], f.UPPER_LEFT: [upper_left]},
+                {
+                    f.UPPER_BOTTOM: upper_bottom,
+                    f.UPPER_RIGHT: [upper_right],
+                    f.UPPER_TOP: [upper_top],
+                    f.UPPER_LEFT: [upper_left],
+                },
             ),
         },
-    )  # fmt: skip
+    )
     # Uniform sizes: size_min == size_max makes the distance irrelevant.
     _set_body_sizes(model, 2, [(lower, h1, h1), (upper, h2, h2)], "0", dist_min=0.0, grading=1.0)
     _generate(model, 2)
@@ -529,15 +537,31 @@ def stacked_boxes(
 
     f = StackedBoxesFacets
     lower_faces = _faces_by_plane(
-        model, 3, lower,
-        {f.LOWER_X0: (0, 0.0), f.LOWER_X1: (0, width), f.LOWER_Y0: (1, 0.0),
-         f.LOWER_Y1: (1, width), f.LOWER_BOTTOM: (2, -h_lower), f.LOWER_TOP: (2, 0.0)},
-    )  # fmt: skip
+        model,
+        3,
+        lower,
+        {
+            f.LOWER_X0: (0, 0.0),
+            f.LOWER_X1: (0, width),
+            f.LOWER_Y0: (1, 0.0),
+            f.LOWER_Y1: (1, width),
+            f.LOWER_BOTTOM: (2, -h_lower),
+            f.LOWER_TOP: (2, 0.0),
+        },
+    )
     upper_faces = _faces_by_plane(
-        model, 3, upper,
-        {f.UPPER_X0: (0, 0.0), f.UPPER_X1: (0, upper_width), f.UPPER_Y0: (1, 0.0),
-         f.UPPER_Y1: (1, upper_width), f.UPPER_BOTTOM: (2, 0.0), f.UPPER_TOP: (2, h_upper)},
-    )  # fmt: skip
+        model,
+        3,
+        upper,
+        {
+            f.UPPER_X0: (0, 0.0),
+            f.UPPER_X1: (0, upper_width),
+            f.UPPER_Y0: (1, 0.0),
+            f.UPPER_Y1: (1, upper_width),
+            f.UPPER_BOTTOM: (2, 0.0),
+            f.UPPER_TOP: (2, h_upper),
+        },
+    )
     _add_body_groups(
         model,
         {
@@ -604,8 +628,9 @@ def cylinders(
         ValueError: Before any gmsh call, if a parameter is invalid.
     """
     if full:
-        _full_cylinders(model, radius_lower, radius_upper, h_contact, h_far, refine, ratio,
-                        offset, grading)  # fmt: skip
+        _full_cylinders(
+            model, radius_lower, radius_upper, h_contact, h_far, refine, ratio, offset, grading
+        )
         return
     check_finite(radius_lower=radius_lower, radius_upper=radius_upper)
     check_positive(radius_lower=radius_lower, radius_upper=radius_upper)
@@ -644,16 +669,22 @@ def cylinders(
         {
             CylindersCells.LOWER: (
                 lower,
-                {f.LOWER_CONTACT: [lower_arc], f.LOWER_BOTTOM: [lower_bottom],
-                 f.LOWER_SYMMETRY: [lower_symmetry]},
+                {
+                    f.LOWER_CONTACT: [lower_arc],
+                    f.LOWER_BOTTOM: [lower_bottom],
+                    f.LOWER_SYMMETRY: [lower_symmetry],
+                },
             ),
             CylindersCells.UPPER: (
                 upper,
-                {f.UPPER_CONTACT: upper_arc, f.UPPER_TOP: [upper_top],
-                 f.UPPER_SYMMETRY: [upper_symmetry]},
+                {
+                    f.UPPER_CONTACT: upper_arc,
+                    f.UPPER_TOP: [upper_top],
+                    f.UPPER_SYMMETRY: [upper_symmetry],
+                },
             ),
         },
-    )  # fmt: skip
+    )
     _set_body_sizes(
         model,
         2,
@@ -676,8 +707,9 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
         _check_first_element(l0, "the upper contact arc", 0.5 * math.pi * r1)
     occ = model.occ
     # lower: the arc (-R2, -R2) -> origin -> (R2, -R2) around (0, -R2), closed by its bottom
-    left, origin, right, centre = (occ.addPoint(x, y, 0.0) for x, y in
-                                   ((-r2, -r2), (0.0, 0.0), (r2, -r2), (0.0, -r2)))  # fmt: skip
+    left, origin, right, centre = (
+        occ.addPoint(x, y, 0.0) for x, y in ((-r2, -r2), (0.0, 0.0), (r2, -r2), (0.0, -r2))
+    )
     lower_arc = [occ.addCircleArc(left, centre, origin), occ.addCircleArc(origin, centre, right)]
     (lower_bottom,) = _polyline(model, [right, left])
     lower = _surface(model, [*lower_arc, lower_bottom])
@@ -690,8 +722,9 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
     else:
         angles[1:1] = [0.0]
     points = [occ.addPoint(r1 * math.sin(t), r1 * (1 - math.cos(t)), 0.0) for t in angles]
-    upper_arc = [occ.addCircleArc(a, centre, b) for a, b in zip(points[:-1], points[1:],
-                                                                   strict=True)]  # fmt: skip
+    upper_arc = [
+        occ.addCircleArc(a, centre, b) for a, b in zip(points[:-1], points[1:], strict=True)
+    ]
     (upper_top,) = _polyline(model, [points[-1], points[0]])
     upper = _surface(model, [*upper_arc, upper_top])
     occ.synchronize()
@@ -700,12 +733,22 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
     f = CylindersFacets
     _add_body_groups(
         model,
-        {CylindersCells.LOWER: (lower, {f.LOWER_CONTACT: lower_arc,
-                                        f.LOWER_BOTTOM: [lower_bottom]}),
-         CylindersCells.UPPER: (upper, {f.UPPER_CONTACT: upper_arc, f.UPPER_TOP: [upper_top]})},
-    )  # fmt: skip
-    _set_body_sizes(model, 2, [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
-                    "Sqrt(x^2+y^2)", dist_min=refine, grading=grading)  # fmt: skip
+        {
+            CylindersCells.LOWER: (
+                lower,
+                {f.LOWER_CONTACT: lower_arc, f.LOWER_BOTTOM: [lower_bottom]},
+            ),
+            CylindersCells.UPPER: (upper, {f.UPPER_CONTACT: upper_arc, f.UPPER_TOP: [upper_top]}),
+        },
+    )
+    _set_body_sizes(
+        model,
+        2,
+        [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
+        "Sqrt(x^2+y^2)",
+        dist_min=refine,
+        grading=grading,
+    )
     _generate(model, 2)
 
 
@@ -795,16 +838,24 @@ def punch_foundation(
         {
             PunchFoundationCells.BLOCK: (
                 block,
-                {f.BLOCK_TOP: [block_top], f.BLOCK_RIGHT: [block_right],
-                 f.BLOCK_BOTTOM: [block_bottom], f.BLOCK_SYMMETRY: [block_symmetry]},
+                {
+                    f.BLOCK_TOP: [block_top],
+                    f.BLOCK_RIGHT: [block_right],
+                    f.BLOCK_BOTTOM: [block_bottom],
+                    f.BLOCK_SYMMETRY: [block_symmetry],
+                },
             ),
             PunchFoundationCells.PUNCH: (
                 punch,
-                {f.PUNCH_CONTACT: [*flat, rounded], f.PUNCH_SIDE: [punch_side],
-                 f.PUNCH_TOP: [punch_top], f.PUNCH_SYMMETRY: [punch_symmetry]},
+                {
+                    f.PUNCH_CONTACT: [*flat, rounded],
+                    f.PUNCH_SIDE: [punch_side],
+                    f.PUNCH_TOP: [punch_top],
+                    f.PUNCH_SYMMETRY: [punch_symmetry],
+                },
             ),
         },
-    )  # fmt: skip
+    )
     # Distance to the segment [0, b] x {0}, as in rectangle().
     zone = matheval_number(b)
     along = f"(Fabs(x)+Fabs(x-{zone})-{zone})/2"
@@ -912,12 +963,16 @@ def rounded_on_block(
         {
             RoundedOnBlockCells.BLOCK: (
                 block,
-                {f.BLOCK_TOP: [block_top], f.BLOCK_RIGHT: [block_right],
-                 f.BLOCK_BOTTOM: [block_bottom], f.BLOCK_LEFT: [block_left]},
+                {
+                    f.BLOCK_TOP: [block_top],
+                    f.BLOCK_RIGHT: [block_right],
+                    f.BLOCK_BOTTOM: [block_bottom],
+                    f.BLOCK_LEFT: [block_left],
+                },
             ),
             RoundedOnBlockCells.ROUNDED: (rounded, {f.ROUNDED_CONTACT: arcs, f.ROUNDED_TOP: [top]}),
         },
-    )  # fmt: skip
+    )
     # The block: distance to the track [0, track] x {0}, as in rectangle(); the body: to the
     # origin.
     end = matheval_number(track)
@@ -989,15 +1044,19 @@ def spheres(
 
     f = SpheresFacets
     lower_faces = _faces_by_plane(
-        model, 3, lower,
+        model,
+        3,
+        lower,
         {f.LOWER_BOTTOM: (2, -r2), f.LOWER_X0: (0, 0.0), f.LOWER_Y0: (1, 0.0)},
         rest=f.LOWER_CONTACT,
-    )  # fmt: skip
+    )
     upper_faces = _faces_by_plane(
-        model, 3, upper,
+        model,
+        3,
+        upper,
         {f.UPPER_TOP: (2, r1), f.UPPER_X0: (0, 0.0), f.UPPER_Y0: (1, 0.0)},
         rest=f.UPPER_CONTACT,
-    )  # fmt: skip
+    )
     _add_body_groups(
         model,
         {SpheresCells.LOWER: (lower, lower_faces), SpheresCells.UPPER: (upper, upper_faces)},

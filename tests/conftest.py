@@ -25,8 +25,10 @@ def pytest_runtest_logreport(report):
     comm = MPI.COMM_WORLD
     if comm.size > 1 and report.failed:
         rank = comm.rank
-        sys.stderr.write(f"\nrank {rank}: {report.nodeid} failed ({report.when}):\n"
-                         f"{report.longreprtext}\nrank {rank}: aborting the MPI job\n")  # fmt: skip
+        sys.stderr.write(
+            f"\nrank {rank}: {report.nodeid} failed ({report.when}):\n"
+            f"{report.longreprtext}\nrank {rank}: aborting the MPI job\n"
+        )
         sys.stderr.flush()
         comm.Abort(1)
 

@@ -118,8 +118,9 @@ def test_bad_input(args, message, ranks):
 
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_diverging_solve_is_reported_and_marked_failed(tmp_path, ranks):
-    res = run_cli("run", "hertz2d", *FAST, "--out", str(tmp_path), "--", "-snes_max_it", "1",
-                  ranks=ranks)  # fmt: skip
+    res = run_cli(
+        "run", "hertz2d", *FAST, "--out", str(tmp_path), "--", "-snes_max_it", "1", ranks=ranks
+    )
     assert res.returncode != 0
     assert "nonlinear solve diverged at load step 1" in res.stderr
     assert "DIVERGED_MAX_IT" in res.stderr
@@ -128,8 +129,7 @@ def test_diverging_solve_is_reported_and_marked_failed(tmp_path, ranks):
 
 
 def test_run_two_ranks_writes_results(tmp_path):
-    res = run_cli("run", "hertz2d", *FAST, "--out", str(tmp_path), "--", "-snes_monitor",
-                  ranks=2)  # fmt: skip
+    res = run_cli("run", "hertz2d", *FAST, "--out", str(tmp_path), "--", "-snes_monitor", ranks=2)
     assert res.returncode == 0, res.stderr
     assert "SNES Function norm" in res.stdout  # command-line PETSc options reach PETSc
     assert "peak pressure p0" in res.stdout and "ParaView: " in res.stdout
@@ -157,11 +157,11 @@ def test_init_then_solve_two_ranks_reproduces_the_run(tmp_path):
     """The user's path: `contactfx init` writes the scene as a problem file, `contactfx solve`
     on it (2 ranks, as `contactfx run`) gives the run's numbers (the same discrete problem:
     round-off apart, tests/verification/test_init.py)."""
-    run = run_cli("run", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "run"),
-                  "--quiet", ranks=2)  # fmt: skip
+    run = run_cli(
+        "run", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "run"), "--quiet", ranks=2
+    )
     assert run.returncode == 0, run.stderr
-    init = run_cli("init", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "p"),
-                   ranks=2)  # fmt: skip
+    init = run_cli("init", "hertz2d", *FAST, "--steps", "2", "--out", str(tmp_path / "p"), ranks=2)
     assert init.returncode == 0, init.stderr
     toml = tmp_path / "p" / "hertz2d.toml"
     assert f"wrote {toml}" in init.stdout and (tmp_path / "p" / "hertz2d.msh").is_file()
@@ -173,8 +173,9 @@ def test_init_then_solve_two_ranks_reproduces_the_run(tmp_path):
     assert b["newton_iterations"] == a["newton_iterations"]
     for key in ("force", "contact_half_width", "peak_pressure"):
         assert b[key] == pytest.approx(a[key], rel=1e-10), key
-    assert [s["force"] for s in b["steps"]] == pytest.approx([s["force"] for s in a["steps"]],
-                                                              rel=1e-10)  # fmt: skip
+    assert [s["force"] for s in b["steps"]] == pytest.approx(
+        [s["force"] for s in a["steps"]], rel=1e-10
+    )
 
 
 def test_module_entry_point_westergaard():
@@ -186,8 +187,20 @@ def test_module_entry_point_westergaard():
 def test_bench_command_line(tmp_path):
     """The bench entry point end to end (positional case, method list, the linear yardstick
     with repeated runs, CSV written)."""
-    res = run_cli("bench", "hertz2d", "--method", "nitsche@-1,penalty@100", "--levels", "1",
-                  "--linear", "--repeat", "2", "--out", str(tmp_path), timeout=300)  # fmt: skip
+    res = run_cli(
+        "bench",
+        "hertz2d",
+        "--method",
+        "nitsche@-1,penalty@100",
+        "--levels",
+        "1",
+        "--linear",
+        "--repeat",
+        "2",
+        "--out",
+        str(tmp_path),
+        timeout=300,
+    )
     assert res.returncode == 0, res.stderr
     assert "nitsche(-1)" in res.stdout and "penalty(100)" in res.stdout
     assert res.stdout.count("contact/linear") == 2
@@ -276,12 +289,22 @@ SYSTEM_PYTHON = Path("/usr/bin/python3")
 def test_module_in_checkout_without_install_says_which_interpreter():
     """In the source folder an interpreter without contactfx installed finds the folder's
     contactfx/ (without contactfx.meshes): one line saying to use the venv, no traceback."""
-    installed = subprocess.run([str(SYSTEM_PYTHON), "-c", "import contactfx.meshes"], cwd="/",
-                               capture_output=True, env=clean_env())  # fmt: skip
+    installed = subprocess.run(
+        [str(SYSTEM_PYTHON), "-c", "import contactfx.meshes"],
+        cwd="/",
+        capture_output=True,
+        env=clean_env(),
+    )
     if installed.returncode == 0:
         pytest.skip("contactfx is installed for /usr/bin/python3")
-    res = subprocess.run([str(SYSTEM_PYTHON), "-m", "contactfx", "list"], cwd=ROOT,
-                         capture_output=True, text=True, env=clean_env(), timeout=60)  # fmt: skip
+    res = subprocess.run(
+        [str(SYSTEM_PYTHON), "-m", "contactfx", "list"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=clean_env(),
+        timeout=60,
+    )
     assert res.returncode == 1
     assert res.stderr.splitlines() == [
         "contactfx: error: contactfx is not installed for /usr/bin/python3: use the venv of "

@@ -97,19 +97,41 @@ print("PROBE " + json.dumps(result))
 """
 
 OBSTACLE = {"displacement", "contact_pressure", "gap", "contact_status"}
-INTERFACE = {"displacement", "enrichment", "aperture", "slip", "normal_traction", "gap",
-             "interface_status"}  # fmt: skip
+INTERFACE = {
+    "displacement",
+    "enrichment",
+    "aperture",
+    "slip",
+    "normal_traction",
+    "gap",
+    "interface_status",
+}
 
 #: kind -> (command-line arguments, point fields, cell fields, colour by, warp scale)
 CASES = {
-    "obstacle": (["hertz2d", "--h-contact", "0.01", "--h-far", "0.2", "--steps", "2"],
-                 OBSTACLE, {"von_mises"}, "contact_pressure", 50.0),
-    "interface": (["crack-sneddon", "--h-crack", "0.1", "--h-tip", "0.02", "--h-far", "2"],
-                  INTERFACE, {"von_mises"}, "aperture", 2000.0),
+    "obstacle": (
+        ["hertz2d", "--h-contact", "0.01", "--h-far", "0.2", "--steps", "2"],
+        OBSTACLE,
+        {"von_mises"},
+        "contact_pressure",
+        50.0,
+    ),
+    "interface": (
+        ["crack-sneddon", "--h-crack", "0.1", "--h-tip", "0.02", "--h-far", "2"],
+        INTERFACE,
+        {"von_mises"},
+        "aperture",
+        2000.0,
+    ),
     "two-body": (["patch-test"], OBSTACLE, {"von_mises"}, "contact_pressure", 50.0),
-    "two-body-3d": (["patch-test", "--dim", "3", "--h", "0.2"], OBSTACLE, {"von_mises"},
-                    "contact_pressure", 50.0),
-}  # fmt: skip
+    "two-body-3d": (
+        ["patch-test", "--dim", "3", "--h", "0.2"],
+        OBSTACLE,
+        {"von_mises"},
+        "contact_pressure",
+        50.0,
+    ),
+}
 
 
 #: pvpython's X connection to the module's Xvfb failed now and then ("bad X server
@@ -130,10 +152,10 @@ class _Display:
 
     def _start(self) -> str:
         read, write = os.pipe()
-        argv = [XVFB, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten",
-                "tcp"]  # fmt: skip
-        self.server = subprocess.Popen(argv, pass_fds=(write,), stdout=subprocess.DEVNULL,
-                                       stderr=subprocess.DEVNULL)  # fmt: skip
+        argv = [XVFB, "-displayfd", str(write), "-screen", "0", "1024x768x24", "-nolisten", "tcp"]
+        self.server = subprocess.Popen(
+            argv, pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        )
         os.close(write)
         with os.fdopen(read) as pipe:
             ready, _, _ = select.select([pipe], [], [], 60.0)
@@ -166,8 +188,17 @@ def _probe(out, scene, field, scale, display):
     png = out / f"{scene}-paraview.png"
     script = out / "probe.py"
     script.write_text(PROBE)
-    cmd = [PVPYTHON, "--force-offscreen-rendering", str(script), str(out / f"{scene}.pvd"),
-           str(out / f"{scene}_surface.pvd"), str(png), "POINTS", str(scale), field]  # fmt: skip
+    cmd = [
+        PVPYTHON,
+        "--force-offscreen-rendering",
+        str(script),
+        str(out / f"{scene}.pvd"),
+        str(out / f"{scene}_surface.pvd"),
+        str(png),
+        "POINTS",
+        str(scale),
+        field,
+    ]
     for _ in range(X_ATTEMPTS):
         env = {**clean_env(), "DISPLAY": display.name}
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)

@@ -11,9 +11,14 @@ import time
 from contactfx.params import option_name
 
 __all__ = [
-    "Parser", "attach_negative_numbers", "split_petsc", "petsc_dict", "add_options", "int_list",
+    "Parser",
+    "attach_negative_numbers",
+    "split_petsc",
+    "petsc_dict",
+    "add_options",
+    "int_list",
     "finish_table",
-]  # fmt: skip
+]
 
 
 class Parser(argparse.ArgumentParser):
@@ -41,8 +46,13 @@ def attach_negative_numbers(args: list[str]) -> list[str]:
     out: list[str] = []
     for arg in args:
         prev = out[-1] if out else ""
-        if (arg.startswith("-") and _is_number(arg) and prev.startswith("-") and "=" not in prev
-                and not _is_number(prev)):  # fmt: skip
+        if (
+            arg.startswith("-")
+            and _is_number(arg)
+            and prev.startswith("-")
+            and "=" not in prev
+            and not _is_number(prev)
+        ):
             out[-1] = f"{prev}={arg}"
         else:
             out.append(arg)
@@ -89,10 +99,13 @@ def add_options(parser, cls, defaults: dict) -> None:
         default = defaults.get(name, f.default)
         kind = type(f.default)
         parser.add_argument(
-            "--" + name.replace("_", "-"), dest=name, type=kind, default=default,
+            "--" + name.replace("_", "-"),
+            dest=name,
+            type=kind,
+            default=default,
             metavar=kind.__name__.upper(),
             help=f"{f.metadata.get('help', '')} (default: {default})",
-        )  # fmt: skip
+        )
 
 
 def int_list(text: str) -> list[int]:

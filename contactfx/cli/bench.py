@@ -48,7 +48,7 @@ def _parser() -> Parser:
         action="store_true",
         help="under mpirun, also run every case on rank 0 alone (parallel speed-up)",
     )
-    return p  # fmt: skip
+    return p
 
 
 def cmd_bench(argv: list[str], petsc_options: dict, comm) -> int:
@@ -69,9 +69,24 @@ def cmd_bench(argv: list[str], petsc_options: dict, comm) -> int:
         raise ValueError(f"--repeat must be >= 1, got {ns.repeat}")
     variants = expand_methods(ns.method)
     started = time.perf_counter()
-    rows = run_bench(cases, variants, degrees, ns.levels, comm, petsc_options,
-                     solver=ns.solver, linear=ns.linear, speedup=ns.speedup,
-                     repeat=ns.repeat)  # fmt: skip
-    finish_table(rows, comm, started, f"bench: {len(rows)} runs in {{total:.0f}} s on "
-                 f"{comm.size} rank(s)", ns.out, write_bench)  # fmt: skip
+    rows = run_bench(
+        cases,
+        variants,
+        degrees,
+        ns.levels,
+        comm,
+        petsc_options,
+        solver=ns.solver,
+        linear=ns.linear,
+        speedup=ns.speedup,
+        repeat=ns.repeat,
+    )
+    finish_table(
+        rows,
+        comm,
+        started,
+        f"bench: {len(rows)} runs in {{total:.0f}} s on {comm.size} rank(s)",
+        ns.out,
+        write_bench,
+    )
     return 0

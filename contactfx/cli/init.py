@@ -19,8 +19,9 @@ def cmd_init(argv: list[str], comm) -> int:
             if comm.rank == 0:
                 print("usage: contactfx init SCENE [options] --out DIR; see `contactfx list`")
             return 0
-        raise ValueError("missing scene name: contactfx init SCENE --out DIR (see "
-                         "`contactfx list`)")  # fmt: skip
+        raise ValueError(
+            "missing scene name: contactfx init SCENE --out DIR (see `contactfx list`)"
+        )
     scene_cls = get_scene(argv[0])
     if comm.rank != 0 and ("-h" in argv or "--help" in argv):
         return 0

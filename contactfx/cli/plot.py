@@ -29,11 +29,16 @@ def _parser() -> argparse.ArgumentParser:
     first = ", ".join(DEFAULT_FIELDS)
     p.add_argument("--field", default=None, help=f"colour by (default: the first of {first})")
     p.add_argument("--step", type=int, default=-1, help="load step, 1-based (default: the last)")
-    p.add_argument("--scale", type=float, default=None,
-                   help="displacement magnification (default: the largest displacement drawn "
-                   "as 5%% of the body's size; 0: undeformed)")  # fmt: skip
-    p.add_argument("--out", type=Path, default=None,
-                   help="the PNG (default: <field>.png next to run.json)")  # fmt: skip
+    p.add_argument(
+        "--scale",
+        type=float,
+        default=None,
+        help="displacement magnification (default: the largest displacement drawn "
+        "as 5%% of the body's size; 0: undeformed)",
+    )
+    p.add_argument(
+        "--out", type=Path, default=None, help="the PNG (default: <field>.png next to run.json)"
+    )
     return p
 
 
@@ -64,8 +69,13 @@ def _pvd_of(run: Path) -> Path:
     raise ValueError(f"{run_json}: no ParaView files ({candidates[-1]} missing)")
 
 
-def plot_run(run: Path, field: str | None = None, step: int = -1, scale: float | None = None,
-             out: Path | None = None) -> tuple[Path, str, float]:  # fmt: skip
+def plot_run(
+    run: Path,
+    field: str | None = None,
+    step: int = -1,
+    scale: float | None = None,
+    out: Path | None = None,
+) -> tuple[Path, str, float]:
     """Render the run's body at ``step`` coloured by ``field``; returns (PNG, field, scale)."""
     import matplotlib
 
@@ -129,8 +139,11 @@ def plot_run(run: Path, field: str | None = None, step: int = -1, scale: float |
         ax = fig.add_subplot(projection="3d")
         norm = matplotlib.colors.Normalize(face_values.min(), face_values.max())
         cmap = matplotlib.colormaps["viridis"]
-        ax.add_collection3d(Poly3DCollection(y[faces], facecolors=cmap(norm(face_values)),
-                                             edgecolors="k", linewidths=0.1))  # fmt: skip
+        ax.add_collection3d(
+            Poly3DCollection(
+                y[faces], facecolors=cmap(norm(face_values)), edgecolors="k", linewidths=0.1
+            )
+        )
         lo, hi = y.min(axis=0), y.max(axis=0)
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
@@ -145,9 +158,10 @@ def plot_run(run: Path, field: str | None = None, step: int = -1, scale: float |
 
 
 #: the faces of a tetrahedron and a hexahedron (VTK vertex order)
-_FACES = {10: [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
-          12: [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6],
-               [3, 0, 4, 7]]}  # fmt: skip
+_FACES = {
+    10: [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    12: [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]],
+}
 
 
 def _boundary_faces(cells: np.ndarray, vtk_type: int) -> tuple[np.ndarray, np.ndarray]:
@@ -155,7 +169,8 @@ def _boundary_faces(cells: np.ndarray, vtk_type: int) -> tuple[np.ndarray, np.nd
     local = np.array(_FACES[vtk_type])
     faces = cells[:, local].reshape(-1, local.shape[1])
     owner = np.repeat(np.arange(len(cells)), len(local))
-    _, index, count = np.unique(np.sort(faces, axis=1), axis=0, return_index=True,
-                                return_counts=True)  # fmt: skip
+    _, index, count = np.unique(
+        np.sort(faces, axis=1), axis=0, return_index=True, return_counts=True
+    )
     keep = index[count == 1]
     return faces[keep], owner[keep]

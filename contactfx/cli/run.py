@@ -65,11 +65,15 @@ def table(res: RunSummary) -> str:
         ("scene", res.scene),
         ("method", f"{method}, {kind}"),
         ("dofs / ranks", f"{res.dofs} / {res.ranks}"),
-        ("load steps / Newton / KSP",
-         f"{len(res.steps)} / {res.newton_iterations} / {res.ksp_iterations}"),
-        ("time mesh / compile / assembly / solve [s]",
-         " / ".join(f"{t.get(k, 0.0):.2f}" for k in ("mesh", "compile", "assembly", "solve"))),
-    ]  # fmt: skip
+        (
+            "load steps / Newton / KSP",
+            f"{len(res.steps)} / {res.newton_iterations} / {res.ksp_iterations}",
+        ),
+        (
+            "time mesh / compile / assembly / solve [s]",
+            " / ".join(f"{t.get(k, 0.0):.2f}" for k in ("mesh", "compile", "assembly", "solve")),
+        ),
+    ]
     rows.append(("peak memory, all ranks [MiB]", f"{res.memory_mib:.0f}"))
     if "contact" in t:  # two bodies: the coupling's part of the assembly time
         rows.append(("time of search + contact terms [s]", f"{t['contact']:.2f}"))
@@ -90,17 +94,27 @@ def table(res: RunSummary) -> str:
 def _obstacle_rows(res: RunSummary, ref: dict) -> list[tuple[str, str]]:
     rows = [("contact force", f"{res.force:.6g}")]
     if "force_rel_error" in ref:
-        rows.append(("reference force", f"{ref['force']:.6g}  (rel. error "
-                     f"{ref['force_rel_error']:.2%})"))  # fmt: skip
+        rows.append(
+            ("reference force", f"{ref['force']:.6g}  (rel. error {ref['force_rel_error']:.2%})")
+        )
     if "a" in ref:
-        rows.append(("contact half-width a (ref)",
-                     f"{ref['a_computed']:.6g} vs {ref['a']:.6g}  (rel. error "
-                     f"{ref['a_rel_error']:.2%}, {ref['a_error_over_h']:.2f} h)"))  # fmt: skip
+        rows.append(
+            (
+                "contact half-width a (ref)",
+                f"{ref['a_computed']:.6g} vs {ref['a']:.6g}  (rel. error "
+                f"{ref['a_rel_error']:.2%}, {ref['a_error_over_h']:.2f} h)",
+            )
+        )
     else:
         rows.append(("contact half-width / radius", f"{res.contact_size:.6g}"))
     if "p0" in ref:
-        rows.append(("peak pressure p0", f"{ref['p0_computed']:.6g} vs {ref['p0']:.6g}  "
-                     f"(rel. error {ref['p0_rel_error']:.2%})"))  # fmt: skip
+        rows.append(
+            (
+                "peak pressure p0",
+                f"{ref['p0_computed']:.6g} vs {ref['p0']:.6g}  "
+                f"(rel. error {ref['p0_rel_error']:.2%})",
+            )
+        )
     else:
         rows.append(("peak pressure", f"{res.peak_pressure:.6g}"))
     f = res.friction
@@ -118,12 +132,18 @@ def _interface_rows(res: RunSummary) -> list[tuple[str, str]]:
     i = res.interface
     rows = [
         ("interface normal / tangential force", f"{res.force:.6g} / {i.tangential_force:.6g}"),
-        ("closed length (area in 3D) / max penetration",
-         f"{res.contact_size:.6g} / {res.max_penetration:.3e}"),
-    ]  # fmt: skip
+        (
+            "closed length (area in 3D) / max penetration",
+            f"{res.contact_size:.6g} / {res.max_penetration:.3e}",
+        ),
+    ]
     if i.proppant_force is not None:
-        rows.append(("proppant force / min aperture (propped)",
-                     f"{i.proppant_force:.6g} / {i.min_aperture_propped:.6g}"))  # fmt: skip
+        rows.append(
+            (
+                "proppant force / min aperture (propped)",
+                f"{i.proppant_force:.6g} / {i.min_aperture_propped:.6g}",
+            )
+        )
     return rows
 
 
@@ -142,8 +162,9 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
     if comm.rank == 0 and not ns["quiet"]:
         print(f"contactfx: {scene.name}, method {numerics.method}, {comm.size} rank(s)", flush=True)
     try:
-        res = scene.run(numerics, comm=comm, out=ns["out"], petsc_options=petsc_options,
-                        verbose=not ns["quiet"])  # fmt: skip
+        res = scene.run(
+            numerics, comm=comm, out=ns["out"], petsc_options=petsc_options, verbose=not ns["quiet"]
+        )
     except ConvergenceError:
         if ns["out"] is not None:
             write_failed(ns["out"], scene, numerics, sys.exc_info()[1], comm)
@@ -165,9 +186,15 @@ def print_outputs(res: RunSummary) -> None:
 
 def write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
     """run.json marked failed, with the error: no half-written result presented as complete."""
-    data = {"status": "failed", "error": str(error), "scene": scene.name,
-            "parameters": dataclasses.asdict(scene.p), "numerics": dataclasses.asdict(numerics),
-            "versions": versions(), "ranks": comm.size}  # fmt: skip
+    data = {
+        "status": "failed",
+        "error": str(error),
+        "scene": scene.name,
+        "parameters": dataclasses.asdict(scene.p),
+        "numerics": dataclasses.asdict(numerics),
+        "versions": versions(),
+        "ranks": comm.size,
+    }
     try:
         write_json(Path(out) / "run.json", data, comm)
     except OSError:

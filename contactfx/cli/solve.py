@@ -16,12 +16,20 @@ __all__ = ["cmd_solve", "cmd_check"]
 
 
 def _parser(command: str, about: str) -> Parser:
-    parser = Parser(prog=f"contactfx {command}", description=about,
-                    epilog="PETSc options go after '--', e.g. -- -snes_monitor")  # fmt: skip
+    parser = Parser(
+        prog=f"contactfx {command}",
+        description=about,
+        epilog="PETSc options go after '--', e.g. -- -snes_monitor",
+    )
     parser.add_argument("problem", type=Path, help="the problem file (TOML)")
-    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                        help="override a key of the file, e.g. numerics.method=al-ssn or "
-                        "bodies.0.E=2e5 (repeatable)")  # fmt: skip
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a key of the file, e.g. numerics.method=al-ssn or "
+        "bodies.0.E=2e5 (repeatable)",
+    )
     return parser
 
 
@@ -39,11 +47,13 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
     out = ns.out if ns.out is not None else ns.problem.parent / "results" / scene.name
     options = {**file_petsc, **petsc_options}
     if comm.rank == 0 and not ns.quiet:
-        print(f"contactfx: {ns.problem} ({scene.summary}), method {numerics.method}, "
-              f"{comm.size} rank(s)", flush=True)  # fmt: skip
+        print(
+            f"contactfx: {ns.problem} ({scene.summary}), method {numerics.method}, "
+            f"{comm.size} rank(s)",
+            flush=True,
+        )
     try:
-        res = scene.run(numerics, comm=comm, out=out, petsc_options=options,
-                        verbose=not ns.quiet)  # fmt: skip
+        res = scene.run(numerics, comm=comm, out=out, petsc_options=options, verbose=not ns.quiet)
     except ConvergenceError:
         write_failed(out, scene, numerics, sys.exc_info()[1], comm)
         raise
@@ -121,10 +131,12 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         return 0
     pb = scene.spec
     print(f"{ns.problem}: valid")
-    where = (f"{pb.mesh_file} (size factor {pb.size})" if pb.builder is None
-             else f"the {pb.builder[0]} builder")  # fmt: skip
-    print(f"  mesh       {where}, {scene.gdim}D, "
-          f"{problem.dofs()} dofs")  # fmt: skip
+    where = (
+        f"{pb.mesh_file} (size factor {pb.size})"
+        if pb.builder is None
+        else f"the {pb.builder[0]} builder"
+    )
+    print(f"  mesh       {where}, {scene.gdim}D, {problem.dofs()} dofs")
     print("  groups     " + scene.group_list())
     for group, mat in pb.bodies:
         print(f"  body       {group}: E = {mat.E:g}, nu = {mat.nu:g}")
@@ -148,12 +160,18 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print(f"  boundary   {b.group}: {'; '.join(what)}{amp}")
     if pb.obstacle is not None:
         ob = pb.obstacle
-        size = ", ".join(f"{k} {ob[k]:g}" for k in ("radius", "edge_radius", "height",
-                                                      "wavelength", "h") if k in ob)  # fmt: skip
-        moves = (f"along the path {ob['path']}" if "path" in ob
-                 else f"moving by {scene.motion.tolist()}")  # fmt: skip
-        print(f"  obstacle   {ob['shape']}{' (' + size + ')' if size else ''} touching "
-              f"{ob['contact']}, from {scene.position.tolist()} {moves}")  # fmt: skip
+        size = ", ".join(
+            f"{k} {ob[k]:g}"
+            for k in ("radius", "edge_radius", "height", "wavelength", "h")
+            if k in ob
+        )
+        moves = (
+            f"along the path {ob['path']}" if "path" in ob else f"moving by {scene.motion.tolist()}"
+        )
+        print(
+            f"  obstacle   {ob['shape']}{' (' + size + ')' if size else ''} touching "
+            f"{ob['contact']}, from {scene.position.tolist()} {moves}"
+        )
     for group, force, _ in pb.body_forces:
         print(f"  body force {group}: {force.tolist()}")
     if pb.initial is not None:
@@ -165,8 +183,10 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     if pb.interface is not None:
         keys = [k for k in pb.interface if k != "group"]
         print(f"  interface  {pb.interface['group']}" + (f" ({', '.join(keys)})" if keys else ""))
-    print(f"  numerics   method {numerics.method}, friction {numerics.friction}, "
-          f"{numerics.steps} step(s), solver {numerics.solver}")  # fmt: skip
+    print(
+        f"  numerics   method {numerics.method}, friction {numerics.friction}, "
+        f"{numerics.steps} step(s), solver {numerics.solver}"
+    )
     if file_petsc:
         print(f"  petsc      {file_petsc}")
     if pb.reactions:

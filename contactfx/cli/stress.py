@@ -16,8 +16,9 @@ def _parser() -> Parser:
     p = Parser(prog="contactfx stress", description="robustness matrix of extreme cases")
     p.add_argument("--quick", action="store_true", help="the fast subset of the matrix")
     p.add_argument("--axis", default=None, help="comma-separated axes to run (default all)")
-    p.add_argument("--time-limit", type=float, default=120.0,
-                   help="wall-time limit per case [s] (default 120)")  # fmt: skip
+    p.add_argument(
+        "--time-limit", type=float, default=120.0, help="wall-time limit per case [s] (default 120)"
+    )
     p.add_argument("--out", type=Path, default=None, help="folder for CSV, Markdown and PNG")
     return p
 
@@ -38,6 +39,12 @@ def cmd_stress(argv: list[str], petsc_options: dict, comm) -> int:
     started = time.perf_counter()
     rows = run_stress(selected, comm, ns.time_limit)
     failed = sum(r["status"] not in STRESS_SETTLED for r in rows)
-    finish_table(rows, comm, started, f"stress: {len(rows)} cases, {failed} not converged, "
-                 "{total:.0f} s", ns.out, write_stress)  # fmt: skip
+    finish_table(
+        rows,
+        comm,
+        started,
+        f"stress: {len(rows)} cases, {failed} not converged, {{total:.0f}} s",
+        ns.out,
+        write_stress,
+    )
     return 0

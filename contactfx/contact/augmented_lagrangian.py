@@ -106,8 +106,9 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
     without friction, vector P1 with); the outer loop is :class:`contactfx.solvers.uzawa.Uzawa`."""
 
     r0: float = param(10.0, _R0, positive=True)
-    al_tol: float = param(1e-8, "al-uzawa stop: max nodal multiplier change / max multiplier",
-                          positive=True)  # fmt: skip
+    al_tol: float = param(
+        1e-8, "al-uzawa stop: max nodal multiplier change / max multiplier", positive=True
+    )
     al_max_it: int = param(100, "al-uzawa maximal outer iterations", positive=True)
     name = "al-uzawa"
     sweep = ("r0", ())
@@ -117,11 +118,16 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
     #: augmented traction instead (``tip_extended``), with its derivative in the Jacobian
     tip_continued = True
     supports = Supports(
-        friction=_FRICTION, mixed_up=True, interfaces=True, dim1=False,
-        why_not={"nodal_quadrature": "it already collocates the contact law at the nodes",
-                 "dim1": "its nodal multiplier update cannot be compiled on intervals; use "
-                         "al-ssn for 1D scenes"},
-    )  # fmt: skip
+        friction=_FRICTION,
+        mixed_up=True,
+        interfaces=True,
+        dim1=False,
+        why_not={
+            "nodal_quadrature": "it already collocates the contact law at the nodes",
+            "dim1": "its nodal multiplier update cannot be compiled on intervals; use "
+            "al-ssn for 1D scenes",
+        },
+    )
 
     def attach(self, solver, problem):
         """Uzawa's outer loop around the Newton solver (the problem gives the multiplier
@@ -129,8 +135,14 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
         from contactfx.solvers.uzawa import Uzawa
 
         update = problem.surface_update(self.update)
-        return Uzawa(solver, problem.multiplier, update, problem.multiplier_mask,
-                     tol=self.al_tol, max_it=self.al_max_it)  # fmt: skip
+        return Uzawa(
+            solver,
+            problem.multiplier,
+            update,
+            problem.multiplier_mask,
+            tol=self.al_tol,
+            max_it=self.al_max_it,
+        )
 
     def pressure(self, s: Surface):
         return self._augmented(s)[0]
@@ -163,17 +175,24 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     and its test function; ``s.ds_nodal`` is the vertex-quadrature contact measure."""
 
     r0: float = param(10.0, _R0, positive=True)
-    ncp: str = param("min", "al-ssn complementarity function: min (Alart-Curnier) or fb "
-                     "(Fischer-Burmeister)", choices=("min", "fb"))  # fmt: skip
+    ncp: str = param(
+        "min",
+        "al-ssn complementarity function: min (Alart-Curnier) or fb (Fischer-Burmeister)",
+        choices=("min", "fb"),
+    )
     name = "al-ssn"
     sweep = ("r0", ())
     multiplier = "field"
     supports = Supports(
-        friction=_FRICTION, interfaces=True, iterative=False,
-        why_not={"nodal_quadrature": "it already collocates the contact law at the nodes",
-                 "mixed_up": "it has its own mixed (u, lambda) space",
-                 "iterative": "a saddle-point system"},
-    )  # fmt: skip
+        friction=_FRICTION,
+        interfaces=True,
+        iterative=False,
+        why_not={
+            "nodal_quadrature": "it already collocates the contact law at the nodes",
+            "mixed_up": "it has its own mixed (u, lambda) space",
+            "iterative": "a saddle-point system",
+        },
+    )
 
     def pressure(self, s: Surface):
         if s.ds_nodal is None:  # a projected multiplier (projected_law)

@@ -50,8 +50,7 @@ class BoundConstraints(MethodBase):
         return {"snes_type": "vinewtonrsls"}
 
     def attach(self, solver, problem):
-        return _Bounded(solver, problem.V, problem.contact_facets, problem.obstacle,
-                        problem.offset)  # fmt: skip
+        return _Bounded(solver, problem.V, problem.contact_facets, problem.obstacle, problem.offset)
 
     @staticmethod
     def reaction_pressure(solver, u, mass: np.ndarray, target) -> float:

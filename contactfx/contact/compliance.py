@@ -29,16 +29,22 @@ __all__ = ["NormalCompliance"]
 class NormalCompliance(MethodBase):
     """kappa0 > 0 (the ``penalty`` option), exponent m > 0."""
 
-    kappa0: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True,
-                          option="penalty")  # fmt: skip
-    exponent: float = param(2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m",
-                            positive=True)  # fmt: skip
+    kappa0: float = param(
+        10.0, "penalty parameter, kappa = penalty E / h", positive=True, option="penalty"
+    )
+    exponent: float = param(
+        2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m", positive=True
+    )
     nodal_size: ClassVar[bool] = True
     tip_continued: ClassVar[bool] = True  # as the penalty's
     name = "compliance"
     sweep = ("exponent", (1.0, 1.5, 2.0))
-    supports = Supports(mixed_up=True, nodal_quadrature=True, interfaces=True,
-                        why_not={"friction": "it is a frictionless law"})  # fmt: skip
+    supports = Supports(
+        mixed_up=True,
+        nodal_quadrature=True,
+        interfaces=True,
+        why_not={"friction": "it is a frictionless law"},
+    )
 
     def __post_init__(self) -> None:
         validate(self)

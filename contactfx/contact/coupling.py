@@ -79,8 +79,9 @@ class PairCoupling(Coupling, Protocol):
 def aij(comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:
     """An empty square parallel AIJ matrix that accepts entries anywhere (new nonzeros are
     allocated on the fly)."""
-    A = PETSc.Mat().createAIJ(((rows_local, rows_global), (rows_local, rows_global)),
-                              nnz=(per_row, per_row), comm=comm)  # fmt: skip
+    A = PETSc.Mat().createAIJ(
+        ((rows_local, rows_global), (rows_local, rows_global)), nnz=(per_row, per_row), comm=comm
+    )
     A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
     A.setUp()
     return A
@@ -117,8 +118,9 @@ class NodeLayout:
         the owned nodes' sums (n_owned, bs)."""
         vec = self.vector(bs)
         rows = blocked_rows(nodes, bs).ravel()
-        vec.setValues(rows, np.asarray(values, dtype=np.float64).ravel(),
-                      addv=PETSc.InsertMode.ADD_VALUES)  # fmt: skip
+        vec.setValues(
+            rows, np.asarray(values, dtype=np.float64).ravel(), addv=PETSc.InsertMode.ADD_VALUES
+        )
         vec.assemblyBegin()
         vec.assemblyEnd()
         out = vec.getArray().reshape(-1, bs).copy()

@@ -230,8 +230,11 @@ def cut_cells(X: np.ndarray, crack: CrackSegment, snap: float) -> CutCells:
     ends[has] = crack.psi(line[has])
     tol = 1e-12 * a
     inside = np.all(np.abs(ends) <= a + tol, axis=1)
-    touches = has & (np.min(ends, axis=1, initial=np.inf) < a - tol) & (
-        np.max(ends, axis=1, initial=-np.inf) > -a + tol)  # fmt: skip
+    touches = (
+        has
+        & (np.min(ends, axis=1, initial=np.inf) < a - tol)
+        & (np.max(ends, axis=1, initial=-np.inf) > -a + tol)
+    )
     # a piece along an edge (two zero vertices) belongs to the cell on the +side
     on_edge = (phi == 0.0).sum(axis=1) == 2
     plus_side = phi.sum(axis=1) > 0.0
@@ -353,9 +356,13 @@ class WeightedMeasure(ufl.Measure):
     """A measure that multiplies every integrand by ``weight`` (``integrand * measure``)."""
 
     def __init__(self, measure: ufl.Measure, weight) -> None:
-        super().__init__(measure.integral_type(), domain=measure.ufl_domain(),
-                         subdomain_id=measure.subdomain_id(), metadata=measure.metadata(),
-                         subdomain_data=measure.subdomain_data())  # fmt: skip
+        super().__init__(
+            measure.integral_type(),
+            domain=measure.ufl_domain(),
+            subdomain_id=measure.subdomain_id(),
+            metadata=measure.metadata(),
+            subdomain_data=measure.subdomain_data(),
+        )
         self.weight = weight
 
     def __rmul__(self, integrand):

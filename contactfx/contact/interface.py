@@ -209,9 +209,15 @@ class InterfaceSurface(SurfaceData):
         lam = self.multiplier
         if lam is not None and self.multiplier_tie is not None:
             lam = lam + self.multiplier_tie
-        return replace(self, w=extend(self.w), u_prev=extend(self.u_prev), multiplier=lam,
-                       traction_prev=extend(self.traction_prev), h_nodal=extend(self.h_nodal),
-                       tip_step=None)  # fmt: skip
+        return replace(
+            self,
+            w=extend(self.w),
+            u_prev=extend(self.u_prev),
+            multiplier=lam,
+            traction_prev=extend(self.traction_prev),
+            h_nodal=extend(self.h_nodal),
+            tip_step=None,
+        )
 
     def slip_increment(self, n):
         """Tangential jump increment since the last converged step."""

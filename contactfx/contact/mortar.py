@@ -100,19 +100,28 @@ class Mortar(MethodBase):
     """r0 > 0 (c = r0 E / h in the complementarity function), ncp: min or fb."""
 
     r0: float = param(10.0, "augmented Lagrangian augmentation, r = r0 E / h", positive=True)
-    ncp: str = param("min", "complementarity function of al-ssn / mortar: min "
-                     "(Alart-Curnier) or fb (Fischer-Burmeister)",
-                     choices=("min", "fb"))  # fmt: skip
+    ncp: str = param(
+        "min",
+        "complementarity function of al-ssn / mortar: min "
+        "(Alart-Curnier) or fb (Fischer-Burmeister)",
+        choices=("min", "fb"),
+    )
     name = "mortar"
     sweep = ("ncp", ("min", "fb"))
     supports = Supports(
         friction=("none", "coulomb"),
-        obstacles=False, interfaces=False, two_body=True, dim1=False, iterative=False,
-        why_not={"obstacles": "a mortar pair joins two meshed surfaces",
-                 "interfaces": "a mortar pair joins two meshed surfaces",
-                 "friction": "mortar has Coulomb friction only",
-                 "iterative": "its condensed Jacobian is not symmetric: use LU"},
-    )  # fmt: skip
+        obstacles=False,
+        interfaces=False,
+        two_body=True,
+        dim1=False,
+        iterative=False,
+        why_not={
+            "obstacles": "a mortar pair joins two meshed surfaces",
+            "interfaces": "a mortar pair joins two meshed surfaces",
+            "friction": "mortar has Coulomb friction only",
+            "iterative": "its condensed Jacobian is not symmetric: use LU",
+        },
+    )
 
     def __post_init__(self) -> None:
         validate(self)
@@ -182,8 +191,10 @@ def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
         rows.append(np.repeat(slave.nodes[i][:, :, None], 2, axis=2))
         cols.append(np.repeat(master.nodes[k][:, None, :], 2, axis=1))
         vals.append(contrib)
-    flat = [np.concatenate([a.reshape(-1) for a in arr]) if arr else np.zeros(0)
-            for arr in (rows, cols, vals)]  # fmt: skip
+    flat = [
+        np.concatenate([a.reshape(-1) for a in arr]) if arr else np.zeros(0)
+        for arr in (rows, cols, vals)
+    ]
     return D, normals, (flat[0].astype(np.int64), flat[1].astype(np.int64), flat[2])
 
 
@@ -225,8 +236,11 @@ def _mortar_triangles(slave: Facets, master: Facets, pairs):
         vals += np.matmul(psi.transpose(0, 2, 1), lm)
     rows = np.repeat(slave.nodes[i][:, :, None], 3, axis=2)
     cols = np.repeat(master.nodes[k][:, None, :], 3, axis=1)
-    return D, normals, (rows.reshape(-1).astype(np.int64), cols.reshape(-1).astype(np.int64),
-                        vals.reshape(-1))  # fmt: skip
+    return (
+        D,
+        normals,
+        (rows.reshape(-1).astype(np.int64), cols.reshape(-1).astype(np.int64), vals.reshape(-1)),
+    )
 
 
 def _to_owners(comm, ranges: np.ndarray, node: np.ndarray, payload: list[np.ndarray]):
@@ -405,8 +419,9 @@ class MortarCoupling:
         T = _owned_matrix(
             lay, *(np.concatenate([x.ravel() for x in arr]) for arr in (t_r, t_c, t_v))
         )
-        G = _owned_matrix(lay, *(np.concatenate([x.ravel() for x in arr])
-                                 for arr in (g_r, g_c, g_v)))  # fmt: skip
+        G = _owned_matrix(
+            lay, *(np.concatenate([x.ravel() for x in arr]) for arr in (g_r, g_c, g_v))
+        )
         self.T, self.G = T, G
         self.g0 = G.createVecLeft()
         G.mult(lay.X, self.g0)
@@ -448,8 +463,9 @@ class MortarCoupling:
     def tangent_rows(self) -> np.ndarray:
         """Local rows (m, gdim) of the contact nodes' components (valid where ``tmask``)."""
         bs = self.layout.bs
-        return ((self.nodes - self.layout.start)[:, None] * bs
-                + np.arange(self.layout.gdim)).astype(np.int64)  # fmt: skip
+        return (
+            (self.nodes - self.layout.start)[:, None] * bs + np.arange(self.layout.gdim)
+        ).astype(np.int64)
 
     def _friction(self, lam, cg, y, q):
         """Coulomb at the contact nodes: C_T = lambda_T - proj_{B(xi)}(lambda_T + c v), the
@@ -474,8 +490,7 @@ class MortarCoupling:
         dxi = np.where(~stick & (arg > 0.0), self.mu, 0.0)
         d_lam = -zhat * dxi[:, None]
         self.stick, self.xi = stick, xi
-        return (lt - proj, eye - dproj, -dproj * c[:, :, None], d_lam,
-                -d_lam * self.c[:, None])  # fmt: skip
+        return (lt - proj, eye - dproj, -dproj * c[:, :, None], d_lam, -d_lam * self.c[:, None])
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         lam, cg, C, self._da, self._db = self._state(x, F)
@@ -556,8 +571,12 @@ class MortarCoupling:
         others = np.ones(lay.n_owned, dtype=bool)
         others[(self.nodes - lay.start).astype(np.int64)] = False
         diag = blocked_rows(np.flatnonzero(others) + lay.start, bs).ravel()
-        Pm = _owned_matrix(lay, np.concatenate([r, diag]), np.concatenate([c, diag]),
-                           np.concatenate([P.ravel(), np.ones(len(diag))]))  # fmt: skip
+        Pm = _owned_matrix(
+            lay,
+            np.concatenate([r, diag]),
+            np.concatenate([c, diag]),
+            np.concatenate([P.ravel(), np.ones(len(diag))]),
+        )
         Qm = _owned_matrix(lay, r, c, Q.ravel())
         A, B = Pm.matMult(self.TK), Qm.matMult(self.G)
         Pm.destroy()
@@ -591,9 +610,13 @@ class MortarCoupling:
         bound = self.mu * self.lam
         excess = np.maximum(np.linalg.norm(self.lam_t, axis=1) - bound, 0.0)
         D, D0 = self.D, self.D0
-        return {"measure": float(np.sum(D0[closed])), "stick": float(np.sum(D0[self.stick])),
-                "bound": float(np.sum(D * bound)), "excess": float(np.sum(D * excess)),
-                "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1)))}  # fmt: skip
+        return {
+            "measure": float(np.sum(D0[closed])),
+            "stick": float(np.sum(D0[self.stick])),
+            "bound": float(np.sum(D * bound)),
+            "excess": float(np.sum(D * excess)),
+            "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1))),
+        }
 
     def nodal_friction(self):
         """Per node of :meth:`nodal`: the nominal |lambda_T| (D_j |lambda_T| / D0_j), |weighted
@@ -627,9 +650,11 @@ def _owned_matrix(lay: NodeLayout, rows, cols, vals) -> PETSc.Mat:
     values = np.bincount(inv, weights=vals, minlength=len(uniq))
     local_rows, cols_u = np.divmod(uniq, n_global)
     indptr = np.searchsorted(local_rows, np.arange(n_local + 1))
-    M = PETSc.Mat().createAIJ(((n_local, n_global), (n_local, n_global)),
-                              csr=(indptr.astype(PETSc.IntType), cols_u.astype(PETSc.IntType),
-                                   values), comm=lay.comm)  # fmt: skip
+    M = PETSc.Mat().createAIJ(
+        ((n_local, n_global), (n_local, n_global)),
+        csr=(indptr.astype(PETSc.IntType), cols_u.astype(PETSc.IntType), values),
+        comm=lay.comm,
+    )
     M.assemble()
     return M
 

@@ -45,13 +45,21 @@ class Nitsche(TrialFriction, MethodBase):
 
     theta: int = param(1, "Nitsche variant: 1 symmetric, 0 incomplete, -1 skew", choices=(1, 0, -1))
     gamma0: float = param(10.0, "Nitsche parameter, gamma_N = gamma0 E / h", positive=True)
-    sides: str = param("biased", "Nitsche between two bodies: biased (the slave's stress) or "
-                       "unbiased (both sides, half weights)",
-                       choices=("biased", "unbiased"))  # fmt: skip
+    sides: str = param(
+        "biased",
+        "Nitsche between two bodies: biased (the slave's stress) or "
+        "unbiased (both sides, half weights)",
+        choices=("biased", "unbiased"),
+    )
     name = "nitsche"
     sweep = ("theta", (1, 0, -1))
-    supports = Supports(friction=("none", "tresca", "coulomb"), mixed_up=True,
-                        nodal_quadrature=True, interfaces=True, two_body=True)  # fmt: skip
+    supports = Supports(
+        friction=("none", "tresca", "coulomb"),
+        mixed_up=True,
+        nodal_quadrature=True,
+        interfaces=True,
+        two_body=True,
+    )
 
     def __post_init__(self) -> None:
         validate(self)

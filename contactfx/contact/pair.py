@@ -28,8 +28,16 @@ from mpi4py import MPI
 
 from contactfx import _compat
 
-__all__ = ["Side", "Facets", "ContactPair", "side_of", "facet_normals", "gather_near",
-           "owners", "facet_order"]  # fmt: skip
+__all__ = [
+    "Side",
+    "Facets",
+    "ContactPair",
+    "side_of",
+    "facet_normals",
+    "gather_near",
+    "owners",
+    "facet_order",
+]
 
 
 @dataclass
@@ -49,8 +57,10 @@ class Facets:
     def diameters(self) -> np.ndarray:
         """(m,) the longest edge of every facet."""
         d = self.x.shape[1]
-        edges = [np.linalg.norm(self.x[:, i] - self.x[:, (i + 1) % d], axis=1)
-                 for i in range(d if d > 2 else 1)]  # fmt: skip
+        edges = [
+            np.linalg.norm(self.x[:, i] - self.x[:, (i + 1) % d], axis=1)
+            for i in range(d if d > 2 else 1)
+        ]
         return np.max(edges, axis=0) if len(self) else np.zeros(0)
 
     def diameter(self) -> float:
@@ -123,8 +133,9 @@ def side_of(V, facet_tags, tag: int) -> Side:
         out = imap.local_to_global(a.ravel().astype(np.int32))
         return np.asarray(out, dtype=np.int64).reshape(a.shape)
 
-    return Side(tag, local, glob(local), X[local], cells, cell_local, glob(cell_local),
-                X[cell_local])  # fmt: skip
+    return Side(
+        tag, local, glob(local), X[local], cells, cell_local, glob(cell_local), X[cell_local]
+    )
 
 
 def facet_normals(x: np.ndarray) -> np.ndarray:
@@ -153,8 +164,9 @@ def gather_near(comm, master: Facets, region: Facets, radius: float) -> Facets:
     boxes = comm.allgather(box)
     if comm.size == 1:
         keep = _boxes_meet(master.x.min(axis=1), master.x.max(axis=1), boxes[0])
-        return Facets(master.x[keep], master.nodes[keep],
-                      None if master.X is None else master.X[keep])  # fmt: skip
+        return Facets(
+            master.x[keep], master.nodes[keep], None if master.X is None else master.X[keep]
+        )
     lo, hi = master.x.min(axis=1), master.x.max(axis=1)
     ref = master.x if master.X is None else master.X
     sends = []

@@ -41,16 +41,20 @@ __all__ = ["Penalty"]
 class Penalty(TrialFriction, MethodBase):
     """kappa0 > 0 (kappa = kappa0 E / h)."""
 
-    kappa0: float = param(10.0, "penalty parameter, kappa = penalty E / h", positive=True,
-                          option="penalty")  # fmt: skip
+    kappa0: float = param(
+        10.0, "penalty parameter, kappa = penalty E / h", positive=True, option="penalty"
+    )
     name = "penalty"
     sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
-        friction=("none", "tresca", "coulomb"), mixed_up=True, nodal_quadrature=True,
-        interfaces=True, two_body=True, two_body_friction=False,
-        why_not={"two_body_friction": "its traction history is kept on one body's surface "
-                                      "only"},
-    )  # fmt: skip
+        friction=("none", "tresca", "coulomb"),
+        mixed_up=True,
+        nodal_quadrature=True,
+        interfaces=True,
+        two_body=True,
+        two_body_friction=False,
+        why_not={"two_body_friction": "its traction history is kept on one body's surface only"},
+    )
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
     traction_history: ClassVar[bool] = True
     nodal_size: ClassVar[bool] = True

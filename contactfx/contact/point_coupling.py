@@ -72,15 +72,17 @@ class _Directed:
         d = slave.local.shape[1]
         gdim = slave.cell_X.shape[-1] if slave.cell_X.ndim == 3 else d
         # (a rank without facets of this side: empty arrays, the collectives still run)
-        self.grads = (_cell_gradients(slave.cell_X) if len(slave)
-                      else np.zeros((0, d + 1, gdim)))  # fmt: skip
+        self.grads = _cell_gradients(slave.cell_X) if len(slave) else np.zeros((0, d + 1, gdim))
         # position of each facet vertex among its cell's nodes
-        self.pos = np.array([[np.flatnonzero(c == v)[0] for v in f]
-                             for f, c in zip(slave.local, slave.cell_local, strict=True)],
-                            dtype=np.int64).reshape(-1, d)  # fmt: skip
+        self.pos = np.array(
+            [
+                [np.flatnonzero(c == v)[0] for v in f]
+                for f, c in zip(slave.local, slave.cell_local, strict=True)
+            ],
+            dtype=np.int64,
+        ).reshape(-1, d)
         X = slave.cell_X
-        edges = [np.linalg.norm(X[:, i] - X[:, j], axis=-1)
-                 for i in range(d + 1) for j in range(i)]  # fmt: skip
+        edges = [np.linalg.norm(X[:, i] - X[:, j], axis=-1) for i in range(d + 1) for j in range(i)]
         self.h = np.max(edges, axis=0) if len(slave) else np.zeros(0)
         if d == 2:
             q, w = gauss_segment(2)
@@ -150,8 +152,9 @@ class PointCoupling:
         if d == 2:
             measure = np.linalg.norm(ref[:, 1] - ref[:, 0], axis=1)
         else:
-            measure = 0.5 * np.linalg.norm(np.cross(ref[:, 1] - ref[:, 0], ref[:, 2] - ref[:, 0]),
-                                           axis=1)  # fmt: skip
+            measure = 0.5 * np.linalg.norm(
+                np.cross(ref[:, 1] - ref[:, 0], ref[:, 2] - ref[:, 0]), axis=1
+            )
         w = (measure[:, None] * dr.qweight[None, :]).reshape(-1) * dr.weight
         facet = np.repeat(np.arange(m), nq)
         pick = self._project(xq, near)
@@ -159,8 +162,12 @@ class PointCoupling:
         # slave cell shape functions at the points: the facet's vertices carry qbary
         N = np.zeros((m, nq, d + 1))
         for b in range(d):
-            np.put_along_axis(N, dr.pos[:, None, b:b + 1].repeat(nq, axis=1),
-                              dr.qbary[None, :, b:b + 1].repeat(m, axis=0), axis=2)  # fmt: skip
+            np.put_along_axis(
+                N,
+                dr.pos[:, None, b : b + 1].repeat(nq, axis=1),
+                dr.qbary[None, :, b : b + 1].repeat(m, axis=0),
+                axis=2,
+            )
         N = N.reshape(-1, d + 1)
         k = np.where(paired, pick.index, 0)
         n_m = np.zeros((len(xq), gdim))
@@ -171,11 +178,13 @@ class PointCoupling:
         # dofs of the point: slave cell nodes, then master facet nodes (gdim each)
         cell_nodes = dr.slave.cell_nodes[facet]
         master_nodes = near.nodes[k] if len(near) else np.zeros((len(xq), d), dtype=np.int64)
-        rows = np.concatenate([blocked_rows(cell_nodes, bs)[..., :gdim],
-                               blocked_rows(master_nodes, bs)[..., :gdim]],
-                              axis=1).reshape(len(xq), (d + 1 + d) * gdim)  # fmt: skip
-        Jn = np.concatenate([N[:, :, None] * n[:, None, :], -Nm[:, :, None] * n[:, None, :]],
-                            axis=1).reshape(len(xq), (d + 1 + d) * gdim)  # fmt: skip
+        rows = np.concatenate(
+            [blocked_rows(cell_nodes, bs)[..., :gdim], blocked_rows(master_nodes, bs)[..., :gdim]],
+            axis=1,
+        ).reshape(len(xq), (d + 1 + d) * gdim)
+        Jn = np.concatenate(
+            [N[:, :, None] * n[:, None, :], -Nm[:, :, None] * n[:, None, :]], axis=1
+        ).reshape(len(xq), (d + 1 + d) * gdim)
         E, lmbda, mu = (dr.lame[facet, i] for i in range(3))
         grads = dr.grads[facet]  # (P, d + 1, gdim)
         # sigma(N_a e_c) n of the slave cell's basis (the material's Hooke's law)
@@ -203,11 +212,20 @@ class PointCoupling:
         # a tie (the law's argument at round-off, as on coinciding flat surfaces at the start)
         # takes the active branch of the derivative: the branch of a gap within 1e-12 h of 0
         tie = 1e-12 * scale * dr.h[facet]
-        return dict(**extra, rows=rows, Jn=Jn, S=S, w=w, paired=paired, scale=scale, n=n,
-                    tie=tie,
-                    x_search=x_search,
-                    N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
-                    slave_nodes=dr.slave.nodes[facet])  # fmt: skip
+        return dict(
+            **extra,
+            rows=rows,
+            Jn=Jn,
+            S=S,
+            w=w,
+            paired=paired,
+            scale=scale,
+            n=n,
+            tie=tie,
+            x_search=x_search,
+            N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
+            slave_nodes=dr.slave.nodes[facet],
+        )
 
     def _project(self, xq: np.ndarray, near: Facets):
         """The master facet of each point (index -1: not in contact)."""
@@ -216,8 +234,14 @@ class PointCoupling:
         n, d = xq.shape
         if n == 0 or len(near) == 0:  # nothing to project, or nothing near: no contact
             nan = np.full((n, d), np.nan)
-            return Pick(-np.ones(n, dtype=np.int64), np.zeros(n, dtype=bool), nan, nan,
-                        np.full(n, np.nan), np.full(n, np.nan))  # fmt: skip
+            return Pick(
+                -np.ones(n, dtype=np.int64),
+                np.zeros(n, dtype=bool),
+                nan,
+                nan,
+                np.full(n, np.nan),
+                np.full(n, np.nan),
+            )
         tree = _compat.FacetTree(near.x, near.diameters())
         rows, facets = tree.collide_points(xq)
         counts = np.bincount(rows, minlength=len(xq))
@@ -257,8 +281,9 @@ class PointCoupling:
         idx.destroy()
 
     def _gather(self, x: PETSc.Vec) -> np.ndarray:
-        self.scatter.scatter(x, self._local, addv=PETSc.InsertMode.INSERT,
-                             mode=PETSc.ScatterMode.FORWARD)  # fmt: skip
+        self.scatter.scatter(
+            x, self._local, addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD
+        )
         return self._local.getArray().copy()
 
     def _gather_u(self, u: np.ndarray) -> np.ndarray:
@@ -291,7 +316,8 @@ class PointCoupling:
         gamma = p["scale"]
         Z = p["ST"] - gamma[:, None, None] * np.einsum("pig,pgh->pih", p["Jvec"], p["P_T"])
         z = np.einsum("pig,pi->pg", p["ST"], u) - gamma[:, None] * np.einsum(
-            "pgh,pih,pi->pg", p["P_T"], p["Jvec"], u - p["u_prev"])  # fmt: skip
+            "pgh,pih,pi->pg", p["P_T"], p["Jvec"], u - p["u_prev"]
+        )
         s = self.mu * P
         nz = np.linalg.norm(z, axis=1)
         stick = nz <= s
@@ -299,9 +325,11 @@ class PointCoupling:
         t = np.where(stick[:, None], z, s[:, None] * zhat)
         ratio = np.where(stick, 1.0, s / np.where(nz > 0.0, nz, 1.0))
         gdim = z.shape[1]
-        proj = np.where(stick[:, None, None], np.eye(gdim)[None],
-                        ratio[:, None, None] * (np.eye(gdim)[None]
-                                                - zhat[:, :, None] * zhat[:, None, :]))  # fmt: skip
+        proj = np.where(
+            stick[:, None, None],
+            np.eye(gdim)[None],
+            ratio[:, None, None] * (np.eye(gdim)[None] - zhat[:, :, None] * zhat[:, None, :]),
+        )
         dt = np.einsum("pgh,pih->pgi", proj, Z)
         dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
@@ -371,8 +399,14 @@ class PointCoupling:
         Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
         nodes = p["slave_nodes"].ravel()
         paired = np.isfinite(g)
-        data = np.stack([Nw.ravel(), (Nw * paired[:, None]).ravel(),
-                         *((Nw * c[:, None]).ravel() for c in columns)], axis=1)  # fmt: skip
+        data = np.stack(
+            [
+                Nw.ravel(),
+                (Nw * paired[:, None]).ravel(),
+                *((Nw * c[:, None]).ravel() for c in columns),
+            ],
+            axis=1,
+        )
         sums = self.layout.node_sum(nodes, data, 2 + len(columns))
         on = (sums[:, 0] > 0.0) & (sums[:, 1] > 0.5 * sums[:, 0])
         return on, sums[on]
@@ -390,8 +424,9 @@ class PointCoupling:
         indicator (the fraction of the node's support in stick), lumped like the pressure."""
         P, _, t, stick, slip = self.state[0]
         closed_stick = (stick & (P > 0.0)).astype(float)
-        _, sums = self._lumped([np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1),
-                                closed_stick])  # fmt: skip
+        _, sums = self._lumped(
+            [np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1), closed_stick]
+        )
         D = sums[:, 0]
         return sums[:, 2] / D, sums[:, 3] / D, sums[:, 4] / D > 0.5
 
@@ -419,14 +454,19 @@ class PointCoupling:
         closed = P > 0.0
         bound = self.mu * P
         excess = np.maximum(np.linalg.norm(t, axis=1) - bound, 0.0)
-        return {"measure": float(np.sum(w[closed])), "stick": float(np.sum(w[closed & stick])),
-                "bound": float(np.sum(w * bound)), "excess": float(np.sum(w * excess)),
-                "tangential": float(np.sum(w * np.linalg.norm(t, axis=1)))}  # fmt: skip
+        return {
+            "measure": float(np.sum(w[closed])),
+            "stick": float(np.sum(w[closed & stick])),
+            "bound": float(np.sum(w * bound)),
+            "excess": float(np.sum(w * excess)),
+            "tangential": float(np.sum(w * np.linalg.norm(t, axis=1))),
+        }
 
     def force(self) -> float:
         """The normal contact force (the quadrature sum of P over both directions)."""
-        local = sum(float(np.sum(p["w"] * s[0])) for p, s in zip(self.points, self.state,
-                                                                  strict=True))  # fmt: skip
+        local = sum(
+            float(np.sum(p["w"] * s[0])) for p, s in zip(self.points, self.state, strict=True)
+        )
         from mpi4py import MPI
 
         return self.comm.allreduce(local, op=MPI.SUM)

@@ -747,8 +747,9 @@ def triangle_overlaps(
     if k < 6:
         fan_area = np.pad(fan_area, ((0, 0), (0, 6 - k)))
         fan = np.pad(fan, ((0, 0), (0, 6 - k), (0, 0), (0, 0)))
-    return TriangleOverlaps(valid, area[good], fan_area, _bary2(fan, s2[good]),
-                            _bary2(fan, m2[good]))  # fmt: skip
+    return TriangleOverlaps(
+        valid, area[good], fan_area, _bary2(fan, s2[good]), _bary2(fan, m2[good])
+    )
 
 
 # --- quadrature ----------------------------------------------------------------------------

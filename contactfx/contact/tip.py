@@ -31,8 +31,13 @@ __all__ = ["STAR_POINTS", "branch", "snapped_point", "star_rule", "tip_split"]
 STAR_POINTS = 3
 
 
-def branch(points: np.ndarray, tip: np.ndarray, e1: np.ndarray, normal: np.ndarray,
-           side: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def branch(
+    points: np.ndarray,
+    tip: np.ndarray,
+    e1: np.ndarray,
+    normal: np.ndarray,
+    side: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """F and grad F (module docstring) at ``points`` (..., 2) about ``tip``, e1 the unit
     direction ahead of the tip, ``normal`` the crack's normal (F > 0 on its side). ``side``
     (...,): the side (+-1) of points in a cut cell (the sides of the cell's zero line of the
@@ -139,8 +144,15 @@ def _fan(poly: np.ndarray, tip: np.ndarray, tol: float) -> list[np.ndarray]:
     return [np.array([poly[0], poly[i], poly[i + 1]]) for i in range(1, len(poly) - 1)]
 
 
-def star_rule(X: np.ndarray, phi: np.ndarray, cut: np.ndarray, cell_side: np.ndarray,
-              tips: np.ndarray, slots: int, snap: float = 0.0):  # fmt: skip
+def star_rule(
+    X: np.ndarray,
+    phi: np.ndarray,
+    cut: np.ndarray,
+    cell_side: np.ndarray,
+    tips: np.ndarray,
+    slots: int,
+    snap: float = 0.0,
+):
     """A rule for the star cells X (cells, 3, 2) (module docstring): points (cells, slots, 2),
     weights (cells, slots) (zero in the unused slots), and each point's side: the side of the
     cell's zero line of phi (cells, 3) in a cut cell, ``cell_side`` (cells,) elsewhere; and
@@ -159,8 +171,10 @@ def star_rule(X: np.ndarray, phi: np.ndarray, cut: np.ndarray, cell_side: np.nda
         q = 0
         for s, poly in parts:
             for t in _fan(poly, tips[c], max(snap, 1e-9 * h)):
-                area = 0.5 * abs((t[1, 0] - t[0, 0]) * (t[2, 1] - t[0, 1])
-                                 - (t[1, 1] - t[0, 1]) * (t[2, 0] - t[0, 0]))  # fmt: skip
+                area = 0.5 * abs(
+                    (t[1, 0] - t[0, 0]) * (t[2, 1] - t[0, 1])
+                    - (t[1, 1] - t[0, 1]) * (t[2, 0] - t[0, 0])
+                )
                 n = len(ref_w)
                 if q + n > slots:
                     raise ValueError("a star cell needs more quadrature points than its rule")

@@ -11,9 +11,19 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 
-__all__ = ["vertex_rule", "surface_mask", "near_points", "at_points", "at_nodes", "confine",
-           "assemble_array", "NodalProjection", "nodal_contact", "global_sum",
-           "zero_pattern"]  # fmt: skip
+__all__ = [
+    "vertex_rule",
+    "surface_mask",
+    "near_points",
+    "at_points",
+    "at_nodes",
+    "confine",
+    "assemble_array",
+    "NodalProjection",
+    "nodal_contact",
+    "global_sum",
+    "zero_pattern",
+]
 
 
 def vertex_rule(fdim: int) -> dict:

@@ -66,8 +66,9 @@ class GridMultiplier:
         """sum over the cracks of int q . law(s) ds, q the quadrature space's test function:
         the vector omega_q law_q at the Gauss points."""
         pb = self.pb
-        terms = [ufl.inner(self.test, law(s)) * c.ds for c, s in zip(pb.cracks, pb.surfaces,
-                                                                        strict=True)]  # fmt: skip
+        terms = [
+            ufl.inner(self.test, law(s)) * c.ds for c, s in zip(pb.cracks, pb.surfaces, strict=True)
+        ]
         return sum(terms[1:], terms[0])
 
     def _global(self, local: np.ndarray) -> np.ndarray:
@@ -86,9 +87,13 @@ class GridMultiplier:
         entries: dict[int, list] = {}  # owned local row: [(columns, values), ...]
         for crack in self.pb.cracks:
             cells = crack.cut_owned
-            parts = comm.allgather((
-                np.asarray(q_map.local_to_global(q_cells[cells].ravel().astype(np.int32))),
-                crack.psi_q[cells].ravel(), crack.weight_q[cells].ravel()))  # fmt: skip
+            parts = comm.allgather(
+                (
+                    np.asarray(q_map.local_to_global(q_cells[cells].ravel().astype(np.int32))),
+                    crack.psi_q[cells].ravel(),
+                    crack.weight_q[cells].ravel(),
+                )
+            )
             gq, psi_q, w_q = (np.concatenate([p[k] for p in parts]) for k in range(3))
             grid = crack.grid
             left, t = grid.hats(psi_q)
@@ -127,9 +132,13 @@ class GridMultiplier:
         empty = np.zeros(0)
         R = PETSc.Mat().createAIJ(
             ((self.n_owned, PETSc.DETERMINE), (q_map.size_local * bs, PETSc.DETERMINE)),
-            csr=(np.asarray(indptr, PETSc.IntType),
-                 np.concatenate(indices or [empty]).astype(PETSc.IntType),
-                 np.concatenate(values or [empty])), comm=comm)  # fmt: skip
+            csr=(
+                np.asarray(indptr, PETSc.IntType),
+                np.concatenate(indices or [empty]).astype(PETSc.IntType),
+                np.concatenate(values or [empty]),
+            ),
+            comm=comm,
+        )
         R.assemble()
         return R, rows
 
@@ -157,8 +166,11 @@ class GridMultiplier:
         J.zeroEntries()
         J.axpy(1.0, K, structure=S.SUBSET_NONZERO_PATTERN)
         # R G reaches beyond a cell's dofs: J's pattern grows once, at the first Jacobian
-        J.axpy(-1.0, RG, structure=S.SUBSET_NONZERO_PATTERN if self._grown
-               else S.DIFFERENT_NONZERO_PATTERN)  # fmt: skip
+        J.axpy(
+            -1.0,
+            RG,
+            structure=S.SUBSET_NONZERO_PATTERN if self._grown else S.DIFFERENT_NONZERO_PATTERN,
+        )
         self._grown = True
         diagonal = J.getDiagonal()  # (the multiplier's diagonal is in K's zero pattern)
         diagonal.getArray()[self.rows] += 1.0

@@ -127,17 +127,25 @@ class InterfaceProblem(Problem):
         self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
         mat = self.material
         return InterfaceSurface(
-            self.w, self.v_load, self.H, self.dSc, mat.weak_stress(self.w),
+            self.w,
+            self.v_load,
+            self.H,
+            self.dSc,
+            mat.weak_stress(self.w),
             mat.weak_stress_derivative(self.w, None, self.v_load),
-            scene.contact_modulus(), self.h, floor=scene.floor(self.s_coord), fluid=self.fluid,
-            joint=scene.joint(), friction=self.friction,
+            scene.contact_modulus(),
+            self.h,
+            floor=scene.floor(self.s_coord),
+            fluid=self.fluid,
+            joint=scene.joint(),
+            friction=self.friction,
             u_prev=None if self.prev is None else self.total(self.previous()),
             traction_prev=None if self.t_prev is None else self.t_prev("+"),
             ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
             multiplier=None if self.lam is None else self.lam("+"),
             multiplier_test=None if self.lam_test is None else self.lam_test("+"),
             **self._tip_terms(),
-        )  # fmt: skip
+        )
 
     def _tip_terms(self) -> dict:
         """What the methods need at the crack tips: ``tip_step``, the vector from each tip's
@@ -201,8 +209,9 @@ class InterfaceProblem(Problem):
     def multiplier_mask(self) -> np.ndarray:
         """On the interface, the 2D tips included (al-uzawa's update gives a tip its
         neighbour's value: ``InterfaceSurface.tip_extended``), a 3D front not."""
-        return surface_mask(self.multiplier.function_space, self.fdim, self.contact_facets,
-                            self.multiplier_excluded)  # fmt: skip
+        return surface_mask(
+            self.multiplier.function_space, self.fdim, self.contact_facets, self.multiplier_excluded
+        )
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:
@@ -251,8 +260,10 @@ class InterfaceProblem(Problem):
         the start's bilinear form on the surface s, for the trial function's jump."""
         n_I = s.interface_normal()
         k_t = self.scene.contact_modulus() / s.h
-        return (joint.Kni * ufl.dot(jump, n_I) * ufl.dot(s.v, n_I)
-                + k_t * ufl.dot(tangential(jump, n_I), s.v)) * ds  # fmt: skip
+        return (
+            joint.Kni * ufl.dot(jump, n_I) * ufl.dot(s.v, n_I)
+            + k_t * ufl.dot(tangential(jump, n_I), s.v)
+        ) * ds
 
     def _trial_jumps(self) -> list:
         """(surface, the trial function's jump on it, its measure) of every interface."""

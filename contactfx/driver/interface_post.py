@@ -65,15 +65,22 @@ class InterfacePost:
         closed = method.contact_indicator(s)
         joint = s.joint
         self.w0 = 0.0 if joint is None else joint.w0
-        quantities = {"aperture": s.opening() + self.w0, "slip": ufl.dot(s.u, t_I),
-                      "normal_traction": p, "gap": s.gap()}  # fmt: skip
+        quantities = {
+            "aperture": s.opening() + self.w0,
+            "slip": ufl.dot(s.u, t_I),
+            "normal_traction": p,
+            "gap": s.gap(),
+        }
         if s.friction is not None:
             quantities["tangential_traction"] = ufl.dot(method.tangential_traction(s), t_I)
             quantities["slipping"] = method.slip_indicator(s)
         if s.floor is not None:
             quantities["proppant"] = s.floor
-        self.fields_nodal = {name: dolfinx.fem.Function(self.Q1, name=name)
-                             for name in quantities if name != "slipping"}  # fmt: skip
+        self.fields_nodal = {
+            name: dolfinx.fem.Function(self.Q1, name=name)
+            for name in quantities
+            if name != "slipping"
+        }
         self._slipping = dolfinx.fem.Function(self.Q1)
         self.forms = {name: self.nodal.form(expr) for name, expr in quantities.items()}
         self.status = dolfinx.fem.Function(self.Q1, name="interface_status")
@@ -115,8 +122,10 @@ class InterfacePost:
             ("pressure_interior", p, None if interior is None else exact_p, interior),
         ):
             if exact is not None:
-                out[name] = (dolfinx.fem.form(weight * (computed - exact) ** 2 * dSf),
-                             dolfinx.fem.form(weight * exact**2 * dSf))  # fmt: skip
+                out[name] = (
+                    dolfinx.fem.form(weight * (computed - exact) ** 2 * dSf),
+                    dolfinx.fem.form(weight * exact**2 * dSf),
+                )
         return out
 
     def evaluate(self, solver) -> Quantities:
@@ -126,8 +135,11 @@ class InterfacePost:
         st = self.status.x.array
         st[:] = 0.0
         peak, closed, penetration, complementarity = nodal_contact(
-            self.fields_nodal["normal_traction"].x.array, self.fields_nodal["gap"].x.array, on,
-            self.comm)  # fmt: skip
+            self.fields_nodal["normal_traction"].x.array,
+            self.fields_nodal["gap"].x.array,
+            on,
+            self.comm,
+        )
         st[closed] = STATUS["stick"]
         if "slipping" in self.forms:
             self.nodal(self.forms["slipping"], self._slipping)
@@ -135,17 +147,21 @@ class InterfacePost:
         if "proppant" in self.fields_nodal:
             st[closed & (self.fields_nodal["proppant"].x.array > 0.0)] = STATUS["propped"]
         interface = InterfaceQuantities(
-            tangential_force=0.0 if self.tforce_form is None else global_sum(self.tforce_form,
-                                                                             self.comm),
+            tangential_force=0.0
+            if self.tforce_form is None
+            else global_sum(self.tforce_form, self.comm),
             extra={k: global_sum(form, self.comm) for k, form in self.extra.items()},
-        )  # fmt: skip
+        )
         if self.propped_form is not None:
             ap = self.fields_nodal["aperture"].x.array[:n]
             propped = on & (self.fields_nodal["proppant"].x.array[:n] > 0.0)
             interface = dataclasses.replace(
-                interface, proppant_force=global_sum(self.propped_form, self.comm),
-                min_aperture_propped=self.comm.allreduce(float(np.min(ap[propped], initial=np.inf)),
-                                                         op=MPI.MIN))  # fmt: skip
+                interface,
+                proppant_force=global_sum(self.propped_form, self.comm),
+                min_aperture_propped=self.comm.allreduce(
+                    float(np.min(ap[propped], initial=np.inf)), op=MPI.MIN
+                ),
+            )
         return Quantities(
             force=global_sum(self.force_form, self.comm),
             contact_size=global_sum(self.closed_form, self.comm),
@@ -176,18 +192,27 @@ class InterfacePost:
             f = self.fields_nodal.get(name)
             return np.zeros(len(s)) if f is None else f.x.array[:n][sel]
 
-        local = np.column_stack([
-            s, xs, col("aperture"), col("slip"), col("normal_traction"),
-            col("tangential_traction"), self.status.x.array[:n][sel], col("proppant"),
-        ])  # fmt: skip
+        local = np.column_stack(
+            [
+                s,
+                xs,
+                col("aperture"),
+                col("slip"),
+                col("normal_traction"),
+                col("tangential_traction"),
+                self.status.x.array[:n][sel],
+                col("proppant"),
+            ]
+        )
         parts = self.comm.gather(local, root=0)
         if self.comm.rank != 0:
             return Profile(np.zeros(0), np.zeros((0, d)), *(np.zeros(0) for _ in range(6)))
         a = np.vstack(parts)
         a = a[np.argsort(a[:, 0], kind="stable")]
         f = a[:, d + 1 :]
-        return Profile(a[:, 0], a[:, 1 : d + 1], f[:, 0] - self.w0, f[:, 1], f[:, 2], f[:, 3],
-                       f[:, 4], f[:, 5])  # fmt: skip
+        return Profile(
+            a[:, 0], a[:, 1 : d + 1], f[:, 0] - self.w0, f[:, 1], f[:, 2], f[:, 3], f[:, 4], f[:, 5]
+        )
 
     def finish(self, q: Quantities, out: Path | None) -> dict:
         """Closed-form comparisons from the gathered profile, field errors, the CSV and the
@@ -206,15 +231,23 @@ class InterfacePost:
                 front = self.scene.front_profile(prof)
                 if front is not None:
                     plot_front(front, self.scene, out / "front.png")
-                    np.savetxt(out / "front.csv", np.column_stack(list(front.values())),
-                               delimiter=",", comments="", header=",".join(front))  # fmt: skip
+                    np.savetxt(
+                        out / "front.csv",
+                        np.column_stack(list(front.values())),
+                        delimiter=",",
+                        comments="",
+                        header=",".join(front),
+                    )
         errors = {}
         for name, (err, norm) in self.err_forms.items():
             e, nrm = np.sqrt(global_sum(err, self.comm)), np.sqrt(global_sum(norm, self.comm))
             errors[f"{name}_L2"] = e
             errors[f"{name}_L2_rel"] = e / nrm if nrm > 0.0 else e
-        return {"reference": reference, "errors": errors,
-                "plot": None if plot is None else str(plot)}  # fmt: skip
+        return {
+            "reference": reference,
+            "errors": errors,
+            "plot": None if plot is None else str(plot),
+        }
 
 
 def pyplot():
@@ -267,10 +300,17 @@ def plot_front(front: dict[str, np.ndarray], scene, path: Path) -> None:
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.0))
     for name in (k for k in front if k != "angle" and not k.endswith("_exact")):
-        (line,) = ax.plot(front["angle"], front[name], "o-", ms=3,
-                          label=f"{name} (displacement extrapolation)")  # fmt: skip
-        ax.plot(front["angle"], front[f"{name}_exact"], "-", lw=1, color=line.get_color(),
-                label=f"{name} (closed form)")  # fmt: skip
+        (line,) = ax.plot(
+            front["angle"], front[name], "o-", ms=3, label=f"{name} (displacement extrapolation)"
+        )
+        ax.plot(
+            front["angle"],
+            front[f"{name}_exact"],
+            "-",
+            lw=1,
+            color=line.get_color(),
+            label=f"{name} (closed form)",
+        )
     ax.set_xlabel("front angle (degrees)")
     ax.set_ylabel("stress intensity")
     ax.legend(fontsize=8)

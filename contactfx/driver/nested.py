@@ -80,8 +80,13 @@ class Transfer:
     ``fine.x.array``: a field confined to a surface is zero elsewhere, and only its surface
     nodes are interpolated). Collective."""
 
-    def __init__(self, coarse: dolfinx.fem.Function, fine: dolfinx.fem.Function,
-                 split: bool, fixed: np.ndarray | None = None) -> None:  # fmt: skip
+    def __init__(
+        self,
+        coarse: dolfinx.fem.Function,
+        fine: dolfinx.fem.Function,
+        split: bool,
+        fixed: np.ndarray | None = None,
+    ) -> None:
         self.coarse, self.fine = coarse, fine
         comm = fine.function_space.mesh.comm
         gdim = fine.function_space.mesh.geometry.dim
@@ -89,8 +94,7 @@ class Transfer:
         if fixed is not None:
             free[fixed] = False
         self.parts = []
-        for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split),
-                                      strict=True):  # fmt: skip
+        for (Vc, dc), (Vf, df) in zip(_leaves(coarse, split), _leaves(fine, split), strict=True):
             n_owned = Vf.dofmap.index_map.size_local
             bs = Vf.dofmap.index_map_bs
             nodes = df[: n_owned * bs].reshape(n_owned, bs)
@@ -100,8 +104,9 @@ class Transfer:
             everywhere = np.concatenate(comm.allgather(points))
             owned = slice(start, start + len(points))
             dofs = nodes[moved].reshape(-1)
-            self.parts.append(_Part(dolfinx.fem.Function(Vc), dc, dofs, free[dofs], everywhere,
-                                    owned, bs))  # fmt: skip
+            self.parts.append(
+                _Part(dolfinx.fem.Function(Vc), dc, dofs, free[dofs], everywhere, owned, bs)
+            )
         self.locators: list[_compat.PointLocator] | None = None
 
     def __call__(self) -> int:
@@ -110,8 +115,7 @@ class Transfer:
         if self.locators is None:
             mesh = self.coarse.function_space.mesh
             tree = _compat.PointLocator.tree(mesh)
-            self.locators = [_compat.PointLocator(mesh, part.points, tree)
-                             for part in self.parts]  # fmt: skip
+            self.locators = [_compat.PointLocator(mesh, part.points, tree) for part in self.parts]
         kept = 0
         for part, locate in zip(self.parts, self.locators, strict=True):
             part.coarse.x.array[:] = self.coarse.x.array[part.coarse_dofs]
@@ -147,8 +151,10 @@ class NestedSolver(SolverWrapper):
         # the state is mixed when the problem is split; a nodal multiplier never is
         pairs = zip(self.fields, problem.nested_fields(), strict=True)
         fixed = owned_bc_dofs(problem.confined, owned_size(problem.state.function_space))
-        self.transfers = [Transfer(c, f, problem.split and i == 0, fixed if i == 0 else None)
-                          for i, (c, f) in enumerate(pairs)]  # fmt: skip
+        self.transfers = [
+            Transfer(c, f, problem.split and i == 0, fixed if i == 0 else None)
+            for i, (c, f) in enumerate(pairs)
+        ]
         #: Newton iterations of the coarse chain in the last solve
         self.coarse_newton = 0
         #: wall time of the coarse chain's solves

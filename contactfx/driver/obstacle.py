@@ -44,16 +44,21 @@ class ObstacleProblem(Problem):
     @classmethod
     def check(cls, scene, numerics, method) -> None:
         if not method.supports.obstacles:
-            raise ValueError(f"method {method.name} is not offered against rigid obstacles ("
-                             f"{method.supports.why_not.get('obstacles', '')})")  # fmt: skip
+            raise ValueError(
+                f"method {method.name} is not offered against rigid obstacles ("
+                f"{method.supports.why_not.get('obstacles', '')})"
+            )
         if numerics.formulation == "mixed-up" and not scene.material().lmbda > 0.0:
-            raise ValueError(f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = "
-                             f"{scene.material().nu}")  # fmt: skip
+            raise ValueError(
+                f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = "
+                f"{scene.material().nu}"
+            )
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
         if mesh.topology.dim == 1 and not method.supports.dim1:
-            raise ValueError(f"method {method.name} needs a 2D or 3D mesh ("
-                             f"{method.supports.why_not['dim1']})")  # fmt: skip
+            raise ValueError(
+                f"method {method.name} needs a 2D or 3D mesh ({method.supports.why_not['dim1']})"
+            )
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.contact_tag]
         self.obstacle = scene.obstacle()
         super().__init__(scene, numerics, method, mesh, facet_tags)
@@ -78,15 +83,23 @@ class ObstacleProblem(Problem):
             self.offset_prev = dolfinx.fem.Constant(mesh, np.zeros(self.gdim))
         self.v_load = self.V_test
         return ContactSurface(
-            self.U, self.V_test, self.dsc, self.obstacle, self.offset,
+            self.U,
+            self.V_test,
+            self.dsc,
+            self.obstacle,
+            self.offset,
             mat.weak_stress(self.U, self.p),
             mat.weak_stress_derivative(self.U, self.p, self.V_test, self.q),
-            scene.contact_modulus(), self.h, friction=self.friction,
+            scene.contact_modulus(),
+            self.h,
+            friction=self.friction,
             u_prev=None if self.prev is None else self.previous(),
-            offset_prev=self.offset_prev, traction_prev=self.t_prev,
+            offset_prev=self.offset_prev,
+            traction_prev=self.t_prev,
             ds_nodal=self.nodal_rule()[0] if self.method.multiplier == "field" else None,
-            multiplier=self.lam, multiplier_test=self.lam_test,
-        )  # fmt: skip
+            multiplier=self.lam,
+            multiplier_test=self.lam_test,
+        )
 
     def nodal_rule(self):
         return self.ds(self.scene.contact_tag, metadata=vertex_rule(self.fdim)), None
@@ -213,7 +226,8 @@ class ObstaclePost:
             self.pressure.interpolate(pk)
         self.gap.interpolate(self.gap_expr)
         peak, closed, penetration, complementarity = nodal_contact(
-            self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
+            self.pressure.x.array, self.gap.x.array, on, self.comm
+        )
         self.status.x.array[:] = closed  # 0 open, 1 closed (stick)
         measure = global_sum(self.measure_form, self.comm) * self.scene.symmetry
         friction = None
@@ -243,8 +257,11 @@ class ObstaclePost:
         reference = closed_form_errors(self.scene, q)
         if q.friction is not None:
             reference.update(self.scene.friction_reference(q, self.pb.friction))
-        return {"reference": reference, "scores": self.scores(q.force),
-                "errors": self.errors.evaluate(self.scene.reference(q.force))}  # fmt: skip
+        return {
+            "reference": reference,
+            "scores": self.scores(q.force),
+            "errors": self.errors.evaluate(self.scene.reference(q.force)),
+        }
 
     def scores(self, force: float) -> dict[str, float]:
         on = self.nodal.on
@@ -296,13 +313,15 @@ class _FrictionPost:
         stick = global_sum(self.stick_form, comm) * scene.symmetry
         self.accumulate_slip()
         return Friction(
-            tangential_force=[global_sum(f, comm) * scene.tangential_symmetry[i]
-                              for i, f in enumerate(self.tforce_forms)],
+            tangential_force=[
+                global_sum(f, comm) * scene.tangential_symmetry[i]
+                for i, f in enumerate(self.tforce_forms)
+            ],
             bound=bound * scene.tangential_symmetry[0],
             stick_size=scene.contact_size(stick),
             slip_fraction=1.0 - stick / measure if measure > 0.0 else 0.0,
             excess=excess / bound if bound > 0.0 else excess,
-        )  # fmt: skip
+        )
 
     def accumulate_slip(self) -> None:
         """slip += tangential slip increment of this step, on the contact boundary's nodes."""
@@ -342,8 +361,9 @@ class _FieldErrors:
             e = pb.surface.u - exact
             dxq = ufl.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
             for key, op in (("L2", lambda f: f), ("H1", ufl.grad)):
-                self.forms[key] = tuple(dolfinx.fem.form(ufl.inner(op(f), op(f)) * dxq)
-                                        for f in (e, exact))  # fmt: skip
+                self.forms[key] = tuple(
+                    dolfinx.fem.form(ufl.inner(op(f), op(f)) * dxq) for f in (e, exact)
+                )
 
     def evaluate(self, ref: dict) -> dict[str, float]:
         out: dict[str, float] = {}

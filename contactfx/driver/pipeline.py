@@ -45,9 +45,14 @@ def run(
     from the start of the first (checked collectively at every residual)."""
     method = _checked_method(scene, numerics)
     run_ = _Run(
-        scene, numerics, method, comm, None if out is None else Path(out),
-        dict(petsc_options or {}), verbose,
-    )  # fmt: skip
+        scene,
+        numerics,
+        method,
+        comm,
+        None if out is None else Path(out),
+        dict(petsc_options or {}),
+        verbose,
+    )
     run_.time_limit = time_limit
     return run_.execute()
 
@@ -66,15 +71,21 @@ def _checked_method(scene, numerics):
     method = numerics.method_object()
     scene.problem.check(scene, numerics, method)
     if not scene.material().linear and not scene.problem.nonlinear_bulk:
-        raise ValueError(f"scene '{scene.name}': its problem kind needs a linear material "
-                         f"(small-strain elasticity)")  # fmt: skip
+        raise ValueError(
+            f"scene '{scene.name}': its problem kind needs a linear material "
+            f"(small-strain elasticity)"
+        )
     if numerics.nested:
         if not scene.problem.nested:
-            raise ValueError(f"--nested: nested iteration is offered for obstacle scenes, not "
-                             f"for scene '{scene.name}'")  # fmt: skip
+            raise ValueError(
+                f"--nested: nested iteration is offered for obstacle scenes, not "
+                f"for scene '{scene.name}'"
+            )
         if scene.coarsened(2.0**numerics.nested) is None:
-            raise ValueError(f"--nested: scene '{scene.name}' cannot mesh itself coarser "
-                             "(its mesh comes from a file)")  # fmt: skip
+            raise ValueError(
+                f"--nested: scene '{scene.name}' cannot mesh itself coarser "
+                "(its mesh comes from a file)"
+            )
     scene.configure(numerics)
     return method
 
@@ -178,12 +189,20 @@ class _Run:
         bulk = forms.bulk()
         assembly = time.perf_counter() - t0
         solver = ContactSNES(
-            problem.state, bulk=bulk, contact_residual=forms.contact_residual,
-            contact_jacobian=forms.contact_jacobian, bcs=problem.bcs, prefix=self.prefix,
-            options=options, user_options=self.petsc_options,
-            near_nullspace=self.num.solver == "gamg", coupling=problem.coupling(),
-            confined=problem.confined, iterate=problem.iterate, deadline=self.deadline,
-        )  # fmt: skip
+            problem.state,
+            bulk=bulk,
+            contact_residual=forms.contact_residual,
+            contact_jacobian=forms.contact_jacobian,
+            bcs=problem.bcs,
+            prefix=self.prefix,
+            options=options,
+            user_options=self.petsc_options,
+            near_nullspace=self.num.solver == "gamg",
+            coupling=problem.coupling(),
+            confined=problem.confined,
+            iterate=problem.iterate,
+            deadline=self.deadline,
+        )
         solver.timer.assembly += assembly
         return solver
 
@@ -194,18 +213,32 @@ class _Run:
         steps: list[StepLog] = []
         writer = None
         if self.out is not None:
-            writer = ResultsWriter(self.out, self.scene.name, problem.mesh,
-                                   facets=getattr(problem, "contact_facets", None),
-                                   split=problem.output_split())  # fmt: skip
+            writer = ResultsWriter(
+                self.out,
+                self.scene.name,
+                problem.mesh,
+                facets=getattr(problem, "contact_facets", None),
+                split=problem.output_split(),
+            )
         with writer or nullcontext():
 
             def on_step(rec: StepRecord) -> None:
                 quantities = post.evaluate(solver)
                 self.scene.on_step(problem, solver, rec.time, quantities)
                 s = rec.stats
-                steps.append(StepLog(rec.step, rec.time, s.newton, s.ksp, s.outer,
-                                     rec.cutbacks, s.reason, s.coarse_newton,
-                                     quantities))  # fmt: skip
+                steps.append(
+                    StepLog(
+                        rec.step,
+                        rec.time,
+                        s.newton,
+                        s.ksp,
+                        s.outer,
+                        rec.cutbacks,
+                        s.reason,
+                        s.coarse_newton,
+                        quantities,
+                    )
+                )
                 if writer is not None:
                     with self.timed("output"):
                         writer.write(rec.time, post.fields())
@@ -263,7 +296,9 @@ def _progress(step: StepLog, outer: bool) -> str:
     head = f"  step {step.step:3d}  load {step.load:6.3f}  newton {step.newton:3d}"
     head += f"  outer {step.outer:3d}" if outer else ""
     if q.interface is not None:
-        return (f"{head}  normal force {q.force:.6g}  tangential force "
-                f"{q.interface.tangential_force:.6g}")  # fmt: skip
+        return (
+            f"{head}  normal force {q.force:.6g}  tangential force "
+            f"{q.interface.tangential_force:.6g}"
+        )
     tangential = "" if q.friction is None else f"  Q {q.friction.tangential_force[0]:.6g}"
     return f"{head}  ksp {step.ksp:4d}  force {q.force:.6g}  a {q.contact_size:.6g}{tangential}"

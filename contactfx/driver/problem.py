@@ -207,8 +207,12 @@ class Problem:
         pattern = self.tangent_pattern()
         if pattern is not None:
             tangent = tangent + pattern
-        return functools.partial(NonlinearBulk, internal=dolfinx.fem.form(f_int),
-                                 tangent=dolfinx.fem.form(tangent), load=load)  # fmt: skip
+        return functools.partial(
+            NonlinearBulk,
+            internal=dolfinx.fem.form(f_int),
+            tangent=dolfinx.fem.form(tangent),
+            load=load,
+        )
 
     def bulk_form(self):
         """The bulk's bilinear form a(du, v) of a linear material (trial ``trial``)."""

@@ -39,8 +39,9 @@ def _not_offered(method, capability: str, what: str, test) -> ValueError:
     from contactfx.contact.registry import methods_supporting
 
     reason = method.supports.why_not.get(capability, "not implemented")
-    return ValueError(f"method {method.name} {what} ({reason}); use "
-                      + ", ".join(methods_supporting(test)))  # fmt: skip
+    return ValueError(
+        f"method {method.name} {what} ({reason}); use " + ", ".join(methods_supporting(test))
+    )
 
 
 class TwoBodyProblem(Problem):
@@ -49,20 +50,25 @@ class TwoBodyProblem(Problem):
     @classmethod
     def check(cls, scene, numerics, method) -> None:
         if not method.supports.two_body:
-            raise _not_offered(method, "two_body", "is not offered between two meshed bodies",
-                               lambda c: c.two_body)  # fmt: skip
+            raise _not_offered(
+                method, "two_body", "is not offered between two meshed bodies", lambda c: c.two_body
+            )
         if numerics.degree != 1:
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
         if numerics.friction != "none" and not method.supports.two_body_friction:
-            raise _not_offered(method, "two_body_friction",
-                               "has no friction between two meshed bodies",
-                               lambda c: c.two_body and c.two_body_friction
-                               and "coulomb" in c.friction)  # fmt: skip
+            raise _not_offered(
+                method,
+                "two_body_friction",
+                "has no friction between two meshed bodies",
+                lambda c: c.two_body and c.two_body_friction and "coulomb" in c.friction,
+            )
         if numerics.friction == "tresca":
-            raise ValueError("Tresca friction between two meshed bodies is not implemented: use "
-                             "--friction coulomb or none")  # fmt: skip
+            raise ValueError(
+                "Tresca friction between two meshed bodies is not implemented: use "
+                "--friction coulomb or none"
+            )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
 
@@ -91,10 +97,13 @@ class TwoBodyProblem(Problem):
             dofs = np.asarray(_compat.bc_dofs(bc))
             fixed[dofs[dofs < n_dofs]] = True
         self.pair = ContactPair(
-            self.layout, side_of(self.V, self.facet_tags, scene.slave_tag),
-            side_of(self.V, self.facet_tags, scene.master_tag), scene.contact_modulus(),
-            search_each_newton=self.num.search_update == "newton", fixed=fixed,
-        )  # fmt: skip
+            self.layout,
+            side_of(self.V, self.facet_tags, scene.slave_tag),
+            side_of(self.V, self.facet_tags, scene.master_tag),
+            scene.contact_modulus(),
+            search_each_newton=self.num.search_update == "newton",
+            fixed=fixed,
+        )
         if self.friction is not None:
             self.pair.mu, self.pair.previous = self.friction.mu, self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
@@ -105,8 +114,9 @@ class TwoBodyProblem(Problem):
         """(m, 3): E, lambda, mu of the cell of each facet of ``side``."""
         mat = self.material
         fields = [mat.modulus, mat.poisson]
-        dofs = np.array([fields[0].function_space.dofmap.cell_dofs(c)[0] for c in side.cell],
-                        dtype=np.int64)  # fmt: skip
+        dofs = np.array(
+            [fields[0].function_space.dofmap.cell_dofs(c)[0] for c in side.cell], dtype=np.int64
+        )
         E, nu = (f.x.array[dofs] for f in fields)
         return np.stack([E, *lame(E, nu)], axis=1)
 
@@ -137,8 +147,10 @@ class TwoBodyProblem(Problem):
         least = comm.allreduce(float(np.min(gaps, initial=np.inf)), op=MPI.MIN)
         tol = 1e-2 * scene.h_contact()
         if least < -tol:
-            raise ValueError(f"the bodies overlap by {-least:.3g} at the start (more than "
-                             f"{tol:.3g}): move them apart or correct the geometry")  # fmt: skip
+            raise ValueError(
+                f"the bodies overlap by {-least:.3g} at the start (more than "
+                f"{tol:.3g}): move them apart or correct the geometry"
+            )
         fixed = np.zeros(len(self.state.x.array) // self.gdim, dtype=bool)
         for bc in self.bcs:
             fixed[np.asarray(_compat.bc_dofs(bc)) // self.gdim] = True
@@ -146,12 +158,15 @@ class TwoBodyProblem(Problem):
         for body, tag in scene.cells.items():
             cells = cell_tags.indices[cell_tags.values == tag]
             dofs = np.unique([self.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
-            supported = comm.allreduce(bool(np.any(fixed[np.asarray(dofs, dtype=np.int64)])),
-                                       op=MPI.LOR)  # fmt: skip
+            supported = comm.allreduce(
+                bool(np.any(fixed[np.asarray(dofs, dtype=np.int64)])), op=MPI.LOR
+            )
             if not supported and not least <= tol:
-                raise ValueError(f"the {body} body has no support and does not touch the other "
-                                 f"one at the start (closest gap {least:.3g}): the solve would "
-                                 "be singular")  # fmt: skip
+                raise ValueError(
+                    f"the {body} body has no support and does not touch the other "
+                    f"one at the start (closest gap {least:.3g}): the solve would "
+                    "be singular"
+                )
 
     def post_processor(self) -> TwoBodyPost:
         return TwoBodyPost(self)
@@ -171,8 +186,9 @@ class TwoBodyPost:
         #: nodes; the status is then 0 open, 1 stick, 2 slip
         self.friction_fields = []
         if pb.friction is not None:
-            self.friction_fields = [dolfinx.fem.Function(self.Q1, name=name)
-                                    for name in ("tangential_traction", "slip")]  # fmt: skip
+            self.friction_fields = [
+                dolfinx.fem.Function(self.Q1, name=name) for name in ("tangential_traction", "slip")
+            ]
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
         self.vm_expr = _compat.expression(pb.material.von_mises(pb.state), DG0)
@@ -199,7 +215,8 @@ class TwoBodyPost:
             f.x.array[local] = values
             f.x.scatter_forward()
         peak, closed, penetration, complementarity = nodal_contact(
-            self.pressure.x.array, self.gap.x.array, on, self.comm)  # fmt: skip
+            self.pressure.x.array, self.gap.x.array, on, self.comm
+        )
         self.status.x.array[:] = closed
         if self.friction_fields:
             t_mag, slip, stick = self.pb.coupling().nodal_friction()
@@ -309,10 +326,19 @@ class TwoBodyPost:
             if self.comm.rank == 0:
                 plot_pressure(x_all[:, : self.gdim], p_all, self.scene, q.force, plot)
                 header = "load," + ",".join(f"force_{c}" for c in "xyz"[: self.gdim])
-                np.savetxt(Path(out) / "pair_forces.csv", np.column_stack([loads, forces]),
-                           delimiter=",", comments="", header=header)  # fmt: skip
-        return {"reference": reference, "scores": scores, "errors": {},
-                "plot": None if plot is None else str(plot)}  # fmt: skip
+                np.savetxt(
+                    Path(out) / "pair_forces.csv",
+                    np.column_stack([loads, forces]),
+                    delimiter=",",
+                    comments="",
+                    header=header,
+                )
+        return {
+            "reference": reference,
+            "scores": scores,
+            "errors": {},
+            "plot": None if plot is None else str(plot),
+        }
 
 
 def plot_pressure(x: np.ndarray, p: np.ndarray, scene, force: float, path: Path) -> None:

@@ -101,8 +101,7 @@ def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.nda
     one value per block)."""
     f = dolfinx.fem.Function(Q)
     blocks = f.x.array.reshape(-1, Q.dofmap.index_map_bs)
-    per_vertex = np.broadcast_to(np.asarray(values, float).reshape(len(values), -1),
-                                 dofs.shape)  # fmt: skip
+    per_vertex = np.broadcast_to(np.asarray(values, float).reshape(len(values), -1), dofs.shape)
     np.add.at(blocks[:, 0], dofs[:n_owned].ravel(), per_vertex[:n_owned].ravel())
     vec = _compat.petsc_vec(f)
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
@@ -119,14 +118,14 @@ class _Crack:
         comm = mesh.comm
         self.true, self.first, self.n_owned = crack, first, n_owned
         near = near_cells(X, crack)
-        self.h = h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)),
-                                    op=MPI.MIN)  # fmt: skip
+        self.h = h = comm.allreduce(float(cell_sizes(X[near]).min(initial=np.inf)), op=MPI.MIN)
         if not np.isfinite(h):
             raise ValueError(f"the crack from {crack.p0} to {crack.p1} lies outside the mesh")
         #: a tip outside the mesh: the crack runs to the boundary (through the body, or an
         #: edge crack), and the enrichment reaches the boundary's nodes there
-        self.exits = any(_compat.PointLocator(mesh, np.asarray([tip])).outside[0]
-                         for tip in crack.tips())  # fmt: skip
+        self.exits = any(
+            _compat.PointLocator(mesh, np.asarray([tip])).outside[0] for tip in crack.tips()
+        )
         # every tip moved onto the boundary of the cell holding it (the same on every rank:
         # from the ranks that hold that cell)
         psi = np.array(comm.allgather(snapped_tips(X, crack, SNAP * h)))
@@ -137,8 +136,7 @@ class _Crack:
         self.segment = CrackSegment(*ends)
         self.cells = cells = cut_cells(X, self.segment, SNAP * h)
         if comm.allreduce(int(cells.cut[:n_owned].sum()), op=MPI.SUM) == 0:
-            raise ValueError("the crack cuts no cell completely (shorter than the cells "
-                             "around it)")  # fmt: skip
+            raise ValueError("the crack cuts no cell completely (shorter than the cells around it)")
         quad = CrackQuadrature(X, cells, rule)
         self.quad_points = quad.points
         DG0 = _compat.function_space(mesh, "DG", 0)
@@ -164,8 +162,9 @@ class _Crack:
         e1, e2 = X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]
         self.area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
         self.h_cut = dolfinx.fem.Function(DG0, name="h_cut")
-        length = np.where(cells.cut, np.linalg.norm(cells.pieces[:, 1] - cells.pieces[:, 0],
-                                                    axis=1), 1.0)  # fmt: skip
+        length = np.where(
+            cells.cut, np.linalg.norm(cells.pieces[:, 1] - cells.pieces[:, 0], axis=1), 1.0
+        )
         self.h_cut.x.array[c0] = NITSCHE_LENGTH * self.area / length
         cut = np.flatnonzero(cells.cut).astype(np.int32)
         self.cut, self.cut_owned = cut, cut[cut < n_owned]
@@ -176,14 +175,18 @@ class _Crack:
         ends = cells.pieces[self.cut_owned].reshape(-1, 2)
         sizes = np.repeat(cell_sizes(X[self.cut_owned]), 2)
         gathered = comm.allgather((self.coordinate(ends.T), sizes))
-        self.grid = CoarseGrid(np.concatenate([g[0] for g in gathered]),
-                               np.concatenate([g[1] for g in gathered]), GRID_FACTOR)  # fmt: skip
+        self.grid = CoarseGrid(
+            np.concatenate([g[0] for g in gathered]),
+            np.concatenate([g[1] for g in gathered]),
+            GRID_FACTOR,
+        )
 
     def nodes(self, Q) -> np.ndarray:
         """Bool per local (block) dof of the space Q: on one of this crack's cut cells, on any
         rank (a node's cut cell may be neither owned nor a ghost where the node is)."""
-        return _accumulate(Q, self.cells.cut.astype(float), _compat.cell_dofs(Q),
-                           self.n_owned) > 0.0  # fmt: skip
+        return (
+            _accumulate(Q, self.cells.cut.astype(float), _compat.cell_dofs(Q), self.n_owned) > 0.0
+        )
 
     def side(self, x):
         """The side (+1 / -1) of the points x (UFL): the crack's level set's sign in its cut
@@ -254,10 +257,16 @@ class _TipFields:
             # the tips on the edges or nodes that they are within the snap of (the same on
             # every rank: from the ranks that hold them)
             snap = SNAP * crack.h
-            held = mesh.comm.allgather([snapped_point(X[star], np.asarray(p, float), snap)
-                                        for p in (seg.p0, seg.p1)])  # fmt: skip
-            ends = np.array([next((h[t] for h in held if not np.isnan(h[t][0])), p)
-                             for t, p in enumerate((seg.p0, seg.p1))], float)  # fmt: skip
+            held = mesh.comm.allgather(
+                [snapped_point(X[star], np.asarray(p, float), snap) for p in (seg.p0, seg.p1)]
+            )
+            ends = np.array(
+                [
+                    next((h[t] for h in held if not np.isnan(h[t][0])), p)
+                    for t, p in enumerate((seg.p0, seg.p1))
+                ],
+                float,
+            )
             self.frames.append((ends, ahead, seg.normal))
             if len(star) == 0:
                 continue
@@ -266,13 +275,17 @@ class _TipFields:
             which = np.argmin(np.linalg.norm(centre[:, None] - ends[None], axis=2), axis=1)
             tips = ends[which]
             side = np.where(cells.fraction[star] >= 0.5, 1.0, -1.0)
-            pts, w, sides, cut_side = star_rule(X[star], cells.phi[star], cells.cut[star],
-                                                side, tips, self.slots, snap)  # fmt: skip
+            pts, w, sides, cut_side = star_rule(
+                X[star], cells.phi[star], cells.cut[star], side, tips, self.slots, snap
+            )
             F, gF = np.zeros(w.shape), np.zeros(w.shape + (2,))
             crack_pts = crack.quad_points[star]
             mids = crack_pts.mean(axis=1, keepdims=True)
-            R, gR, Rm = np.zeros(crack_pts.shape[:2]), np.zeros(crack_pts.shape), np.zeros(
-                (len(star), 1))  # fmt: skip
+            R, gR, Rm = (
+                np.zeros(crack_pts.shape[:2]),
+                np.zeros(crack_pts.shape),
+                np.zeros((len(star), 1)),
+            )
             for t in range(2):
                 on = which == t
                 F[on], gF[on] = branch(pts[on], ends[t], ahead[t], seg.normal, cut_side[on])
@@ -289,9 +302,14 @@ class _TipFields:
             Lc, Pc = Lc * cut[:, None], Pc * cut[:, None, None]
             Lm, Pm = Lm * cut[:, None], Pm * cut[:, None, None]
             ratio = w / (ref_w[None, :] * 2.0 * area[star, None])
-            for f, v in ((self.ratio, ratio), (self.side, sides), (self.F, F), (self.L, L),
-                         *zip(self.gF, np.moveaxis(gF, 2, 0), strict=True),
-                         *zip(self.P, np.moveaxis(P, 2, 0), strict=True)):  # fmt: skip
+            for f, v in (
+                (self.ratio, ratio),
+                (self.side, sides),
+                (self.F, F),
+                (self.L, L),
+                *zip(self.gF, np.moveaxis(gF, 2, 0), strict=True),
+                *zip(self.P, np.moveaxis(P, 2, 0), strict=True),
+            ):
                 f.x.array[qb[star]] = v
             for f, v in (
                 (self.R, R),
@@ -345,8 +363,10 @@ class UnfittedProblem(InterfaceProblem):
     def check(cls, scene, numerics, method) -> None:
         super().check(scene, numerics, method)
         if numerics.degree != 1:
-            raise ValueError("unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
-                             "integration is exact for constant strains only")  # fmt: skip
+            raise ValueError(
+                "unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
+                "integration is exact for constant strains only"
+            )
         if method.multiplier == "field" and getattr(method, "ncp", "min") != "min":
             raise ValueError(
                 "al-ssn on unfitted cracks projects its multiplier's law (--ncp min); the "
@@ -366,8 +386,9 @@ class UnfittedProblem(InterfaceProblem):
         segments = scene.crack_segments()
         #: U = (u, a_1, ..., a_K): one enrichment per crack
         self.components_per_dim = 1 + len(segments)
-        self.cracks = [_Crack(mesh, X, seg, 2 * (k + 1), self.rule, n_owned)
-                       for k, seg in enumerate(segments)]  # fmt: skip
+        self.cracks = [
+            _Crack(mesh, X, seg, 2 * (k + 1), self.rule, n_owned) for k, seg in enumerate(segments)
+        ]
         self.area = self.cracks[0].area
         self.tip = _TipFields(mesh, X, self.area, self.cracks, n_owned)
         c0 = _compat.cell_dofs(self.cracks[0].h_cut.function_space)[:, 0]
@@ -386,13 +407,14 @@ class UnfittedProblem(InterfaceProblem):
             tags[crack.cells.cut] = k + 1
         clash = mesh.comm.allreduce(clash, op=MPI.MAX)  # every rank raises, or none
         if clash != (0, 0):
-            raise ValueError(f"cracks {clash[0]} and {clash[1]} cross or share a cell; unfitted "
-                             "cracks must be a cell apart")  # fmt: skip
+            raise ValueError(
+                f"cracks {clash[0]} and {clash[1]} cross or share a cell; unfitted "
+                "cracks must be a cell apart"
+            )
         # every cell tagged: 0, k + 1 (cut by crack k), K + 1 + k (around a tip of crack k)
         star = self.tip.tags >= 0
         tags[star] = K + 1 + self.tip.tags[star]
-        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, np.arange(len(X), dtype=np.int32),
-                                              tags)  # fmt: skip
+        self.cut_tags = dolfinx.mesh.meshtags(mesh, tdim, np.arange(len(X), dtype=np.int32), tags)
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
 
     # -- a method's values at the cracks' pieces ----------------------------------------------
@@ -482,14 +504,19 @@ class UnfittedProblem(InterfaceProblem):
         tdim = mesh.topology.dim
         mesh.topology.create_connectivity(tdim - 1, tdim)
         f2c = mesh.topology.connectivity(tdim - 1, tdim)
-        n_facets = mesh.topology.index_map(tdim - 1).size_local + mesh.topology.index_map(
-            tdim - 1).num_ghosts  # fmt: skip
+        n_facets = (
+            mesh.topology.index_map(tdim - 1).size_local
+            + mesh.topology.index_map(tdim - 1).num_ghosts
+        )
         side = np.where(crack.cells.fraction >= 0.5, 1.0, -1.0)
         facets = []
         for f in range(n_facets):
             cells = f2c.links(f)
-            if len(cells) == 2 and side[cells[0]] != side[cells[1]] and np.any(
-                    crack.cells.cut[cells]):  # fmt: skip
+            if (
+                len(cells) == 2
+                and side[cells[0]] != side[cells[1]]
+                and np.any(crack.cells.cut[cells])
+            ):
                 facets.append(f)
         return Split(crack.H, np.asarray(facets, dtype=np.int32), jump="enrichment_1")
 
@@ -547,9 +574,9 @@ class UnfittedProblem(InterfaceProblem):
         u = ufl.as_vector([X[i] for i in range(d)])
         m = [2.0 * c.fraction - 1.0 for c in self.cracks]
         mean = self.material.sigma(
-            u + sum((mk * c.enrichment(X) for mk, c in zip(m, self.cracks, strict=True)),
-                    ufl.zero(d))
-        )  # fmt: skip
+            u
+            + sum((mk * c.enrichment(X) for mk, c in zip(m, self.cracks, strict=True)), ufl.zero(d))
+        )
         a = crack.enrichment(X)
         aT = t.part(a, t.Lc, t.Pc)
         tip = ufl.outer(aT, ufl.as_vector(t.gR)) + (t.R - 1.0) * t.part_grad(a)
@@ -579,19 +606,31 @@ class UnfittedProblem(InterfaceProblem):
             t, K = self.tip, len(self.cracks)
             crack.ds = WeightedMeasure(dx((k + 1, K + 1 + k), metadata=rule), crack.weight)
             crack.s_coord = crack.coordinate(Y)
-            self.surfaces.append(CutSurface(
-                self.U, self.V_test, ufl.as_vector([float(v) for v in crack.true.normal]),
-                crack.ds, self._mean_stress(self.U, crack), self._mean_stress(self.V_test, crack),
-                scene.contact_modulus(), crack.h_cut, floor=scene.floor(crack.s_coord),
-                fluid=self.fluid, friction=self.friction, joint=scene.joint(),
-                u_prev=None if self.prev is None else self.previous(), at_crack=at_crack,
-                at_law=at_midpoint, first=crack.first, traction_prev=self.t_prev,
-                at_jump=functools.partial(t.half_jump, at_crack, R=t.R, L=t.Lc, P=t.Pc),
-                at_jump_law=functools.partial(t.half_jump, at_midpoint, R=t.Rm, L=t.Lm,
-                                              P=t.Pm),
-                multiplier=self._multiplier_at(at_crack),
-                h_nodal=self._nodal_size(),
-            ))  # fmt: skip
+            self.surfaces.append(
+                CutSurface(
+                    self.U,
+                    self.V_test,
+                    ufl.as_vector([float(v) for v in crack.true.normal]),
+                    crack.ds,
+                    self._mean_stress(self.U, crack),
+                    self._mean_stress(self.V_test, crack),
+                    scene.contact_modulus(),
+                    crack.h_cut,
+                    floor=scene.floor(crack.s_coord),
+                    fluid=self.fluid,
+                    friction=self.friction,
+                    joint=scene.joint(),
+                    u_prev=None if self.prev is None else self.previous(),
+                    at_crack=at_crack,
+                    at_law=at_midpoint,
+                    first=crack.first,
+                    traction_prev=self.t_prev,
+                    at_jump=functools.partial(t.half_jump, at_crack, R=t.R, L=t.Lc, P=t.Pc),
+                    at_jump_law=functools.partial(t.half_jump, at_midpoint, R=t.Rm, L=t.Lm, P=t.Pm),
+                    multiplier=self._multiplier_at(at_crack),
+                    h_nodal=self._nodal_size(),
+                )
+            )
         self._refuse_loaded_crossings()
         first = self.cracks[0]
         self.dSc = self.dS_fine = first.ds
@@ -665,14 +704,16 @@ class UnfittedProblem(InterfaceProblem):
 
         def mean(X):
             u = ufl.as_vector([X[i] for i in range(d)])
-            return u + sum(((2.0 * c.fraction - 1.0) * c.enrichment(X) for c in self.cracks),
-                           ufl.zero(d))  # fmt: skip
+            return u + sum(
+                ((2.0 * c.fraction - 1.0) * c.enrichment(X) for c in self.cracks), ufl.zero(d)
+            )
 
         form = ufl.inner(sigma(mean(self.dU)), eps(mean(self.V_test)))
         for c in self.cracks:
             m = 2.0 * c.fraction - 1.0
-            form += (1.0 - m * m) * ufl.inner(sigma(c.enrichment(self.dU)),
-                                              eps(c.enrichment(self.V_test)))  # fmt: skip
+            form += (1.0 - m * m) * ufl.inner(
+                sigma(c.enrichment(self.dU)), eps(c.enrichment(self.V_test))
+            )
         # (one measure for every cell integral: dolfinx 0.9 wants one subdomain data per form)
         K = len(self.cracks)
         dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cut_tags)
@@ -685,8 +726,11 @@ class UnfittedProblem(InterfaceProblem):
         cut = [(dx((k + 1, K + 1 + k)), lambda f: f) for k in range(K)]
         lam, mu = ufl.split(self.trial)[1], ufl.split(self.test)[1]
         zero = dolfinx.fem.Constant(self.mesh, 0.0)
-        return (form + zero_pattern(self.mesh, self.trial, self.test, cut)
-                + zero * ufl.inner(lam, mu) * dx)  # fmt: skip
+        return (
+            form
+            + zero_pattern(self.mesh, self.trial, self.test, cut)
+            + zero * ufl.inner(lam, mu) * dx
+        )
 
     def _star_form(self, dx):
         """The bulk energy on the cells around the tips' nodes, by the star rule
@@ -698,10 +742,13 @@ class UnfittedProblem(InterfaceProblem):
             if self.mesh.comm.allreduce(int(np.sum(t.tags == k)), op=MPI.SUM) == 0:
                 continue
             others = [(2.0 * c.fraction - 1.0, c) for c in self.cracks if c is not crack]
-            e_u, e_v = (t.strain(X, crack, [(m, c.enrichment(X)) for m, c in others], t.side)
-                        for X in (self.dU, self.V_test))  # fmt: skip
-            form += ufl.inner(self.material.stress(e_u), e_v) * t.ratio * dx(
-                K + 1 + k, metadata=rule)  # fmt: skip
+            e_u, e_v = (
+                t.strain(X, crack, [(m, c.enrichment(X)) for m, c in others], t.side)
+                for X in (self.dU, self.V_test)
+            )
+            form += (
+                ufl.inner(self.material.stress(e_u), e_v) * t.ratio * dx(K + 1 + k, metadata=rule)
+            )
         return form
 
     def post_processor(self) -> CutPost:
@@ -723,9 +770,14 @@ class CutPost(InterfacePost):
         for crack, s in zip(pb.cracks, pb.surfaces, strict=True):
             t_I = tangent(s.interface_normal())
             p = method.pressure(s)
-            quantities = {"aperture": s.opening() + self.w0, "slip": ufl.dot(s.u, t_I),
-                          "normal_traction": p, "gap": s.gap(), "x": crack.Y[0],
-                          "y": crack.Y[1]}  # fmt: skip
+            quantities = {
+                "aperture": s.opening() + self.w0,
+                "slip": ufl.dot(s.u, t_I),
+                "normal_traction": p,
+                "gap": s.gap(),
+                "x": crack.Y[0],
+                "y": crack.Y[1],
+            }
             forms["force"] += p * s.ds
             forms["closed"] += active(method.contact_indicator(s)) * s.ds
             if s.friction is not None:
@@ -736,8 +788,7 @@ class CutPost(InterfacePost):
             if s.floor is not None:
                 quantities["proppant"] = s.floor
                 forms["propped"] += p * active(s.floor) * s.ds
-            self.exprs.append({k: dolfinx.fem.Expression(v, points)
-                               for k, v in quantities.items()})  # fmt: skip
+            self.exprs.append({k: dolfinx.fem.Expression(v, points) for k, v in quantities.items()})
         s = pb.surface
         self.force_form = dolfinx.fem.form(forms["force"])
         self.closed_form = dolfinx.fem.form(forms["closed"])
@@ -748,8 +799,10 @@ class CutPost(InterfacePost):
         if s.floor is not None:
             self.propped_form = dolfinx.fem.form(forms["propped"])
         self.err_forms = self._error_forms(s, method.pressure(s), tangent(s.interface_normal()))
-        self.extra = {k: dolfinx.fem.form(v) for k, v in self.scene.extra_quantities(
-            mesh, pb.boundary_total(pb.U), pb.ds).items()}  # fmt: skip
+        self.extra = {
+            k: dolfinx.fem.form(v)
+            for k, v in self.scene.extra_quantities(mesh, pb.boundary_total(pb.U), pb.ds).items()
+        }
         if s.friction is not None:  # the slipping length
             self.extra["slipping_size"] = dolfinx.fem.form(forms["slipping"])
         DG0 = _compat.function_space(mesh, "DG", 0)
@@ -759,11 +812,13 @@ class CutPost(InterfacePost):
         self.u_out = dolfinx.fem.Function(V1, name="displacement")
         U, d = pb.U, pb.gdim
         self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(d)]), V1)
-        self.a_out = [dolfinx.fem.Function(V1, name=f"enrichment_{k + 1}")
-                      for k in range(len(pb.cracks))]  # fmt: skip
+        self.a_out = [
+            dolfinx.fem.Function(V1, name=f"enrichment_{k + 1}") for k in range(len(pb.cracks))
+        ]
         self.a_expr = [_compat.expression(c.enrichment(U), V1) for c in pb.cracks]
-        self._tip_scales = [self._tip_scale(V1, c, frame)
-                            for c, frame in zip(pb.cracks, pb.tip.frames, strict=True)]  # fmt: skip
+        self._tip_scales = [
+            self._tip_scale(V1, c, frame) for c, frame in zip(pb.cracks, pb.tip.frames, strict=True)
+        ]
         self.values: dict[str, np.ndarray] = {}
 
     def _tip_scale(self, V1, crack, frame) -> np.ndarray:
@@ -786,20 +841,22 @@ class CutPost(InterfacePost):
         numbers the cracks from 1, ``s`` is each one's own coordinate)."""
         mesh, parts = self.pb.mesh, []
         for k, (crack, exprs) in enumerate(zip(self.pb.cracks, self.exprs, strict=True)):
-            v = {name: _compat.eval_expression(e, mesh, crack.cut_owned).ravel()
-                 for name, e in exprs.items()}  # fmt: skip
+            v = {
+                name: _compat.eval_expression(e, mesh, crack.cut_owned).ravel()
+                for name, e in exprs.items()
+            }
             v["s"] = crack.coordinate(np.vstack([v["x"], v["y"]]))
             v["crack"] = np.full(len(v["s"]), k + 1.0)
             parts.append(v)
         names = set().union(*parts)
-        return {n: np.concatenate([p.get(n, np.zeros(len(p["s"]))) for p in parts])
-                for n in names}  # fmt: skip
+        return {n: np.concatenate([p.get(n, np.zeros(len(p["s"]))) for p in parts]) for n in names}
 
     def evaluate(self, solver) -> Quantities:
         v = self.values = self._evaluate_points()
         on = np.ones(len(v["normal_traction"]), dtype=bool)
         peak, closed, penetration, complementarity = nodal_contact(
-            v["normal_traction"], v["gap"], on, self.comm)  # fmt: skip
+            v["normal_traction"], v["gap"], on, self.comm
+        )
         status = np.where(closed, STATUS["stick"], STATUS["open"]).astype(float)
         if "slipping" in v:
             status[closed & (v["slipping"] > 0.5)] = STATUS["slip"]
@@ -807,18 +864,21 @@ class CutPost(InterfacePost):
             status[closed & (v["proppant"] > 0.0)] = STATUS["propped"]
         v["status"] = status
         interface = InterfaceQuantities(
-            tangential_force=0.0 if self.tforce_form is None else global_sum(self.tforce_form,
-                                                                             self.comm),
+            tangential_force=0.0
+            if self.tforce_form is None
+            else global_sum(self.tforce_form, self.comm),
             extra={k: global_sum(form, self.comm) for k, form in self.extra.items()},
-        )  # fmt: skip
+        )
         if self.propped_form is not None:
             propped = v["proppant"] > 0.0
             interface = InterfaceQuantities(
-                tangential_force=interface.tangential_force, extra=interface.extra,
+                tangential_force=interface.tangential_force,
+                extra=interface.extra,
                 proppant_force=global_sum(self.propped_form, self.comm),
                 min_aperture_propped=self.comm.allreduce(
-                    float(np.min(v["aperture"][propped], initial=np.inf)), op=MPI.MIN),
-            )  # fmt: skip
+                    float(np.min(v["aperture"][propped], initial=np.inf)), op=MPI.MIN
+                ),
+            )
         return Quantities(
             force=global_sum(self.force_form, self.comm),
             contact_size=global_sum(self.closed_form, self.comm),
@@ -845,9 +905,19 @@ class CutPost(InterfacePost):
             return v[name] if name in v else np.zeros(len(v["s"]))
 
         opening = col("aperture") - self.w0
-        local = np.column_stack([v["s"], x, opening, col("slip"), col("normal_traction"),
-                                 col("tangential_traction"), col("status"), col("proppant"),
-                                 v["crack"]])  # fmt: skip
+        local = np.column_stack(
+            [
+                v["s"],
+                x,
+                opening,
+                col("slip"),
+                col("normal_traction"),
+                col("tangential_traction"),
+                col("status"),
+                col("proppant"),
+                v["crack"],
+            ]
+        )
         parts = self.comm.gather(local, root=0)
         if self.comm.rank != 0:
             return Profile(np.zeros(0), np.zeros((0, 2)), *(np.zeros(0) for _ in range(6)))

@@ -42,8 +42,13 @@ VTK_CELLS = {
     "tetrahedron": (10, [0, 1, 2, 3]),
     "hexahedron": (12, [0, 1, 3, 2, 4, 5, 7, 6]),
 }
-_FACET = {"interval": "point", "triangle": "interval", "quadrilateral": "interval",
-          "tetrahedron": "triangle", "hexahedron": "quadrilateral"}  # fmt: skip
+_FACET = {
+    "interval": "point",
+    "triangle": "interval",
+    "quadrilateral": "interval",
+    "tetrahedron": "triangle",
+    "hexahedron": "quadrilateral",
+}
 _VTK_VERTEX = 1
 
 
@@ -166,8 +171,7 @@ class ResultsWriter:
             if self._surface is None:
                 self._surface = self._surface_cells(side)
             cells, local = self._surface
-            self._write(self.out / surface, _FACET[self.cell_name], cells, local, point, cell,
-                        None)  # fmt: skip
+            self._write(self.out / surface, _FACET[self.cell_name], cells, local, point, cell, None)
         self._steps.append((t, body, surface))
         if self.comm.rank == 0:
             _write_pvd(self.path, [(t, b) for t, b, _ in self._steps])
@@ -191,16 +195,16 @@ class ResultsWriter:
             verts = list(c2v.links(c))
             cells.append(c)
             local.append([verts.index(v) for v in f2v.links(f)])
-        nv = {"point": 1, "interval": 2, "triangle": 3, "quadrilateral": 4}[
-            _FACET[self.cell_name]]  # fmt: skip
+        nv = {"point": 1, "interval": 2, "triangle": 3, "quadrilateral": 4}[_FACET[self.cell_name]]
         return np.array(cells, dtype=np.int32), np.array(local, dtype=np.int32).reshape(-1, nv)
 
     def _write(self, path, cell_name, cells, local, point, cell, side) -> None:
         """Gather the cells' data on rank 0 and write one VTU. ``local``: the vertices of
         each cell to keep (a facet of it), all when None."""
         if local is None:
-            local = np.broadcast_to(np.arange(self.q_dofs.shape[1]), (len(cells),
-                                    self.q_dofs.shape[1]))  # fmt: skip
+            local = np.broadcast_to(
+                np.arange(self.q_dofs.shape[1]), (len(cells), self.q_dofs.shape[1])
+            )
         rows = np.repeat(cells, local.shape[1]).reshape(local.shape)
         qd = self.q_dofs[rows, local]
         nodes = self.q_global[qd]
@@ -208,8 +212,12 @@ class ResultsWriter:
             minus = (side[cells] < 0)[:, None] & np.isin(nodes, self.split_nodes)
             dup = self.n_global + np.searchsorted(self.split_nodes, nodes)
             nodes = np.where(minus, dup, nodes)
-        mine = _Local(nodes, self.q_x[qd], {k: v[rows, local] for k, v in point.items()},
-                      {k: v[cells] for k, v in cell.items()})  # fmt: skip
+        mine = _Local(
+            nodes,
+            self.q_x[qd],
+            {k: v[rows, local] for k, v in point.items()},
+            {k: v[cells] for k, v in cell.items()},
+        )
         parts = self.comm.gather(mine, root=0)
         if self.comm.rank != 0:
             return
@@ -258,16 +266,20 @@ def _b64(a: np.ndarray) -> str:
 
 
 def _array(parent, name: str, a: np.ndarray, components: int = 1) -> None:
-    types = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64",
-             np.dtype(np.uint8): "UInt8"}  # fmt: skip
+    types = {
+        np.dtype(np.float64): "Float64",
+        np.dtype(np.int64): "Int64",
+        np.dtype(np.uint8): "UInt8",
+    }
     e = ET.SubElement(parent, "DataArray", type=types[a.dtype], Name=name, format="binary")
     if components > 1:
         e.set("NumberOfComponents", str(components))
     e.text = _b64(a)
 
 
-def write_vtu(path: Path, x: np.ndarray, conn: np.ndarray, cell_name: str, point: dict,
-              cell: dict) -> None:  # fmt: skip
+def write_vtu(
+    path: Path, x: np.ndarray, conn: np.ndarray, cell_name: str, point: dict, cell: dict
+) -> None:
     """One unstructured grid: points x (n, 3), cells conn (m, k) of dolfinx's ``cell_name``
     (``point`` for vertex cells), point and cell data (n or m rows, 1 or 3 components)."""
     if cell_name == "point":
@@ -275,10 +287,19 @@ def write_vtu(path: Path, x: np.ndarray, conn: np.ndarray, cell_name: str, point
     else:
         vtk_type, perm = VTK_CELLS[cell_name]
     conn = np.asarray(conn, dtype=np.int64)[:, perm] if len(conn) else conn.astype(np.int64)
-    root = ET.Element("VTKFile", type="UnstructuredGrid", version="1.0",
-                      byte_order="LittleEndian", header_type="UInt64")  # fmt: skip
-    piece = ET.SubElement(ET.SubElement(root, "UnstructuredGrid"), "Piece",
-                          NumberOfPoints=str(len(x)), NumberOfCells=str(len(conn)))  # fmt: skip
+    root = ET.Element(
+        "VTKFile",
+        type="UnstructuredGrid",
+        version="1.0",
+        byte_order="LittleEndian",
+        header_type="UInt64",
+    )
+    piece = ET.SubElement(
+        ET.SubElement(root, "UnstructuredGrid"),
+        "Piece",
+        NumberOfPoints=str(len(x)),
+        NumberOfCells=str(len(conn)),
+    )
     _array(ET.SubElement(piece, "Points"), "Points", np.asarray(x, dtype=np.float64), 3)
     cells = ET.SubElement(piece, "Cells")
     k = conn.shape[1] if conn.ndim == 2 else 0
@@ -329,8 +350,14 @@ def read_vtu(path: Path) -> dict:
     cells = {e.get("Name"): _decode(e) for e in piece.find("Cells")}
     m = len(cells["types"])
     conn = cells["connectivity"].reshape(m, -1) if m else np.zeros((0, 0), dtype=np.int64)
-    data = {tag: {e.get("Name"): _decode(e) for e in piece.find(tag)}
-            for tag in ("PointData", "CellData")}  # fmt: skip
-    return {"points": x.reshape(-1, 3), "cells": conn,
-            "type": int(cells["types"][0]) if m else 0, "point_data": data["PointData"],
-            "cell_data": data["CellData"]}  # fmt: skip
+    data = {
+        tag: {e.get("Name"): _decode(e) for e in piece.find(tag)}
+        for tag in ("PointData", "CellData")
+    }
+    return {
+        "points": x.reshape(-1, 3),
+        "cells": conn,
+        "type": int(cells["types"][0]) if m else 0,
+        "point_data": data["PointData"],
+        "cell_data": data["CellData"],
+    }

@@ -43,8 +43,9 @@ def hooke(eps, lmbda, mu, trace, identity):
     return 2.0 * mu * eps + lmbda * trace(eps) * identity
 
 
-def basis_tractions(grads: np.ndarray, n: np.ndarray, lmbda: np.ndarray,
-                    mu: np.ndarray) -> np.ndarray:  # fmt: skip
+def basis_tractions(
+    grads: np.ndarray, n: np.ndarray, lmbda: np.ndarray, mu: np.ndarray
+) -> np.ndarray:
     """sigma(N_a e_c) n: the traction on the plane of normal n of the displacement N_a e_c of
     each P1 basis function N_a and direction c, by :func:`hooke` with eps = sym(e_c grad N_a).
     grads (P, A, d): the basis gradients at P points; n (P, d); lmbda, mu (P,). Returns
@@ -53,8 +54,13 @@ def basis_tractions(grads: np.ndarray, n: np.ndarray, lmbda: np.ndarray,
     unit = np.eye(d)
     grad_u = unit[None, None, :, :, None] * grads[:, :, None, None, :]  # e_c (x) grad N_a
     eps = 0.5 * (grad_u + np.swapaxes(grad_u, -1, -2))
-    sigma = hooke(eps, lmbda[:, None, None, None, None], mu[:, None, None, None, None],
-                  lambda e: np.trace(e, axis1=-2, axis2=-1)[..., None, None], unit)  # fmt: skip
+    sigma = hooke(
+        eps,
+        lmbda[:, None, None, None, None],
+        mu[:, None, None, None, None],
+        lambda e: np.trace(e, axis1=-2, axis2=-1)[..., None, None],
+        unit,
+    )
     return np.einsum("pacij,pj->paci", sigma, n)
 
 

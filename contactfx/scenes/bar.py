@@ -66,9 +66,13 @@ class Bar1D(ObstacleScene):
         return {
             "bodies": [export.body("bar", self.material(), body_force=[p.body_force])],
             "boundary": [export.fixed("left", (0,))],
-            "obstacle": {"shape": "plane", "contact": "right", "h": self.h_contact(),
-                         **export.motion(self.obstacle_offset, 1)},
-        }  # fmt: skip
+            "obstacle": {
+                "shape": "plane",
+                "contact": "right",
+                "h": self.h_contact(),
+                **export.motion(self.obstacle_offset, 1),
+            },
+        }
 
     def obstacle(self) -> Obstacle:
         return HalfSpace(0.0)

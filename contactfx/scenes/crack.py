@@ -52,12 +52,17 @@ __all__ = [
     "CrackSet",
 ]
 
-_OUTER = (CrackPlateFacets.BOTTOM, CrackPlateFacets.RIGHT, CrackPlateFacets.TOP,
-          CrackPlateFacets.LEFT)  # fmt: skip
+_OUTER = (
+    CrackPlateFacets.BOTTOM,
+    CrackPlateFacets.RIGHT,
+    CrackPlateFacets.TOP,
+    CrackPlateFacets.LEFT,
+)
 
 
-def stress_intensity_from_jump(s, jump, a: float, E: float, nu: float,
-                               window: tuple[float, float] = (0.05, 0.5)):  # fmt: skip
+def stress_intensity_from_jump(
+    s, jump, a: float, E: float, nu: float, window: tuple[float, float] = (0.05, 0.5)
+):
     """K from the crack-face displacement jump near both tips (see the module docstring);
     nan when a tip has fewer than 3 nodes at window[0] a <= r <= window[1] a."""
     values = []
@@ -67,8 +72,9 @@ def stress_intensity_from_jump(s, jump, a: float, E: float, nu: float,
     return float(np.mean(values))
 
 
-def extrapolated_K(r, jump, E: float, nu: float, a: float,
-                   window: tuple[float, float] = (0.05, 0.5), near=True) -> float:  # fmt: skip
+def extrapolated_K(
+    r, jump, E: float, nu: float, a: float, window: tuple[float, float] = (0.05, 0.5), near=True
+) -> float:
     """K at one tip (or one stretch of a 3D front) from the jump at the distances r to it:
     the near-tip plane-strain field [[u]] = 8 K / E' sqrt(r / (2 pi)) read at the nodes with
     window[0] a <= r <= window[1] a (and ``near``), fitted by K0 + K1 r, K0; nan with fewer
@@ -95,19 +101,26 @@ class _PlateParams(elastic(10e9, 0.25)):
     h_tip: float = param(0.0025, "element size at the crack tips (<= h-crack)", positive=True)
     h_far: float = param(0.5, "element size far from the crack", positive=True)
     grading: float = param(0.15, "element size increase per unit distance", positive=True)
-    boundary: str = param("infinite", "plate boundary traction: infinite (closed-form "
-                          "infinite-plate field) or remote (uniform remote stress)",
-                          choices=("infinite", "remote"))  # fmt: skip
+    boundary: str = param(
+        "infinite",
+        "plate boundary traction: infinite (closed-form "
+        "infinite-plate field) or remote (uniform remote stress)",
+        choices=("infinite", "remote"),
+    )
     crack: str = param(
         "fitted",
         "fitted (a chain of mesh edges) or unfitted (level sets on a mesh that ignores the crack)",
         choices=("fitted", "unfitted"),
     )
-    crack_offset: float = param(0.0, "shift of the crack along its normal (unfitted: its "
-                                "position against the mesh's nodes)")  # fmt: skip
-    background: str = param("graded", "the unfitted crack's mesh: graded (the fitted crack's "
-                            "size field) or structured (a grid of spacing h-crack around it)",
-                            choices=("graded", "structured"))  # fmt: skip
+    crack_offset: float = param(
+        0.0, "shift of the crack along its normal (unfitted: its position against the mesh's nodes)"
+    )
+    background: str = param(
+        "graded",
+        "the unfitted crack's mesh: graded (the fitted crack's "
+        "size field) or structured (a grid of spacing h-crack around it)",
+        choices=("graded", "structured"),
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -163,17 +176,25 @@ class _CrackPlate(InterfaceScene):
             d, _ = self._axes()
             reach = p.crack_half_length * np.abs(d).max() + abs(p.crack_offset)
             return functools.partial(
-                structured_plate, half_width=0.5 * p.plate_width,
-                inner_half_width=min(reach + 0.25 * p.crack_half_length,
-                                     0.5 * (reach + 0.5 * p.plate_width)),
+                structured_plate,
+                half_width=0.5 * p.plate_width,
+                inner_half_width=min(
+                    reach + 0.25 * p.crack_half_length, 0.5 * (reach + 0.5 * p.plate_width)
+                ),
                 h=p.h_crack,
-            ), 2  # fmt: skip
+            ), 2
         return functools.partial(
-            crack_plate, half_width=0.5 * p.plate_width,
-            crack_half_length=p.crack_half_length, angle=self.angle(), h_crack=p.h_crack,
-            h_far=p.h_far, grading=p.grading, h_tip=p.h_tip, embed=p.crack == "fitted",
+            crack_plate,
+            half_width=0.5 * p.plate_width,
+            crack_half_length=p.crack_half_length,
+            angle=self.angle(),
+            h_crack=p.h_crack,
+            h_far=p.h_far,
+            grading=p.grading,
+            h_tip=p.h_tip,
+            embed=p.crack == "fitted",
             split_at=self.split_points() if p.crack == "fitted" else (),
-        ), 2  # fmt: skip
+        ), 2
 
     def length_scale(self) -> float:
         return self.p.plate_width
@@ -207,8 +228,11 @@ class _CrackPlate(InterfaceScene):
 
     def pinned(self):
         half = 0.5 * self.p.plate_width
-        return [(np.array([-half, -half]), 0), (np.array([-half, -half]), 1),
-                (np.array([half, -half]), 1)]  # fmt: skip
+        return [
+            (np.array([-half, -half]), 0),
+            (np.array([-half, -half]), 1),
+            (np.array([half, -half]), 1),
+        ]
 
     def _boundary_stress(self, x):
         """UFL stress on the plate boundary at load factor 1."""
@@ -261,15 +285,24 @@ class _CrackPlate(InterfaceScene):
         stress = self._boundary_stress_text()
         boundary = []
         if any(v != 0.0 for row in stress for v in row):
-            boundary = [{"group": tag.name.lower(), "stress": stress, "quadrature_degree": 8}
-                        for tag in _OUTER]  # fmt: skip
+            boundary = [
+                {"group": tag.name.lower(), "stress": stress, "quadrature_degree": 8}
+                for tag in _OUTER
+            ]
         origin, direction = self.frame()
-        interface = {"group": "crack", "h": self.h_contact(),
-                     "origin": [float(v) for v in origin],
-                     "direction": [float(v) for v in direction],
-                     **self.interface_data()}  # fmt: skip
-        return {"bodies": [export.body("domain", self.material())], "boundary": boundary,
-                "pins": export.pins(self.pinned()), "interface": interface}  # fmt: skip
+        interface = {
+            "group": "crack",
+            "h": self.h_contact(),
+            "origin": [float(v) for v in origin],
+            "direction": [float(v) for v in direction],
+            **self.interface_data(),
+        }
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": boundary,
+            "pins": export.pins(self.pinned()),
+            "interface": interface,
+        }
 
     def load(self, v, ds, t):
         mesh = ds.ufl_domain()
@@ -285,8 +318,9 @@ class _CrackPlate(InterfaceScene):
         return cf.opening(s, self.p.crack_half_length, load, self.p.E, self.p.nu, m)
 
     def _K(self, prof: Profile, jump) -> float:
-        return stress_intensity_from_jump(prof.s, jump, self.p.crack_half_length, self.p.E,
-                                          self.p.nu)  # fmt: skip
+        return stress_intensity_from_jump(
+            prof.s, jump, self.p.crack_half_length, self.p.E, self.p.nu
+        )
 
 
 @dataclass(frozen=True)
@@ -336,8 +370,9 @@ class CrackSneddon(_CrackPlate):
 
 @dataclass(frozen=True)
 class CrackInclinedParams(_PlateParams):
-    beta: float = param(45.0, "crack angle to the x axis, degrees (the plane normal to the "
-                        "compression)")  # fmt: skip
+    beta: float = param(
+        45.0, "crack angle to the x axis, degrees (the plane normal to the compression)"
+    )
     sigma: float = param(10e6, "uniaxial compression along y", positive=True)
 
 
@@ -403,8 +438,12 @@ class CrackInclined(SlidingCrack, _CrackPlate):
         sigma_n, tau = self._plane()
         a = self.p.crack_half_length
         exact = abs(self._q()) * np.sqrt(np.pi * a)
-        out = {"sigma_n": sigma_n, "tau": tau, "K_II_exact": exact,
-               "K_II_normalised_exact": exact / (self.p.sigma * np.sqrt(np.pi * a))}  # fmt: skip
+        out = {
+            "sigma_n": sigma_n,
+            "tau": tau,
+            "K_II_exact": exact,
+            "K_II_normalised_exact": exact / (self.p.sigma * np.sqrt(np.pi * a)),
+        }
         K = self._K(prof, prof.slip) if exact > 0.0 else float(np.max(np.abs(prof.slip)))
         out["K_II"] = K
         if exact > 0.0:
@@ -429,11 +468,13 @@ class CrackInclined(SlidingCrack, _CrackPlate):
 @dataclass(frozen=True)
 class ProppedFractureParams(_PlateParams):
     net_pressure: float = param(-1e6, "net pressure p_net = p - s_c (fluid minus closure)")
-    closure_stress: float = param(20e6, "remote compression s_c normal to the fracture",
-                                  nonnegative=True)  # fmt: skip
+    closure_stress: float = param(
+        20e6, "remote compression s_c normal to the fracture", nonnegative=True
+    )
     proppant_half_length: float = param(0.5, "proppant layer on |s| < b", positive=True)
-    proppant_thickness: float = param(1e-4, "proppant thickness h (aperture >= h there)",
-                                      positive=True)  # fmt: skip
+    proppant_thickness: float = param(
+        1e-4, "proppant thickness h (aperture >= h there)", positive=True
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -452,8 +493,11 @@ class ProppedFracture(_CrackPlate):
 
     def p_star(self) -> float:
         p = self.p
-        return float(cf.propping_pressure(p.proppant_thickness, p.crack_half_length,
-                                          p.proppant_half_length, p.E, p.nu))  # fmt: skip
+        return float(
+            cf.propping_pressure(
+                p.proppant_thickness, p.crack_half_length, p.proppant_half_length, p.E, p.nu
+            )
+        )
 
     def open_branch(self) -> bool:
         return self.p.net_pressure >= self.p_star()
@@ -478,8 +522,11 @@ class ProppedFracture(_CrackPlate):
 
     def interface_data(self):
         b = self.p.proppant_half_length
-        return {**super().interface_data(), "proppant_thickness": self.p.proppant_thickness,
-                "proppant_zone": [-b, b]}  # fmt: skip
+        return {
+            **super().interface_data(),
+            "proppant_thickness": self.p.proppant_thickness,
+            "proppant_zone": [-b, b],
+        }
 
     def exact_opening(self, s):
         return self._ellipse(s, self.p.net_pressure) if self.open_branch() else None
@@ -490,8 +537,11 @@ class ProppedFracture(_CrackPlate):
         return {}
 
     def interface_reference(self, prof, q, friction):
-        out = {"p_star": self.p_star(), "open_branch": float(self.open_branch()),
-               "proppant_thickness": self.p.proppant_thickness}  # fmt: skip
+        out = {
+            "p_star": self.p_star(),
+            "open_branch": float(self.open_branch()),
+            "proppant_thickness": self.p.proppant_thickness,
+        }
         propped = prof.floor > 0.0
         out["min_aperture_propped_over_h"] = float(
             np.min(prof.opening[propped], initial=np.inf) / self.p.proppant_thickness
@@ -506,10 +556,14 @@ class ProppedFracture(_CrackPlate):
 
 @dataclass(frozen=True)
 class CrackSetParams(_PlateParams):
-    crack: str = param("unfitted", "unfitted (several cracks are implemented unfitted only)",
-                       choices=("unfitted",))  # fmt: skip
-    angles: str = param("30,75,-40", "the cracks' angles to the x axis, degrees, comma-"
-                        "separated: centred on y = 0, spacing apart along x")  # fmt: skip
+    crack: str = param(
+        "unfitted", "unfitted (several cracks are implemented unfitted only)", choices=("unfitted",)
+    )
+    angles: str = param(
+        "30,75,-40",
+        "the cracks' angles to the x axis, degrees, comma-"
+        "separated: centred on y = 0, spacing apart along x",
+    )
     spacing: float = param(5.0, "distance between neighbouring cracks' centres", positive=True)
     sigma_x: float = param(5e6, "remote compression along x", nonnegative=True)
     sigma_y: float = param(10e6, "remote compression along y", nonnegative=True)
@@ -527,8 +581,10 @@ class CrackSetParams(_PlateParams):
             )
         reach = 0.5 * (len(angles) - 1) * self.spacing + self.crack_half_length
         if not reach < 0.5 * self.plate_width:
-            raise ValueError(f"the cracks reach x = {reach}, beyond the plate (half-width "
-                             f"{0.5 * self.plate_width})")  # fmt: skip
+            raise ValueError(
+                f"the cracks reach x = {reach}, beyond the plate (half-width "
+                f"{0.5 * self.plate_width})"
+            )
 
     def angle_list(self) -> list[float]:
         try:
@@ -559,8 +615,9 @@ class CrackSet(SlidingCrack, _CrackPlate):
         """(centre, angle in degrees) of every crack."""
         angles = self.p.angle_list()
         shift = 0.5 * (len(angles) - 1)
-        return [(np.array([(k - shift) * self.p.spacing, 0.0]), beta)
-                for k, beta in enumerate(angles)]  # fmt: skip
+        return [
+            (np.array([(k - shift) * self.p.spacing, 0.0]), beta) for k, beta in enumerate(angles)
+        ]
 
     @staticmethod
     def _frame(beta: float) -> tuple[np.ndarray, np.ndarray]:
@@ -603,10 +660,15 @@ class CrackSet(SlidingCrack, _CrackPlate):
         p = self.p
         cracks = tuple((float(c[0]), float(c[1]), float(beta)) for c, beta in self._layout())
         return functools.partial(
-            crack_set_plate, half_width=0.5 * p.plate_width, cracks=cracks,
-            crack_half_length=p.crack_half_length, h_crack=p.h_crack, h_tip=p.h_tip,
-            h_far=p.h_far, grading=p.grading,
-        ), 2  # fmt: skip
+            crack_set_plate,
+            half_width=0.5 * p.plate_width,
+            cracks=cracks,
+            crack_half_length=p.crack_half_length,
+            h_crack=p.h_crack,
+            h_tip=p.h_tip,
+            h_far=p.h_far,
+            grading=p.grading,
+        ), 2
 
     def _boundary_stress(self, x):
         sigma = ufl.as_matrix(self.remote_stress().tolist())
@@ -619,15 +681,18 @@ class CrackSet(SlidingCrack, _CrackPlate):
             d, n = self._frame(beta)
             xl = d[0] * (x[0] - centre[0]) + d[1] * (x[1] - centre[1])
             yl = n[0] * (x[0] - centre[0]) + n[1] * (x[1] - centre[1])
-            sxx, syy, sxy = cf.crack_perturbation_stress(xl, yl, self.p.crack_half_length, 0.0,
-                                                         q, ufl_math)  # fmt: skip
+            sxx, syy, sxy = cf.crack_perturbation_stress(
+                xl, yl, self.p.crack_half_length, 0.0, q, ufl_math
+            )
             R = ufl.as_matrix([[d[0], n[0]], [d[1], n[1]]])
             sigma = sigma + R * ufl.as_matrix([[sxx, sxy], [sxy, syy]]) * R.T
         return sigma
 
     def problem_data(self, numerics):
-        raise ValueError(f"scene '{self.name}' cannot be written as a problem file: problem "
-                         "files carry fitted interfaces only")  # fmt: skip
+        raise ValueError(
+            f"scene '{self.name}' cannot be written as a problem file: problem "
+            "files carry fitted interfaces only"
+        )
 
     def interface_reference(self, prof, q, friction):
         a, out = self.p.crack_half_length, {}
@@ -639,16 +704,22 @@ class CrackSet(SlidingCrack, _CrackPlate):
             qk = self._q_of(beta)
             exact = abs(qk) * np.sqrt(np.pi * a)
             name = f"crack_{k + 1}"
-            out.update({f"{name}_sigma_n": sigma_n, f"{name}_tau": tau,
-                        f"{name}_K_II_exact": exact})  # fmt: skip
+            out.update(
+                {f"{name}_sigma_n": sigma_n, f"{name}_tau": tau, f"{name}_K_II_exact": exact}
+            )
             if exact == 0.0:
                 out[f"{name}_max_slip"] = float(np.max(slip, initial=0.0))
                 continue
             K = stress_intensity_from_jump(s, slip, a, self.p.E, self.p.nu)
             ref = np.abs(self._ellipse(s, qk))
             err = float(np.sqrt(np.mean((slip - ref) ** 2) / np.mean(ref**2)))
-            out.update({f"{name}_K_II": K, f"{name}_K_rel_error": abs(K - exact) / exact,
-                        f"{name}_slip_rms_rel": err})  # fmt: skip
+            out.update(
+                {
+                    f"{name}_K_II": K,
+                    f"{name}_K_rel_error": abs(K - exact) / exact,
+                    f"{name}_slip_rms_rel": err,
+                }
+            )
             K_errors.append(abs(K - exact) / exact)
             slip_errors.append(err)
         if K_errors:

@@ -23,8 +23,20 @@ from contactfx.numerics import Numerics
 
 __all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
 
-ORDER = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
-         "initial", "numerics", "petsc", "output")  # fmt: skip
+ORDER = (
+    "title",
+    "mesh",
+    "bodies",
+    "boundary",
+    "pins",
+    "obstacle",
+    "contact",
+    "interface",
+    "initial",
+    "numerics",
+    "petsc",
+    "output",
+)
 
 
 def numerics_table(numerics: Numerics) -> dict:
@@ -38,8 +50,9 @@ def numerics_table(numerics: Numerics) -> dict:
     return out
 
 
-def write_problem(scene, numerics: Numerics, out: Path, command: str,
-                  comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[Path, Path]:  # fmt: skip
+def write_problem(
+    scene, numerics: Numerics, out: Path, command: str, comm: MPI.Comm = MPI.COMM_WORLD
+) -> tuple[Path, Path]:
     """Write ``out/<scene>.msh`` and ``out/<scene>.toml``; returns their paths. Collective:
     rank 0 writes, an error there is raised on every rank."""
     try:
@@ -54,8 +67,12 @@ def write_problem(scene, numerics: Numerics, out: Path, command: str,
         try:
             out.mkdir(parents=True, exist_ok=True)
             write_msh(builder, gdim, msh, scene.name, binary=True)  # exact coordinates
-            doc = {"title": scene.name, "mesh": {"file": msh.name}, **tables,
-                   "numerics": numerics_table(numerics)}  # fmt: skip
+            doc = {
+                "title": scene.name,
+                "mesh": {"file": msh.name},
+                **tables,
+                "numerics": numerics_table(numerics),
+            }
             doc = {k: doc[k] for k in ORDER if k in doc}
             head = (
                 f"# {scene.summary}\n# the built-in scene '{scene.name}' as a problem file, "
@@ -177,8 +194,13 @@ def _call(name: str):
 
 
 #: the math namespace of the closed forms (:mod:`contactfx.references`) on :class:`Symbol`
-SYMBOLIC = types.SimpleNamespace(sqrt=_call("sqrt"), atan2=_call("atan2"), cos=_call("cos"),
-                                 sin=_call("sin"), maximum=_call("max"))  # fmt: skip
+SYMBOLIC = types.SimpleNamespace(
+    sqrt=_call("sqrt"),
+    atan2=_call("atan2"),
+    cos=_call("cos"),
+    sin=_call("sin"),
+    maximum=_call("max"),
+)
 _OPERATORS = ("+", "-", "*", "/", "**")
 
 

@@ -57,9 +57,15 @@ class FlatPunch2D(ObstacleScene):
         w = 1.2 * p.punch_half_width
         return functools.partial(
             rectangle,
-            x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
-            refine_x0=-w, refine_x1=w, h_contact=p.h_contact, h_far=p.h_far,
-        ), 2  # fmt: skip
+            x0=-p.half_width,
+            x1=p.half_width,
+            y0=-p.height,
+            y1=0.0,
+            refine_x0=-w,
+            refine_x1=w,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+        ), 2
 
     def obstacle(self) -> Obstacle:
         return FlatPunch(self.p.punch_half_width, self.p.edge_radius)
@@ -75,10 +81,15 @@ class FlatPunch2D(ObstacleScene):
         return {
             "bodies": [export.body("domain", self.material())],
             "boundary": [export.fixed("bottom", (0, 1))],
-            "obstacle": {"shape": "punch", "contact": "top", "radius": p.punch_half_width,
-                         "edge_radius": p.edge_radius, "h": p.h_contact,
-                         **export.motion(self.obstacle_offset, 2)},
-        }  # fmt: skip
+            "obstacle": {
+                "shape": "punch",
+                "contact": "top",
+                "radius": p.punch_half_width,
+                "edge_radius": p.edge_radius,
+                "h": p.h_contact,
+                **export.motion(self.obstacle_offset, 2),
+            },
+        }
 
     def pressure_scores(self, x: np.ndarray, p: np.ndarray, force: float) -> dict[str, float]:
         """max |pi sqrt(a^2 - x^2) p_h / P - 1| over surface nodes with |x| <= 0.8 a."""
@@ -106,8 +117,7 @@ class FlatPunch3D(QuarterBlock):
         return 1.2 * self.p.punch_radius
 
     def obstacle_data(self) -> dict:
-        return {"shape": "punch", "radius": self.p.punch_radius,
-                "edge_radius": self.p.edge_radius}  # fmt: skip
+        return {"shape": "punch", "radius": self.p.punch_radius, "edge_radius": self.p.edge_radius}
 
     def obstacle(self) -> Obstacle:
         return FlatPunch(self.p.punch_radius, self.p.edge_radius)

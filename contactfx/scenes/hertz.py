@@ -64,8 +64,13 @@ def cattaneo_mindlin(f, a: float, exponent: float, exact: bool = False) -> dict[
         return {}
     ratio = abs(f.tangential_force[0]) / f.bound
     c = a * max(0.0, 1.0 - ratio) ** exponent
-    out = {"Q_over_bound": ratio, "c": c, "c_computed": f.stick_size,
-           "c_over_a_computed": f.stick_size / a, "c_over_a": c / a}  # fmt: skip
+    out = {
+        "Q_over_bound": ratio,
+        "c": c,
+        "c_computed": f.stick_size,
+        "c_over_a_computed": f.stick_size / a,
+        "c_over_a": c / a,
+    }
     if exact and c > 0.0:
         out["c_rel_error"] = abs(f.stick_size - c) / c
     return out
@@ -85,14 +90,20 @@ class Hertz2DParams(elastic(1000.0, 0.3)):
     h_contact: float = param(3e-3, "element size in the contact zone", positive=True)
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
     refine_half_width: float = param(0.06, "half-width of the refined zone", positive=True)
-    shift: float = param(0.0, "tangential displacement of the indenter after the indentation "
-                         "(needs friction)", nonnegative=True)  # fmt: skip
-    gap0: float = param(0.0, "initial clearance of the indenter at load 0 (< 0: interference; "
-                        "the final position is still -depth)")  # fmt: skip
-    layer_thickness: float = param(0.0, "thickness of a bonded top layer -t < y < 0 (0: "
-                                   "homogeneous block)", nonnegative=True)  # fmt: skip
-    layer_E: float = param(0.0, "Young's modulus of the top layer (0: same as E)",
-                           nonnegative=True)  # fmt: skip
+    shift: float = param(
+        0.0,
+        "tangential displacement of the indenter after the indentation (needs friction)",
+        nonnegative=True,
+    )
+    gap0: float = param(
+        0.0,
+        "initial clearance of the indenter at load 0 (< 0: interference; "
+        "the final position is still -depth)",
+    )
+    layer_thickness: float = param(
+        0.0, "thickness of a bonded top layer -t < y < 0 (0: homogeneous block)", nonnegative=True
+    )
+    layer_E: float = param(0.0, "Young's modulus of the top layer (0: same as E)", nonnegative=True)
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -125,11 +136,16 @@ class Hertz2D(ObstacleScene):
         p = self.p
         return functools.partial(
             rectangle,
-            x0=-p.half_width, x1=p.half_width, y0=-p.height, y1=0.0,
-            refine_x0=-p.refine_half_width, refine_x1=p.refine_half_width,
-            h_contact=p.h_contact, h_far=p.h_far,
+            x0=-p.half_width,
+            x1=p.half_width,
+            y0=-p.height,
+            y1=0.0,
+            refine_x0=-p.refine_half_width,
+            refine_x1=p.refine_half_width,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
             interfaces=(-p.layer_thickness,) if self.layered else (),
-        ), 2  # fmt: skip
+        ), 2
 
     def modulus(self, mesh):
         """Piecewise constant (DG0) modulus: layer_E in the layer, E below. The interface is a
@@ -165,9 +181,14 @@ class Hertz2D(ObstacleScene):
         return {
             "bodies": bodies,
             "boundary": [export.fixed("bottom", (0, 1))],
-            "obstacle": {"shape": shape, "contact": "top", "radius": p.radius,
-                         "h": p.h_contact, **export.motion(self.obstacle_offset, 2, kinks)},
-        }  # fmt: skip
+            "obstacle": {
+                "shape": shape,
+                "contact": "top",
+                "radius": p.radius,
+                "h": p.h_contact,
+                **export.motion(self.obstacle_offset, 2, kinks),
+            },
+        }
 
     def _hertz(self, force: float) -> dict[str, float]:
         """The half-space closed form, or {} for a layer of another modulus (none applies)."""
@@ -198,8 +219,12 @@ class Hertz3DParams(elastic(1000.0, 0.3)):
     h_contact: float = param(0.02, "element size in the contact zone", positive=True)
     h_far: float = param(0.3, "element size far from the contact zone", positive=True)
     refine_radius: float = param(0.15, "radius of the refined zone", positive=True)
-    shift: float = param(0.0, "tangential displacement (x) of the indenter after the "
-                         "indentation (needs friction; half model)", nonnegative=True)  # fmt: skip
+    shift: float = param(
+        0.0,
+        "tangential displacement (x) of the indenter after the "
+        "indentation (needs friction; half model)",
+        nonnegative=True,
+    )
 
 
 class QuarterBlock(ObstacleScene):
@@ -225,11 +250,17 @@ class QuarterBlock(ObstacleScene):
         p = self.p
         return functools.partial(
             box,
-            x0=-p.size if self.half else 0.0, x1=p.size, y0=0.0, y1=p.size,
-            z0=-p.height, z1=0.0,
-            refine_center=(0.0, 0.0), refine_radius=self.refine_radius(),
-            h_contact=p.h_contact, h_far=p.h_far,
-        ), 3  # fmt: skip
+            x0=-p.size if self.half else 0.0,
+            x1=p.size,
+            y0=0.0,
+            y1=p.size,
+            z0=-p.height,
+            z1=0.0,
+            refine_center=(0.0, 0.0),
+            refine_radius=self.refine_radius(),
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+        ), 3
 
     def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
         return _indent_then_shift(t, self.p.depth, self.shift, gdim)
@@ -246,11 +277,17 @@ class QuarterBlock(ObstacleScene):
         return {
             "bodies": [export.body("domain", self.material())],
             "boundary": boundary,
-            "obstacle": {**self.obstacle_data(), "contact": "zmax", "h": self.p.h_contact,
-                         **export.motion(self.obstacle_offset, 3, kinks)},
-            "output": {"symmetry": self.symmetry,
-                       "tangential_symmetry": list(self.tangential_symmetry)},
-        }  # fmt: skip
+            "obstacle": {
+                **self.obstacle_data(),
+                "contact": "zmax",
+                "h": self.p.h_contact,
+                **export.motion(self.obstacle_offset, 3, kinks),
+            },
+            "output": {
+                "symmetry": self.symmetry,
+                "tangential_symmetry": list(self.tangential_symmetry),
+            },
+        }
 
     def dirichlet(self, V, facet_tags):
         bcs = [*fix(V, facet_tags, BoxFacets.ZMIN), fix_component(V, facet_tags, BoxFacets.YMIN, 1)]

@@ -41,30 +41,39 @@ class JointColumnParams(elastic(10e9, 0.25)):
     closure_stress: float = param(30e6, "compression s_c on the top", nonnegative=True)
     fluid_pressure: float = param(10e6, "fluid pressure p in the joint", nonnegative=True)
     aperture: float = param(1e-3, "initial joint aperture w0", positive=True)
-    Kni: float = param(50e9, "initial normal stiffness K_ni of the joint (stress / length)",
-                       positive=True)  # fmt: skip
+    Kni: float = param(
+        50e9, "initial normal stiffness K_ni of the joint (stress / length)", positive=True
+    )
     Vm: float = param(3e-4, "maximal closure V_m", positive=True)
     h: float = param(0.25, "element size", positive=True)
-    crack: str = param("fitted", "the joint: fitted (a chain of mesh edges) or unfitted (a level "
-                       "set on a mesh of the column that ignores it)",
-                       choices=("fitted", "unfitted"))  # fmt: skip
-    joint_offset: float = param(0.0, "the unfitted joint's height above H (its position "
-                                "against the mesh's nodes)")  # fmt: skip
+    crack: str = param(
+        "fitted",
+        "the joint: fitted (a chain of mesh edges) or unfitted (a level "
+        "set on a mesh of the column that ignores it)",
+        choices=("fitted", "unfitted"),
+    )
+    joint_offset: float = param(
+        0.0, "the unfitted joint's height above H (its position against the mesh's nodes)"
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
         if self.crack == "fitted" and self.joint_offset != 0.0:
             raise ValueError("--joint-offset needs --crack unfitted")
         if not abs(self.joint_offset) < self.block_height - self.h:
-            raise ValueError(f"--joint-offset ({self.joint_offset:g}) must leave a cell between "
-                             f"the joint and the column's ends (|offset| < block-height - h = "
-                             f"{self.block_height - self.h:g})")  # fmt: skip
+            raise ValueError(
+                f"--joint-offset ({self.joint_offset:g}) must leave a cell between "
+                f"the joint and the column's ends (|offset| < block-height - h = "
+                f"{self.block_height - self.h:g})"
+            )
         if self.Vm > self.aperture:
             raise ValueError(f"--Vm ({self.Vm}) must be <= --aperture ({self.aperture})")
         if self.fluid_pressure > self.closure_stress:
-            raise ValueError(f"--fluid-pressure ({self.fluid_pressure:g}) exceeds --closure-stress "
-                             f"({self.closure_stress:g}): the joint would open and the upper "
-                             "block has no equilibrium")  # fmt: skip
+            raise ValueError(
+                f"--fluid-pressure ({self.fluid_pressure:g}) exceeds --closure-stress "
+                f"({self.closure_stress:g}): the joint would open and the upper "
+                "block has no equilibrium"
+            )
 
 
 class JointColumn(InterfaceScene):
@@ -75,8 +84,13 @@ class JointColumn(InterfaceScene):
 
     def mesh_builder(self):
         p = self.p
-        return functools.partial(joint_column, width=p.width, block_height=p.block_height,
-                                 h=p.h, fitted=p.crack == "fitted"), 2  # fmt: skip
+        return functools.partial(
+            joint_column,
+            width=p.width,
+            block_height=p.block_height,
+            h=p.h,
+            fitted=p.crack == "fitted",
+        ), 2
 
     def crack_segments(self) -> list[CrackSegment]:
         """The unfitted joint: the line y = H + offset, its ends a width beyond the column's
@@ -94,15 +108,20 @@ class JointColumn(InterfaceScene):
         F = JointColumnFacets
         return {
             "bodies": [export.body("domain", self.material())],
-            "boundary": [*(export.fixed(tag.name.lower(), (c,)) for tag, c in self.supports()),
-                         {"group": "top", "traction": [0.0, -p.closure_stress]}],
-            "interface": {"group": F.JOINT.name.lower(), "h": p.h,
-                          "origin": [float(v) for v in origin],
-                          "direction": [float(v) for v in direction],
-                          "fluid_pressure": p.fluid_pressure,
-                          "joint": {"Kni": p.Kni, "Vm": p.Vm, "w0": p.aperture}},
+            "boundary": [
+                *(export.fixed(tag.name.lower(), (c,)) for tag, c in self.supports()),
+                {"group": "top", "traction": [0.0, -p.closure_stress]},
+            ],
+            "interface": {
+                "group": F.JOINT.name.lower(),
+                "h": p.h,
+                "origin": [float(v) for v in origin],
+                "direction": [float(v) for v in direction],
+                "fluid_pressure": p.fluid_pressure,
+                "joint": {"Kni": p.Kni, "Vm": p.Vm, "w0": p.aperture},
+            },
             "output": {"mean_displacement": {"top_displacement": ["top", "y"]}},
-        }  # fmt: skip
+        }
 
     def length_scale(self) -> float:
         return self.p.block_height
@@ -134,8 +153,9 @@ class JointColumn(InterfaceScene):
 
     def exact(self) -> dict:
         p = self.p
-        return cf.joint_column(p.closure_stress, p.fluid_pressure, p.E, p.nu, p.block_height,
-                               p.aperture, p.Kni, p.Vm)  # fmt: skip
+        return cf.joint_column(
+            p.closure_stress, p.fluid_pressure, p.E, p.nu, p.block_height, p.aperture, p.Kni, p.Vm
+        )
 
     def interface_reference(self, prof, q, friction):
         ref = self.exact()
@@ -143,8 +163,11 @@ class JointColumn(InterfaceScene):
         aperture = self.p.aperture + float(np.mean(prof.opening))
         settlement = -q.interface.extra["top_displacement"]
         out = {}
-        for key, value in (("closure", closure), ("aperture", aperture),
-                           ("settlement", settlement)):  # fmt: skip
+        for key, value in (
+            ("closure", closure),
+            ("aperture", aperture),
+            ("settlement", settlement),
+        ):
             out[f"{key}_exact"] = float(ref[key])
             out[key] = value
             out[f"{key}_rel_error"] = abs(value - ref[key]) / abs(ref[key])

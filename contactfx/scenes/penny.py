@@ -95,10 +95,15 @@ class _PennyBlock(InterfaceScene):
     def mesh_builder(self):
         p = self.p
         return functools.partial(
-            penny_block, half_width=0.5 * p.block_width, crack_radius=p.crack_radius,
-            h_front=p.h_front, h_crack=p.h_crack, h_far=p.h_far, grading=p.grading,
+            penny_block,
+            half_width=0.5 * p.block_width,
+            crack_radius=p.crack_radius,
+            h_front=p.h_front,
+            h_crack=p.h_crack,
+            h_far=p.h_far,
+            grading=p.grading,
             half=self.half,
-        ), 3  # fmt: skip
+        ), 3
 
     def dimension(self) -> int:
         return 3
@@ -142,10 +147,12 @@ class _PennyBlock(InterfaceScene):
         x, y = prof.x[:, 0], np.abs(prof.x[:, 1])
         phi = np.degrees(np.arctan2(y, x if self.half else np.abs(x)))
         edges = np.linspace(0.0, 180.0 if self.half else 90.0, n + 1)
-        K = np.array([
-            extrapolated_K(a - prof.s, jump, E, nu, a, near=(phi >= lo) & (phi <= hi))
-            for lo, hi in zip(edges[:-1], edges[1:], strict=True)
-        ])  # fmt: skip
+        K = np.array(
+            [
+                extrapolated_K(a - prof.s, jump, E, nu, a, near=(phi >= lo) & (phi <= hi))
+                for lo, hi in zip(edges[:-1], edges[1:], strict=True)
+            ]
+        )
         return 0.5 * (edges[:-1] + edges[1:]), K
 
 
@@ -222,8 +229,7 @@ class PennyShear(SlidingCrack, _PennyBlock):
     name = "penny-shear"
     summary = "closed penny-shaped crack sliding under inclined compression, Coulomb (3D)"
     Params = PennyShearParams
-    numerics_defaults: ClassVar[dict] = {"steps": 1, "degree": 2, "friction": "coulomb",
-                                         "mu": 0.3}  # fmt: skip
+    numerics_defaults: ClassVar[dict] = {"steps": 1, "degree": 2, "friction": "coulomb", "mu": 0.3}
     half = True
 
     def supports(self):
@@ -231,8 +237,11 @@ class PennyShear(SlidingCrack, _PennyBlock):
 
     def pinned(self):
         w = 0.5 * self.p.block_width
-        return [(np.array([-w, 0.0, -w]), 0), (np.array([-w, 0.0, -w]), 2),
-                (np.array([w, 0.0, -w]), 2)]  # fmt: skip
+        return [
+            (np.array([-w, 0.0, -w]), 0),
+            (np.array([-w, 0.0, -w]), 2),
+            (np.array([w, 0.0, -w]), 2),
+        ]
 
     def remote_stress(self) -> np.ndarray:
         b = np.radians(self.p.beta)
@@ -242,8 +251,13 @@ class PennyShear(SlidingCrack, _PennyBlock):
     def load(self, v, ds, t):
         n = ufl.FacetNormal(ds.ufl_domain())
         sigma = ufl.as_matrix(self.remote_stress().tolist())
-        outer = (PennyBlockFacets.XMIN, PennyBlockFacets.XMAX, PennyBlockFacets.YMAX,
-                 PennyBlockFacets.BOTTOM, PennyBlockFacets.TOP)  # fmt: skip
+        outer = (
+            PennyBlockFacets.XMIN,
+            PennyBlockFacets.XMAX,
+            PennyBlockFacets.YMAX,
+            PennyBlockFacets.BOTTOM,
+            PennyBlockFacets.TOP,
+        )
         return t * ufl.dot(ufl.dot(sigma, n), v) * ds(outer)
 
     # -- closed forms -----------------------------------------------------------------------
@@ -304,11 +318,15 @@ class PennyShear(SlidingCrack, _PennyBlock):
 @dataclass(frozen=True)
 class FaultBlockParams(_PennyParams):
     sigma_v: float = param(20e6, "vertical remote compression sigma_v", positive=True)
-    sigma_h: float = param(8e6, "horizontal remote compression sigma_h (in the dip plane)",
-                           nonnegative=True)  # fmt: skip
+    sigma_h: float = param(
+        8e6, "horizontal remote compression sigma_h (in the dip plane)", nonnegative=True
+    )
     dip: float = param(60.0, "the fault's dip: its normal's angle to the vertical, degrees")
-    overpressure: float = param(0.0, "fluid overpressure p on the fault's faces (it lowers "
-                                "the effective normal stress)", nonnegative=True)  # fmt: skip
+    overpressure: float = param(
+        0.0,
+        "fluid overpressure p on the fault's faces (it lowers the effective normal stress)",
+        nonnegative=True,
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()

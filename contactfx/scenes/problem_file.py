@@ -100,8 +100,20 @@ from contactfx.scenes.two_body_base import CONTACT_EDGES, TwoBodyScene, contact_
 __all__ = ["load_problem", "ProblemFile", "FileParams", "apply_sets"]
 
 AXES = ("x", "y", "z")
-SECTIONS = ("title", "mesh", "bodies", "boundary", "pins", "obstacle", "contact", "interface",
-            "initial", "numerics", "petsc", "output")  # fmt: skip
+SECTIONS = (
+    "title",
+    "mesh",
+    "bodies",
+    "boundary",
+    "pins",
+    "obstacle",
+    "contact",
+    "interface",
+    "initial",
+    "numerics",
+    "petsc",
+    "output",
+)
 KEYS = {
     "mesh": ("file", "size", "builder", "parameters"),
     "bodies": ("group", "E", "nu", "body_force", "amplitude"),
@@ -151,8 +163,17 @@ KEYS = {
         "mean_displacement",
     ),
 }
-SHAPES = ("plane", "circle", "cylinder", "sphere", "parabola", "paraboloid", "sinusoid",
-          "punch", "distance")  # fmt: skip
+SHAPES = (
+    "plane",
+    "circle",
+    "cylinder",
+    "sphere",
+    "parabola",
+    "paraboloid",
+    "sinusoid",
+    "punch",
+    "distance",
+)
 #: the contact size reported from the measure m of the contact set (times the symmetry)
 CONTACT_SIZES = ("half-measure", "measure", "disc-radius")
 
@@ -194,8 +215,9 @@ def apply_sets(data: dict, sets: list[str], where: str) -> dict:
         for i, part in enumerate(parts[:-1]):
             if isinstance(node, list):
                 if not part.isdigit() or int(part) >= len(node):
-                    raise ProblemError(f"{where}: --set {key}: no entry {part} in "
-                                       f"'{'.'.join(parts[:i])}'")  # fmt: skip
+                    raise ProblemError(
+                        f"{where}: --set {key}: no entry {part} in '{'.'.join(parts[:i])}'"
+                    )
                 node = node[int(part)]
             else:
                 node = node.setdefault(part, {})
@@ -239,29 +261,42 @@ class _Reader:
     def string(self, data: dict, key: str, name: str, choices=None, default=None) -> str:
         value = data.get(name, default)
         if not isinstance(value, str):
-            self.fail(f"{key}.{name}", f"expected a string, got {value!r}" if value is not None
-                      else "missing (a string)")  # fmt: skip
+            self.fail(
+                f"{key}.{name}",
+                f"expected a string, got {value!r}" if value is not None else "missing (a string)",
+            )
         if choices is not None and value not in choices:
             self.fail(f"{key}.{name}", f"must be one of {', '.join(choices)}, got '{value}'")
         return value
 
     def vector(self, data: dict, key: str, name: str, gdim: int, default=None) -> np.ndarray:
         value = data.get(name, default)
-        ok = isinstance(value, list) and len(value) == gdim and all(
-            isinstance(v, int | float) and not isinstance(v, bool) for v in value)  # fmt: skip
+        ok = (
+            isinstance(value, list)
+            and len(value) == gdim
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+        )
         if not ok:
             self.fail(f"{key}.{name}", f"expected {gdim} numbers, got {value!r}")
         return np.asarray(value, dtype=np.float64)
 
     def amplitude(self, data: dict, key: str) -> list[tuple[float, float]]:
         value = data.get("amplitude", [[0.0, 0.0], [1.0, 1.0]])
-        ok = isinstance(value, list) and len(value) >= 1 and all(
-            isinstance(r, list) and len(r) == 2
-            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
-            for r in value)  # fmt: skip
+        ok = (
+            isinstance(value, list)
+            and len(value) >= 1
+            and all(
+                isinstance(r, list)
+                and len(r) == 2
+                and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
+                for r in value
+            )
+        )
         if not ok:
-            self.fail(f"{key}.amplitude", "expected a table of [load factor, multiplier] pairs, "
-                      f"got {value!r}")  # fmt: skip
+            self.fail(
+                f"{key}.amplitude",
+                f"expected a table of [load factor, multiplier] pairs, got {value!r}",
+            )
         ts = [r[0] for r in value]
         if any(b <= a for a, b in zip(ts, ts[1:], strict=False)):
             self.fail(f"{key}.amplitude", f"load factors must increase, got {ts}")
@@ -269,13 +304,21 @@ class _Reader:
 
     def offsets(self, data: dict, key: str) -> list[list[float]]:
         value = data["path"]
-        ok = isinstance(value, list) and len(value) >= 1 and all(
-            isinstance(r, list) and len(r) >= 2
-            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
-            for r in value)  # fmt: skip
+        ok = (
+            isinstance(value, list)
+            and len(value) >= 1
+            and all(
+                isinstance(r, list)
+                and len(r) >= 2
+                and all(isinstance(v, int | float) and not isinstance(v, bool) for v in r)
+                for r in value
+            )
+        )
         if not ok or len({len(r) for r in value}) != 1:
-            self.fail(f"{key}.path", "expected a table of [load factor, offset components] "
-                      f"rows, got {value!r}")  # fmt: skip
+            self.fail(
+                f"{key}.path",
+                f"expected a table of [load factor, offset components] rows, got {value!r}",
+            )
         ts = [r[0] for r in value]
         if any(b <= a for a, b in zip(ts, ts[1:], strict=False)):
             self.fail(f"{key}.path", f"load factors must increase, got {ts}")
@@ -290,13 +333,22 @@ def _amplitude(table: list[tuple[float, float]], t: float) -> float:
 def _stress(r: _Reader, value, key: str) -> list[list]:
     """A boundary's stress tensor: d rows of d entries, each a number or an expression in x,
     y, z (:func:`parse_expression`; e.g. a closed-form field around a crack)."""
-    ok = isinstance(value, list) and len(value) in (1, 2, 3) and all(
-        isinstance(row, list) and len(row) == len(value)
-        and all(isinstance(v, int | float | str) and not isinstance(v, bool) for v in row)
-        for row in value)  # fmt: skip
+    ok = (
+        isinstance(value, list)
+        and len(value) in (1, 2, 3)
+        and all(
+            isinstance(row, list)
+            and len(row) == len(value)
+            and all(isinstance(v, int | float | str) and not isinstance(v, bool) for v in row)
+            for row in value
+        )
+    )
     if not ok:
-        r.fail(key, "expected a square table of numbers or expressions in x, y, z (the stress "
-               f"tensor's rows), got {value!r}")  # fmt: skip
+        r.fail(
+            key,
+            "expected a square table of numbers or expressions in x, y, z (the stress "
+            f"tensor's rows), got {value!r}",
+        )
     out = []
     for row in value:
         entries = []
@@ -384,8 +436,9 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         name = r.string(mesh, "mesh", "builder", tuple(BUILDERS))
         params = mesh.get("parameters", {})
         if not isinstance(params, dict):
-            r.fail("mesh.parameters", f"expected a table of the builder's parameters, got "
-                   f"{params!r}")  # fmt: skip
+            r.fail(
+                "mesh.parameters", f"expected a table of the builder's parameters, got {params!r}"
+            )
         params = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
         builder = (name, params)
         mesh_file, size = None, 1.0
@@ -411,8 +464,11 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         bodies.append((group, Elastic(E, nu)))
         if "body_force" in b:
             f = b["body_force"]
-            if not isinstance(f, list) or not f or not all(
-                    isinstance(v, int | float) and not isinstance(v, bool) for v in f):  # fmt: skip
+            if (
+                not isinstance(f, list)
+                or not f
+                or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in f)
+            ):
                 r.fail(f"{key}.body_force", f"expected a list of numbers, got {f!r}")
             body_forces.append((group, np.asarray(f, dtype=np.float64), r.amplitude(b, key)))
         elif "amplitude" in b:
@@ -434,10 +490,13 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         if "displacement" in b:
             disp = b["displacement"]
             if not isinstance(disp, dict) or not disp or any(c not in AXES for c in disp):
-                r.fail(f"{key}.displacement", "expected a table of components, e.g. "
-                       f"{{ y = -0.01 }}, got {disp!r}")  # fmt: skip
-            entry.displacement = {AXES.index(c): r.number(disp, f"{key}.displacement", c)
-                                   for c in disp}  # fmt: skip
+                r.fail(
+                    f"{key}.displacement",
+                    f"expected a table of components, e.g. {{ y = -0.01 }}, got {disp!r}",
+                )
+            entry.displacement = {
+                AXES.index(c): r.number(disp, f"{key}.displacement", c) for c in disp
+            }
             both = set(entry.fix) & set(entry.displacement)
             if both:
                 r.fail(key, f"component {AXES[min(both)]} is both fixed and prescribed")
@@ -465,8 +524,11 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         key = f"pins.{i}"
         q = r.table(q, key, KEYS["pins"])
         point = q.get("point")
-        if not isinstance(point, list) or len(point) not in (1, 2, 3) or not all(
-                isinstance(v, int | float) and not isinstance(v, bool) for v in point):  # fmt: skip
+        if (
+            not isinstance(point, list)
+            or len(point) not in (1, 2, 3)
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in point)
+        ):
             r.fail(f"{key}.point", f"expected the coordinates of a mesh vertex, got {point!r}")
         fixv = q.get("fix")
         if not isinstance(fixv, list) or not fixv or any(c not in AXES for c in fixv):
@@ -480,8 +542,11 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     if not given:
         r.fail("obstacle", "a problem needs an [obstacle], a [[contact]] pair or an [interface]")
     if len(given) > 1:
-        r.fail(given[1], "give one of [obstacle], [[contact]], [interface], not "
-               f"{' and '.join(given)} (one contact kind per problem)")  # fmt: skip
+        r.fail(
+            given[1],
+            "give one of [obstacle], [[contact]], [interface], not "
+            f"{' and '.join(given)} (one contact kind per problem)",
+        )
     if interface is not None:
         interface = dict(r.table(interface, "interface", KEYS["interface"]))
         interface["group"] = r.string(interface, "interface", "group")
@@ -494,13 +559,22 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         if "proppant_zone" in interface:
             zone = interface["proppant_zone"]
             if "proppant_thickness" not in interface:
-                r.fail("interface.proppant_zone", "a zone of the proppant layer: give its "
-                       "proppant_thickness")  # fmt: skip
-            if not (isinstance(zone, list) and len(zone) == 2 and all(
-                    isinstance(v, int | float) and not isinstance(v, bool) for v in zone)
-                    and np.all(np.isfinite(zone)) and zone[0] < zone[1]):  # fmt: skip
-                r.fail("interface.proppant_zone", "expected [s0, s1] with s0 < s1 (the layer's "
-                       f"ends along the interface coordinate s), got {zone!r}")  # fmt: skip
+                r.fail(
+                    "interface.proppant_zone",
+                    "a zone of the proppant layer: give its proppant_thickness",
+                )
+            if not (
+                isinstance(zone, list)
+                and len(zone) == 2
+                and all(isinstance(v, int | float) and not isinstance(v, bool) for v in zone)
+                and np.all(np.isfinite(zone))
+                and zone[0] < zone[1]
+            ):
+                r.fail(
+                    "interface.proppant_zone",
+                    "expected [s0, s1] with s0 < s1 (the layer's "
+                    f"ends along the interface coordinate s), got {zone!r}",
+                )
             interface["proppant_zone"] = (float(zone[0]), float(zone[1]))
         if "h" in interface:
             interface["h"] = r.number(interface, "interface", "h", positive=True)
@@ -514,8 +588,9 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             interface["direction"] = interface["direction"] / norm
         if "joint" in interface:
             j = r.table(interface["joint"], "interface.joint", ("Kni", "Vm", "w0"))
-            values = {k: r.number(j, "interface.joint", k, positive=True)
-                      for k in ("Kni", "Vm", "w0")}  # fmt: skip
+            values = {
+                k: r.number(j, "interface.joint", k, positive=True) for k in ("Kni", "Vm", "w0")
+            }
             try:
                 interface["joint"] = BartonBandis(**values)
             except ValueError as err:
@@ -524,21 +599,23 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
             r.fail("bodies", f"an interface lies inside one body, got {len(bodies)} bodies")
         for i, b in enumerate(boundary):
             if b.displacement:
-                r.fail(f"boundary.{i}.displacement", "prescribed displacements are not offered "
-                       "with an [interface] yet (fix, traction, pressure are)")  # fmt: skip
+                r.fail(
+                    f"boundary.{i}.displacement",
+                    "prescribed displacements are not offered "
+                    "with an [interface] yet (fix, traction, pressure are)",
+                )
     if pins and interface is None:
-        r.fail("pins", "pinned points are offered with an [interface] (use fix on a group "
-               "otherwise)")  # fmt: skip
+        r.fail(
+            "pins", "pinned points are offered with an [interface] (use fix on a group otherwise)"
+        )
     if obstacle is not None:
         obstacle = dict(r.table(obstacle, "obstacle", KEYS["obstacle"]))
         obstacle["shape"] = r.string(obstacle, "obstacle", "shape", SHAPES)
         obstacle["contact"] = r.string(obstacle, "obstacle", "contact")
-        if obstacle["shape"] in ("circle", "cylinder", "sphere", "parabola", "paraboloid",
-                                 "punch"):  # fmt: skip
+        if obstacle["shape"] in ("circle", "cylinder", "sphere", "parabola", "paraboloid", "punch"):
             obstacle["radius"] = r.number(obstacle, "obstacle", "radius", positive=True)
         if obstacle["shape"] == "punch":
-            obstacle["edge_radius"] = r.number(obstacle, "obstacle", "edge_radius",
-                                               positive=True)  # fmt: skip
+            obstacle["edge_radius"] = r.number(obstacle, "obstacle", "edge_radius", positive=True)
         if obstacle["shape"] == "sinusoid":
             for k in ("height", "wavelength"):
                 obstacle[k] = r.number(obstacle, "obstacle", k, positive=True)
@@ -578,8 +655,10 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
                 r.fail("contact.0.edge_ring", "the ring width of edge = 'radial' only")
             pair["edge_ring"] = r.number(c, "contact.0", "edge_ring", positive=True)
         elif pair.get("edge") == "radial":
-            r.fail("contact.0.edge_ring", "missing (the ring width of edge = 'radial', "
-                   "about the slave element size)")  # fmt: skip
+            r.fail(
+                "contact.0.edge_ring",
+                "missing (the ring width of edge = 'radial', about the slave element size)",
+            )
     output = r.table(data.get("output", {}), "output", KEYS["output"])
     reactions = output.get("reactions", [])
     if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
@@ -596,24 +675,34 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     displacement = initial.get("displacement")
     if displacement is not None:
         if not isinstance(displacement, list) or not all(
-                isinstance(e, str | int | float) for e in displacement):  # fmt: skip
-            r.fail("initial.displacement", "expected a list of expressions in x, y, z (one per "
-                   f"component), got {displacement!r}")  # fmt: skip
+            isinstance(e, str | int | float) for e in displacement
+        ):
+            r.fail(
+                "initial.displacement",
+                "expected a list of expressions in x, y, z (one per "
+                f"component), got {displacement!r}",
+            )
         try:
             displacement = [parse_expression(str(e)) for e in displacement]
         except ValueError as err:
             r.fail("initial.displacement", str(err))
     symmetry = r.number(output, "output", "symmetry", 1.0, positive=True)
     tsym = output.get("tangential_symmetry")
-    if tsym is not None and (not isinstance(tsym, list) or not all(
-            isinstance(v, int | float) and not isinstance(v, bool) for v in tsym)):  # fmt: skip
+    if tsym is not None and (
+        not isinstance(tsym, list)
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in tsym)
+    ):
         r.fail("output.tangential_symmetry", f"expected a list of numbers, got {tsym!r}")
     mean_displacement = output.get("mean_displacement", {})
     if not isinstance(mean_displacement, dict) or not all(
-            isinstance(v, list) and len(v) == 2 and isinstance(v[0], str) and v[1] in AXES
-            for v in mean_displacement.values()):  # fmt: skip
-        r.fail("output.mean_displacement", "expected a table name = [group, component], e.g. "
-               f"{{ top_displacement = [\"top\", \"y\"] }}, got {mean_displacement!r}")  # fmt: skip
+        isinstance(v, list) and len(v) == 2 and isinstance(v[0], str) and v[1] in AXES
+        for v in mean_displacement.values()
+    ):
+        r.fail(
+            "output.mean_displacement",
+            "expected a table name = [group, component], e.g. "
+            f'{{ top_displacement = ["top", "y"] }}, got {mean_displacement!r}',
+        )
     if mean_displacement and interface is None:
         r.fail("output.mean_displacement", "reported with an [interface] only")
     contact_size = None
@@ -623,18 +712,38 @@ def _read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     if not isinstance(title, str):
         r.fail("title", f"expected a string, got {title!r}")
 
-    numerics = r.table(data.get("numerics", {}), "numerics",
-                       tuple(f.name for f in dataclasses.fields(Numerics)))  # fmt: skip
+    numerics = r.table(
+        data.get("numerics", {}), "numerics", tuple(f.name for f in dataclasses.fields(Numerics))
+    )
     petsc = data.get("petsc", {})
     if not isinstance(petsc, dict):
         r.fail("petsc", f"expected a table of PETSc options, got {petsc!r}")
-    petsc = {k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
-             for k, v in petsc.items()}  # fmt: skip
-    problem = ProblemFile(path, mesh_file, size, bodies, boundary, obstacle, contact, interface,
-                          list(reactions), probes, title, body_forces, displacement, symmetry,
-                          None if tsym is None else [float(v) for v in tsym],
-                          contact_size, pair if contact is not None else {}, pins,
-                          dict(mean_displacement), builder)  # fmt: skip
+    petsc = {
+        k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
+        for k, v in petsc.items()
+    }
+    problem = ProblemFile(
+        path,
+        mesh_file,
+        size,
+        bodies,
+        boundary,
+        obstacle,
+        contact,
+        interface,
+        list(reactions),
+        probes,
+        title,
+        body_forces,
+        displacement,
+        symmetry,
+        None if tsym is None else [float(v) for v in tsym],
+        contact_size,
+        pair if contact is not None else {},
+        pins,
+        dict(mean_displacement),
+        builder,
+    )
     return problem, numerics, petsc
 
 
@@ -660,12 +769,25 @@ def load_problem(path, sets: list[str] = ()):
 
 # -- signed distance expressions -------------------------------------------------------------
 
-_FUNCTIONS = {"sqrt": ufl.sqrt, "sin": ufl.sin, "cos": ufl.cos, "tan": ufl.tan,
-              "exp": ufl.exp, "ln": ufl.ln, "abs": abs, "atan2": _compat.ufl_math.atan2,
-              "min": ufl.min_value, "max": ufl.max_value}  # fmt: skip
-_BINARY = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
-           ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b,
-           ast.Pow: lambda a, b: a**b}  # fmt: skip
+_FUNCTIONS = {
+    "sqrt": ufl.sqrt,
+    "sin": ufl.sin,
+    "cos": ufl.cos,
+    "tan": ufl.tan,
+    "exp": ufl.exp,
+    "ln": ufl.ln,
+    "abs": abs,
+    "atan2": _compat.ufl_math.atan2,
+    "min": ufl.min_value,
+    "max": ufl.max_value,
+}
+_BINARY = {
+    ast.Add: lambda a, b: a + b,
+    ast.Sub: lambda a, b: a - b,
+    ast.Mult: lambda a, b: a * b,
+    ast.Div: lambda a, b: a / b,
+    ast.Pow: lambda a, b: a**b,
+}
 
 
 def parse_expression(text: str):
@@ -683,10 +805,12 @@ def parse_expression(text: str):
         raise ValueError(f"not an expression: '{shown}'") from None
     *defs, last = module.body or [None]
     if not isinstance(last, ast.Expr) or not all(
-            isinstance(d, ast.Assign) and len(d.targets) == 1
-            and isinstance(d.targets[0], ast.Name) for d in defs):  # fmt: skip
-        raise ValueError(f"not an expression: '{shown}' (definitions name = expression, then "
-                         "the value)")  # fmt: skip
+        isinstance(d, ast.Assign) and len(d.targets) == 1 and isinstance(d.targets[0], ast.Name)
+        for d in defs
+    ):
+        raise ValueError(
+            f"not an expression: '{shown}' (definitions name = expression, then the value)"
+        )
     for d in defs:
         if d.targets[0].id in ("x", "y", "z", "pi", *_FUNCTIONS):
             raise ValueError(f"'{d.targets[0].id}' cannot be redefined in '{shown}'")
@@ -708,11 +832,17 @@ def parse_expression(text: str):
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
             v = build(node.operand, y, env)
             return -v if isinstance(node.op, ast.USub) else v
-        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
-                and node.func.id in _FUNCTIONS and not node.keywords):  # fmt: skip
+        if (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id in _FUNCTIONS
+            and not node.keywords
+        ):
             return _FUNCTIONS[node.func.id](*(build(a, y, env) for a in node.args))
-        raise ValueError(f"'{ast.unparse(node)}' is not allowed in '{shown}' (numbers, x, y, "
-                         "z, pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")")  # fmt: skip
+        raise ValueError(
+            f"'{ast.unparse(node)}' is not allowed in '{shown}' (numbers, x, y, "
+            "z, pi, + - * / **, " + ", ".join(_FUNCTIONS) + ")"
+        )
 
     def evaluate(y):
         env = {}
@@ -736,8 +866,10 @@ class DistanceObstacle(Obstacle):
         return self._phi(y)
 
     def height(self, t: np.ndarray) -> np.ndarray:
-        raise ValueError("the vi method needs an obstacle with a height function (plane, "
-                         "circle, cylinder, sphere), not a distance expression")  # fmt: skip
+        raise ValueError(
+            "the vi method needs an obstacle with a height function (plane, "
+            "circle, cylinder, sphere), not a distance expression"
+        )
 
 
 # -- the scenes -------------------------------------------------------------------------------
@@ -794,8 +926,11 @@ class _FileMesh:
     def tag(self, key: str, name: str, dim: int) -> int:
         g = self.groups.get(name)
         if g is None:
-            self._fail(key, f"no physical group '{name}' in {self.spec.mesh_label} (it "
-                       f"has: {self.group_list()})")  # fmt: skip
+            self._fail(
+                key,
+                f"no physical group '{name}' in {self.spec.mesh_label} (it "
+                f"has: {self.group_list()})",
+            )
         if g.dim != dim:
             what = "cells (a body)" if dim == self.gdim else "facets (a boundary)"
             self._fail(key, f"group '{name}' has dimension {g.dim}, expected {dim}: {what}")
@@ -805,8 +940,9 @@ class _FileMesh:
 
     def _check_groups(self) -> None:
         pb, fdim = self.spec, self.gdim - 1
-        self.body_tags = [self.tag(f"bodies.{i}.group", g, self.gdim)
-                          for i, (g, _) in enumerate(pb.bodies)]  # fmt: skip
+        self.body_tags = [
+            self.tag(f"bodies.{i}.group", g, self.gdim) for i, (g, _) in enumerate(pb.bodies)
+        ]
         for i, b in enumerate(pb.boundary):
             self.tag(f"boundary.{i}.group", b.group, fdim)
             comps = [*b.fix, *b.displacement]
@@ -828,14 +964,23 @@ class _FileMesh:
             touching.add(pb.obstacle["contact"])
         for i, b in enumerate(pb.boundary):
             if b.group in touching:
-                self._fail(f"boundary.{i}.group", f"'{b.group}' is a contact surface: the "
-                           "contact law there assumes no other condition or load (Nitsche "
-                           "would be inconsistent); give it its own physical group")  # fmt: skip
-        if pb.contact is None and not pb.pins and not any(b.fix or b.displacement
-                                                          for b in pb.boundary):  # fmt: skip
-            self._fail("boundary", "the body has no support (fix or displacement on a group): "
-                       "frictionless contact alone leaves it free to slide, the solve would be "
-                       "singular")  # fmt: skip
+                self._fail(
+                    f"boundary.{i}.group",
+                    f"'{b.group}' is a contact surface: the "
+                    "contact law there assumes no other condition or load (Nitsche "
+                    "would be inconsistent); give it its own physical group",
+                )
+        if (
+            pb.contact is None
+            and not pb.pins
+            and not any(b.fix or b.displacement for b in pb.boundary)
+        ):
+            self._fail(
+                "boundary",
+                "the body has no support (fix or displacement on a group): "
+                "frictionless contact alone leaves it free to slide, the solve would be "
+                "singular",
+            )
         for i, g in enumerate(pb.reactions):
             self.tag(f"output.reactions.{i}", g, fdim)
         for i, q in enumerate(pb.probes):
@@ -849,8 +994,10 @@ class _FileMesh:
             tag = self.groups[b.group].tag
             if V.num_sub_spaces == 0:  # one component (1D on dolfinx 0.9): no sub-spaces
                 if b.displacement:
-                    self._fail(f"boundary.{i}.displacement", "prescribed displacements are "
-                               "not offered in 1D (fix is)")  # fmt: skip
+                    self._fail(
+                        f"boundary.{i}.displacement",
+                        "prescribed displacements are not offered in 1D (fix is)",
+                    )
                 bcs += fix(V, facet_tags, tag) if b.fix else []
                 continue
             bcs += [fix_component(V, facet_tags, tag, c) for c in b.fix]
@@ -883,11 +1030,13 @@ class _FileMesh:
             if b.stress is not None:  # the traction sigma n of a stress field
                 x = ufl.SpatialCoordinate(self._mesh)
                 y = ufl.as_vector([x[i] for i in range(self.gdim)])
-                sigma = ufl.as_matrix([[e(y) if callable(e) else e for e in row]
-                                       for row in b.stress])  # fmt: skip
+                sigma = ufl.as_matrix(
+                    [[e(y) if callable(e) else e for e in row] for row in b.stress]
+                )
                 term = term + ufl.dot(ufl.dot(sigma, ufl.FacetNormal(self._mesh)), v)
-            rule = None if b.quadrature_degree is None else {
-                "quadrature_degree": b.quadrature_degree}  # fmt: skip
+            rule = (
+                None if b.quadrature_degree is None else {"quadrature_degree": b.quadrature_degree}
+            )
             form = amp * term * ds(self.groups[b.group].tag, metadata=rule)
             L = form if L is None else L + form
         return L
@@ -914,13 +1063,15 @@ class _FileMesh:
         if exprs is None:
             return
         if len(exprs) != self.gdim:
-            self._fail("initial.displacement", f"expected {self.gdim} expressions, got "
-                       f"{len(exprs)}")  # fmt: skip
+            self._fail(
+                "initial.displacement", f"expected {self.gdim} expressions, got {len(exprs)}"
+            )
         x = ufl.SpatialCoordinate(self._mesh)
         y = ufl.as_vector([x[i] for i in range(self.gdim)])
         values = [e(y) for e in exprs]
-        values = [v if isinstance(v, ufl.core.expr.Expr) else ufl.as_ufl(v) + 0.0 * x[0]
-                  for v in values]  # fmt: skip
+        values = [
+            v if isinstance(v, ufl.core.expr.Expr) else ufl.as_ufl(v) + 0.0 * x[0] for v in values
+        ]
         u.interpolate(_compat.expression(ufl.as_vector(values), u.function_space))
 
     def _facet_points(self, mesh, facets: np.ndarray) -> np.ndarray:
@@ -958,8 +1109,7 @@ class _FileMesh:
         facets = facet_tags.indices[facet_tags.values == tag]
         local = {int(cell_body.get(int(c), -1)) for f in facets for c in f2c.links(f)}
         found = set().union(*mesh.comm.allgather(local))
-        return [g for (g, _), t in zip(self.spec.bodies, self.body_tags, strict=True)
-                if t in found]  # fmt: skip
+        return [g for (g, _), t in zip(self.spec.bodies, self.body_tags, strict=True) if t in found]
 
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float, quantities) -> None:
@@ -1018,12 +1168,17 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         mesh, facet_tags = self.read_mesh(comm)
         ob = self.spec.obstacle
         self.contact_tag = self.tag("obstacle.contact", ob["contact"], self.gdim - 1)
-        for shape, dim, other in (("circle", 2, "sphere"), ("cylinder", 2, "sphere"),
-                                  ("parabola", 2, "paraboloid"), ("sphere", 3, "circle"),
-                                  ("paraboloid", 3, "parabola")):  # fmt: skip
+        for shape, dim, other in (
+            ("circle", 2, "sphere"),
+            ("cylinder", 2, "sphere"),
+            ("parabola", 2, "paraboloid"),
+            ("sphere", 3, "circle"),
+            ("paraboloid", 3, "parabola"),
+        ):
             if ob["shape"] == shape and self.gdim != dim:
-                self._fail("obstacle.shape", f"{shape} is a {dim}D obstacle (in "
-                           f"{5 - dim}D: {other})")  # fmt: skip
+                self._fail(
+                    "obstacle.shape", f"{shape} is a {dim}D obstacle (in {5 - dim}D: {other})"
+                )
         if ob["shape"] in ("sinusoid", "punch") and self.gdim == 1:
             self._fail("obstacle.shape", f"{ob['shape']} needs a 2D or 3D problem")
         r = _Reader(self.spec.path)
@@ -1031,15 +1186,20 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         self.position = r.vector(ob, "obstacle", "position", self.gdim, zero)
         self.motion = r.vector(ob, "obstacle", "motion", self.gdim, zero)
         if "path" in ob and len(ob["path"][0]) != self.gdim + 1:
-            self._fail("obstacle.path", f"expected rows [load factor, {self.gdim} offset "
-                       "components]")  # fmt: skip
+            self._fail(
+                "obstacle.path", f"expected rows [load factor, {self.gdim} offset components]"
+            )
         self._h = ob.get("h") or self._facet_size(mesh, facet_tags, [self.contact_tag])
         if not self._h > 0.0:
-            self._fail("obstacle.h", "the contact facets have no size (a 1D problem): give "
-                       "the element size h")  # fmt: skip
+            self._fail(
+                "obstacle.h",
+                "the contact facets have no size (a 1D problem): give the element size h",
+            )
         if len(self.spec.bodies) > 1 and len({m.nu for _, m in self.spec.bodies}) > 1:
-            self._fail("bodies", "bodies of different nu against an obstacle are not supported "
-                       "(one nu, E per body)")  # fmt: skip
+            self._fail(
+                "bodies",
+                "bodies of different nu against an obstacle are not supported (one nu, E per body)",
+            )
         # the modulus of the body at the contact surface (the largest, if several touch)
         moduli = dict(self.spec.bodies)
         touching = self._bodies_touching(mesh, facet_tags, self.contact_tag) or list(moduli)
@@ -1097,14 +1257,15 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
         fdim = self.gdim - 1
         self._slave = self.tag("contact.0.slave", slave, fdim)
         self._master = self.tag("contact.0.master", master, fdim)
-        self.cells = {g: t for (g, _), t in zip(self.spec.bodies, self.body_tags,
-                                                strict=True)}  # fmt: skip
+        self.cells = {g: t for (g, _), t in zip(self.spec.bodies, self.body_tags, strict=True)}
         contact = [self._slave, self._master]
         self._h = self.spec.pair.get("h") or self._facet_size(mesh, facet_tags, contact)
         bodies = self._bodies_touching(mesh, facet_tags, self._slave)
         if len(bodies) != 1:
-            self._fail("contact.0.slave", "the surface must bound one body, it bounds "
-                       f"{sorted(bodies) or 'none'}")  # fmt: skip
+            self._fail(
+                "contact.0.slave",
+                f"the surface must bound one body, it bounds {sorted(bodies) or 'none'}",
+            )
         self._slave_body = bodies[0]
         return mesh, facet_tags
 
@@ -1176,9 +1337,12 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         self._normal = np.array([-self._dir[1], self._dir[0]])
         off = np.abs((pts - centre) @ np.array([-vt[0][1], vt[0][0]])).max()
         if off > 1e-8 * self._length:
-            self._fail("interface.group", f"the group '{self.spec.interface['group']}' is not "
-                       f"straight ({off:.3g} off its line): curved interfaces are not offered "
-                       "yet")  # fmt: skip
+            self._fail(
+                "interface.group",
+                f"the group '{self.spec.interface['group']}' is not "
+                f"straight ({off:.3g} off its line): curved interfaces are not offered "
+                "yet",
+            )
         given = [k for k in ("origin", "direction") if k in spec]
         off = np.abs((pts - self._origin) @ self._normal).max()
         if given and off > 1e-8 * self._length:
@@ -1195,8 +1359,7 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         mesh.topology.create_connectivity(fdim, mesh.topology.dim)
         exterior = _compat_exterior(mesh)
         outer = self._segments(mesh, None, exterior).reshape(-1, 2)
-        self._tips = [e for e in ends
-                      if not np.any(np.linalg.norm(outer - e, axis=1) < 1e3 * tol)]  # fmt: skip
+        self._tips = [e for e in ends if not np.any(np.linalg.norm(outer - e, axis=1) < 1e3 * tol)]
         self._h = spec.get("h") or self._facet_size(mesh, facet_tags, [self.interface_tag])
         self._check_pins(mesh, tol)
         return mesh, facet_tags
@@ -1207,14 +1370,19 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
         for i, (point, _) in enumerate(self.spec.pins):
             found = bool(len(x)) and float(np.min(np.linalg.norm(x - point, axis=1))) < tol
             if not mesh.comm.allreduce(found, op=MPI.LOR):
-                self._fail(f"pins.{i}.point", f"{point.tolist()} is not a vertex of the mesh "
-                           f"{self.spec.mesh_label}")  # fmt: skip
+                self._fail(
+                    f"pins.{i}.point",
+                    f"{point.tolist()} is not a vertex of the mesh {self.spec.mesh_label}",
+                )
 
     def _segments(self, mesh, facet_tags, selection) -> np.ndarray:
         """(m, 2, gdim) vertex coordinates of the facets (of the groups ``selection``, or the
         facet indices ``selection`` when facet_tags is None) of every rank."""
-        facets = (selection if facet_tags is None
-                  else facet_tags.indices[np.isin(facet_tags.values, selection)])  # fmt: skip
+        facets = (
+            selection
+            if facet_tags is None
+            else facet_tags.indices[np.isin(facet_tags.values, selection)]
+        )
         local = self._facet_points(mesh, facets)
         # ghost facets appear on two ranks: keep each facet once
         every = np.concatenate(mesh.comm.allgather(local))

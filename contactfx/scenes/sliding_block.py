@@ -36,10 +36,12 @@ __all__ = ["SlidingBlock", "SlidingBlockParams"]
 class SlidingBlockParams(elastic(1000.0, 0.3)):
     width: float = param(1.0, "block width L", positive=True)
     height: float = param(0.5, "block height H", positive=True)
-    pressure: float = param(10.0, "pressure p on the bottom face (first half of the load)",
-                            positive=True)  # fmt: skip
-    shift: float = param(0.02, "tangential displacement of the rigid plane (second half)",
-                         nonnegative=True)  # fmt: skip
+    pressure: float = param(
+        10.0, "pressure p on the bottom face (first half of the load)", positive=True
+    )
+    shift: float = param(
+        0.02, "tangential displacement of the rigid plane (second half)", nonnegative=True
+    )
     h: float = param(0.05, "element size", positive=True)
 
 
@@ -57,9 +59,15 @@ class SlidingBlock(ObstacleScene):
         half = 0.5 * p.width
         return functools.partial(
             rectangle,
-            x0=-half, x1=half, y0=-p.height, y1=0.0, refine_x0=-half, refine_x1=half,
-            h_contact=p.h, h_far=p.h,
-        ), 2  # fmt: skip
+            x0=-half,
+            x1=half,
+            y0=-p.height,
+            y1=0.0,
+            refine_x0=-half,
+            refine_x1=half,
+            h_contact=p.h,
+            h_far=p.h,
+        ), 2
 
     def h_contact(self) -> float:
         return self.p.h
@@ -91,12 +99,22 @@ class SlidingBlock(ObstacleScene):
         overlap = 1e-3 * p.h
         return {
             "bodies": [export.body("domain", self.material())],
-            "boundary": [{"group": "bottom", "fix": ["x"], "traction": [0.0, p.pressure],
-                          "amplitude": [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]]}],
-            "obstacle": {"shape": "plane", "contact": "top", "h": p.h,
-                         **export.motion(self.obstacle_offset, 2, (0.0, 0.5, 1.0))},
+            "boundary": [
+                {
+                    "group": "bottom",
+                    "fix": ["x"],
+                    "traction": [0.0, p.pressure],
+                    "amplitude": [[0.0, 0.0], [0.5, 1.0], [1.0, 1.0]],
+                }
+            ],
+            "obstacle": {
+                "shape": "plane",
+                "contact": "top",
+                "h": p.h,
+                **export.motion(self.obstacle_offset, 2, (0.0, 0.5, 1.0)),
+            },
             "initial": {"displacement": ["0.0", f"{overlap!r} - {strain!r} * y"]},
-        }  # fmt: skip
+        }
 
     def reference(self, force: float) -> dict[str, float]:
         return {"force": self.p.pressure * self.p.width}

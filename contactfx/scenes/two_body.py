@@ -78,16 +78,21 @@ class PatchTestParams(two_elastic(1000.0, 0.3)):
     height: float = param(0.5, "height of each block", positive=True)
     h: float = param(0.1, "element size of the lower block", positive=True)
     ratio: float = param(0.7, "element size of the upper block / h", positive=True)
-    offset: float = param(0.3, "shift of the upper block's contact nodes (fraction of its "
-                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    offset: float = param(
+        0.3,
+        "shift of the upper block's contact nodes (fraction of its element, in [0, 1))",
+        nonnegative=True,
+    )
     pressure: float = param(1.0, "pressure q on the top of the upper block", positive=True)
     dim: int = param(2, "dimension: 2 (stacked blocks) or 3 (stacked boxes)", choices=(2, 3))
 
 
 class PatchTest(TwoBodyScene):
     name = "patch-test"
-    summary = ("two stacked blocks (--dim 3: boxes) with non-matching meshes under uniform "
-               "pressure; exact: uniform stress and contact pressure")  # fmt: skip
+    summary = (
+        "two stacked blocks (--dim 3: boxes) with non-matching meshes under uniform "
+        "pressure; exact: uniform stress and contact pressure"
+    )
     Params = PatchTestParams
     size_rule = "measure"  # the contact length (2D) or area (3D)
     cells = {"lower": StackedBlocksCells.LOWER, "upper": StackedBlocksCells.UPPER}
@@ -97,14 +102,23 @@ class PatchTest(TwoBodyScene):
         super().__init__(params)
         if params.dim == 3:
             self.cells = {"lower": StackedBoxesCells.LOWER, "upper": StackedBoxesCells.UPPER}
-            self.surfaces = {"lower": StackedBoxesFacets.LOWER_TOP,
-                             "upper": StackedBoxesFacets.UPPER_BOTTOM}  # fmt: skip
+            self.surfaces = {
+                "lower": StackedBoxesFacets.LOWER_TOP,
+                "upper": StackedBoxesFacets.UPPER_BOTTOM,
+            }
 
     def mesh_builder(self):
         p = self.p
         blocks = stacked_boxes if p.dim == 3 else stacked_blocks
-        builder = functools.partial(blocks, width=p.width, h_lower=p.height, h_upper=p.height,
-                                    h1=p.h, ratio=p.ratio, offset=p.offset)  # fmt: skip
+        builder = functools.partial(
+            blocks,
+            width=p.width,
+            h_lower=p.height,
+            h_upper=p.height,
+            h1=p.h,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
         return builder, p.dim
 
     def h_contact(self) -> float:
@@ -113,28 +127,39 @@ class PatchTest(TwoBodyScene):
     def dirichlet(self, V, facet_tags) -> list:
         if self.p.dim == 3:
             f = StackedBoxesFacets
-            return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
-                    fix_component(V, facet_tags, f.LOWER_X0, 0),
-                    fix_component(V, facet_tags, f.UPPER_X0, 0),
-                    fix_component(V, facet_tags, f.LOWER_Y0, 1),
-                    fix_component(V, facet_tags, f.UPPER_Y0, 1)]  # fmt: skip
+            return [
+                fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
+                fix_component(V, facet_tags, f.LOWER_X0, 0),
+                fix_component(V, facet_tags, f.UPPER_X0, 0),
+                fix_component(V, facet_tags, f.LOWER_Y0, 1),
+                fix_component(V, facet_tags, f.UPPER_Y0, 1),
+            ]
         f = StackedBlocksFacets
-        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
-                fix_component(V, facet_tags, f.LOWER_LEFT, 0),
-                fix_component(V, facet_tags, f.UPPER_LEFT, 0)]  # fmt: skip
+        return [
+            fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
+            fix_component(V, facet_tags, f.LOWER_LEFT, 0),
+            fix_component(V, facet_tags, f.UPPER_LEFT, 0),
+        ]
 
     def boundary_data(self) -> list[dict]:
         """The rollers of :meth:`dirichlet` and the pressure q on the top (a traction -q along
         the last axis, ramped with the load factor as :meth:`load`)."""
         if self.p.dim == 3:
-            rollers = [("lower_bottom", 2), ("lower_x0", 0), ("upper_x0", 0), ("lower_y0", 1),
-                       ("upper_y0", 1)]  # fmt: skip
+            rollers = [
+                ("lower_bottom", 2),
+                ("lower_x0", 0),
+                ("upper_x0", 0),
+                ("lower_y0", 1),
+                ("upper_y0", 1),
+            ]
         else:
             rollers = [("lower_bottom", 1), ("lower_left", 0), ("upper_left", 0)]
         traction = [0.0] * self.p.dim
         traction[-1] = -self.p.pressure
-        return [*(export.fixed(g, (c,)) for g, c in rollers),
-                {"group": "upper_top", "traction": traction}]  # fmt: skip
+        return [
+            *(export.fixed(g, (c,)) for g, c in rollers),
+            {"group": "upper_top", "traction": traction},
+        ]
 
     def load(self, v, ds, t):
         if self.p.dim == 3:
@@ -162,17 +187,22 @@ class PatchTest(TwoBodyScene):
 class HertzCylindersParams(two_elastic(1000.0, 0.3)):
     R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
     R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
-    depth: float = param(5e-3, "approach of the upper body's top (ramped over the load "
-                         "steps)", positive=True)  # fmt: skip
-    h_contact: float = param(2e-3, "element size of the lower body in the contact zone",
-                             positive=True)  # fmt: skip
+    depth: float = param(
+        5e-3, "approach of the upper body's top (ramped over the load steps)", positive=True
+    )
+    h_contact: float = param(
+        2e-3, "element size of the lower body in the contact zone", positive=True
+    )
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
-    refine: float = param(0.08, "radius of the refined zone around the first contact point",
-                          positive=True)  # fmt: skip
-    ratio: float = param(0.75, "element size of the upper body / that of the lower",
-                         positive=True)  # fmt: skip
-    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
-                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    refine: float = param(
+        0.08, "radius of the refined zone around the first contact point", positive=True
+    )
+    ratio: float = param(0.75, "element size of the upper body / that of the lower", positive=True)
+    offset: float = param(
+        0.3,
+        "shift of the upper body's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
 
 
 class _TwoHertz(TwoBodyScene):
@@ -200,9 +230,16 @@ class HertzCylinders(_TwoHertz):
 
     def mesh_builder(self):
         p = self.p
-        builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
-                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
-                                    ratio=p.ratio, offset=p.offset)  # fmt: skip
+        builder = functools.partial(
+            cylinders,
+            radius_lower=p.R_lower,
+            radius_upper=p.R_upper,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
         return builder, 2
 
     def make_constants(self, mesh) -> None:
@@ -210,15 +247,20 @@ class HertzCylinders(_TwoHertz):
 
     def dirichlet(self, V, facet_tags) -> list:
         f = CylindersFacets
-        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
-                fix_component(V, facet_tags, f.LOWER_SYMMETRY, 0),
-                fix_component(V, facet_tags, f.UPPER_SYMMETRY, 0),
-                _component_value(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
+        return [
+            fix_component(V, facet_tags, f.LOWER_BOTTOM, 1),
+            fix_component(V, facet_tags, f.LOWER_SYMMETRY, 0),
+            fix_component(V, facet_tags, f.UPPER_SYMMETRY, 0),
+            _component_value(V, facet_tags, f.UPPER_TOP, 1, self.push),
+        ]
 
     def boundary_data(self) -> list[dict]:
-        return [export.fixed("lower_bottom", (1,)), export.fixed("lower_symmetry", (0,)),
-                export.fixed("upper_symmetry", (0,)),
-                {"group": "upper_top", "displacement": {"y": -self.p.depth}}]  # fmt: skip
+        return [
+            export.fixed("lower_bottom", (1,)),
+            export.fixed("lower_symmetry", (0,)),
+            export.fixed("upper_symmetry", (0,)),
+            {"group": "upper_top", "displacement": {"y": -self.p.depth}},
+        ]
 
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.depth
@@ -236,21 +278,27 @@ class HertzCylinders(_TwoHertz):
 class HertzSpheresParams(two_elastic(1000.0, 0.3)):
     R_upper: float = param(1.0, "radius R1 of the upper sphere", positive=True)
     R_lower: float = param(1.0, "radius R2 of the lower sphere", positive=True)
-    depth: float = param(0.02, "approach of the upper body's top (ramped over the load "
-                         "steps)", positive=True)  # fmt: skip
-    h_contact: float = param(0.0065, "element size of the lower body in the contact zone",
-                             positive=True)  # fmt: skip
+    depth: float = param(
+        0.02, "approach of the upper body's top (ramped over the load steps)", positive=True
+    )
+    h_contact: float = param(
+        0.0065, "element size of the lower body in the contact zone", positive=True
+    )
     h_far: float = param(0.25, "element size far from the contact zone", positive=True)
-    refine: float = param(0.13, "radius of the refined zone around the first contact point",
-                          positive=True)  # fmt: skip
+    refine: float = param(
+        0.13, "radius of the refined zone around the first contact point", positive=True
+    )
     # the slave (upper) surface coarser than the master: with a finer slave the nodal
     # pressures scatter by several % (docs/verification.md section 10)
-    ratio: float = param(1.3, "element size of the upper body / that of the lower",
-                         positive=True)  # fmt: skip
-    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
-                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
-    grading: float = param(0.3, "element size growth per unit distance from the refined zone",
-                           positive=True)  # fmt: skip
+    ratio: float = param(1.3, "element size of the upper body / that of the lower", positive=True)
+    offset: float = param(
+        0.3,
+        "shift of the upper body's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
+    grading: float = param(
+        0.3, "element size growth per unit distance from the refined zone", positive=True
+    )
 
 
 class HertzSpheres(_TwoHertz):
@@ -268,10 +316,17 @@ class HertzSpheres(_TwoHertz):
 
     def mesh_builder(self):
         p = self.p
-        builder = functools.partial(spheres, radius_lower=p.R_lower, radius_upper=p.R_upper,
-                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
-                                    ratio=p.ratio, offset=p.offset,
-                                    grading=p.grading)  # fmt: skip
+        builder = functools.partial(
+            spheres,
+            radius_lower=p.R_lower,
+            radius_upper=p.R_upper,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+            grading=p.grading,
+        )
         return builder, 3
 
     def make_constants(self, mesh) -> None:
@@ -279,18 +334,24 @@ class HertzSpheres(_TwoHertz):
 
     def dirichlet(self, V, facet_tags) -> list:
         f = SpheresFacets
-        return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
-                fix_component(V, facet_tags, f.LOWER_X0, 0),
-                fix_component(V, facet_tags, f.UPPER_X0, 0),
-                fix_component(V, facet_tags, f.LOWER_Y0, 1),
-                fix_component(V, facet_tags, f.UPPER_Y0, 1),
-                _component_value(V, facet_tags, f.UPPER_TOP, 2, self.push)]  # fmt: skip
+        return [
+            fix_component(V, facet_tags, f.LOWER_BOTTOM, 2),
+            fix_component(V, facet_tags, f.LOWER_X0, 0),
+            fix_component(V, facet_tags, f.UPPER_X0, 0),
+            fix_component(V, facet_tags, f.LOWER_Y0, 1),
+            fix_component(V, facet_tags, f.UPPER_Y0, 1),
+            _component_value(V, facet_tags, f.UPPER_TOP, 2, self.push),
+        ]
 
     def boundary_data(self) -> list[dict]:
-        return [export.fixed("lower_bottom", (2,)), export.fixed("lower_x0", (0,)),
-                export.fixed("upper_x0", (0,)), export.fixed("lower_y0", (1,)),
-                export.fixed("upper_y0", (1,)),
-                {"group": "upper_top", "displacement": {"z": -self.p.depth}}]  # fmt: skip
+        return [
+            export.fixed("lower_bottom", (2,)),
+            export.fixed("lower_x0", (0,)),
+            export.fixed("upper_x0", (0,)),
+            export.fixed("lower_y0", (1,)),
+            export.fixed("upper_y0", (1,)),
+            {"group": "upper_top", "displacement": {"z": -self.p.depth}},
+        ]
 
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.depth

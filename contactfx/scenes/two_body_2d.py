@@ -84,52 +84,81 @@ def press_then_drag(group: str, drag: float, push: float, fraction: float) -> li
     """The ``[[boundary]]`` tables of a face moved by ``push`` along y during the first
     ``fraction`` of the load program, then along x by ``drag`` at that vertical displacement:
     one table per component, each with its piecewise-linear amplitude."""
-    return [{"group": group, "displacement": {"x": float(drag)},
-             "amplitude": [[0.0, 0.0], [float(fraction), 0.0], [1.0, 1.0]]},
-            {"group": group, "displacement": {"y": float(push)},
-             "amplitude": [[0.0, 0.0], [float(fraction), 1.0], [1.0, 1.0]]}]  # fmt: skip
+    return [
+        {
+            "group": group,
+            "displacement": {"x": float(drag)},
+            "amplitude": [[0.0, 0.0], [float(fraction), 0.0], [1.0, 1.0]],
+        },
+        {
+            "group": group,
+            "displacement": {"y": float(push)},
+            "amplitude": [[0.0, 0.0], [float(fraction), 1.0], [1.0, 1.0]],
+        },
+    ]
 
 
 @dataclass(frozen=True)
 class PunchFoundationParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the punch (stiff by default)
     E_upper: float = param(1e6, "Young's modulus of the upper body (the punch)", positive=True)
-    b: float = param(0.052, "half-width of the punch (flat face b - rho, then the rounded "
-                     "edge)", positive=True)  # fmt: skip
+    b: float = param(
+        0.052, "half-width of the punch (flat face b - rho, then the rounded edge)", positive=True
+    )
     rho: float = param(0.002, "edge radius of the punch", positive=True)
     punch_height: float = param(0.05, "height of the punch", positive=True)
-    indentation: float = param(1e-4, "prescribed downward displacement of the punch's top",
-                               positive=True)  # fmt: skip
+    indentation: float = param(
+        1e-4, "prescribed downward displacement of the punch's top", positive=True
+    )
     width: float = param(1.0, "half-width of the block", positive=True)
     depth: float = param(1.0, "depth of the block", positive=True)
     h_contact: float = param(5e-4, "element size of the block under the punch", positive=True)
     h_far: float = param(0.1, "element size far from the punch", positive=True)
-    refine: float = param(0.01, "distance from the punch face meshed with the contact sizes",
-                          positive=True)  # fmt: skip
+    refine: float = param(
+        0.01, "distance from the punch face meshed with the contact sizes", positive=True
+    )
     ratio: float = param(1.2, "element size of the punch / that of the block", positive=True)
-    offset: float = param(0.3, "shift of the punch's contact nodes (fraction of an element, "
-                          "in [0, 1))", nonnegative=True)  # fmt: skip
-    rigid_ratio: float = param(1e3, "E_upper / E_lower from which the punch is compared with "
-                               "the rigid flat punch", positive=True)  # fmt: skip
+    offset: float = param(
+        0.3,
+        "shift of the punch's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
+    rigid_ratio: float = param(
+        1e3,
+        "E_upper / E_lower from which the punch is compared with the rigid flat punch",
+        positive=True,
+    )
 
 
 class PunchFoundation(TwoBodyScene):
     name = "punch-foundation"
-    summary = ("elastic flat punch with rounded edges on an elastic block (half model); stiff "
-               "punch: rigid flat punch pressure, equal moduli: edge peak")  # fmt: skip
+    summary = (
+        "elastic flat punch with rounded edges on an elastic block (half model); stiff "
+        "punch: rigid flat punch pressure, equal moduli: edge peak"
+    )
     Params = PunchFoundationParams
     cells = {"lower": PunchFoundationCells.BLOCK, "upper": PunchFoundationCells.PUNCH}
-    surfaces = {"lower": PunchFoundationFacets.BLOCK_TOP,
-                "upper": PunchFoundationFacets.PUNCH_CONTACT}  # fmt: skip
+    surfaces = {
+        "lower": PunchFoundationFacets.BLOCK_TOP,
+        "upper": PunchFoundationFacets.PUNCH_CONTACT,
+    }
     symmetry = 2.0
 
     def mesh_builder(self):
         p = self.p
         builder = functools.partial(
-            punch_foundation, width=p.width, depth=p.depth, b=p.b, rho=p.rho,
-            h_punch=p.punch_height, h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
-            ratio=p.ratio, offset=p.offset,
-        )  # fmt: skip
+            punch_foundation,
+            width=p.width,
+            depth=p.depth,
+            b=p.b,
+            rho=p.rho,
+            h_punch=p.punch_height,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
         return builder, 2
 
     def make_constants(self, mesh) -> None:
@@ -137,15 +166,20 @@ class PunchFoundation(TwoBodyScene):
 
     def dirichlet(self, V, facet_tags) -> list:
         f = PunchFoundationFacets
-        return [*fix(V, facet_tags, f.BLOCK_BOTTOM),
-                fix_component(V, facet_tags, f.BLOCK_SYMMETRY, 0),
-                fix_component(V, facet_tags, f.PUNCH_SYMMETRY, 0),
-                prescribe_component(V, facet_tags, f.PUNCH_TOP, 1, self.push)]  # fmt: skip
+        return [
+            *fix(V, facet_tags, f.BLOCK_BOTTOM),
+            fix_component(V, facet_tags, f.BLOCK_SYMMETRY, 0),
+            fix_component(V, facet_tags, f.PUNCH_SYMMETRY, 0),
+            prescribe_component(V, facet_tags, f.PUNCH_TOP, 1, self.push),
+        ]
 
     def boundary_data(self) -> list[dict]:
-        return [export.fixed("block_bottom", (0, 1)), export.fixed("block_symmetry", (0,)),
-                export.fixed("punch_symmetry", (0,)),
-                {"group": "punch_top", "displacement": {"y": -self.p.indentation}}]  # fmt: skip
+        return [
+            export.fixed("block_bottom", (0, 1)),
+            export.fixed("block_symmetry", (0,)),
+            export.fixed("punch_symmetry", (0,)),
+            {"group": "punch_top", "displacement": {"y": -self.p.indentation}},
+        ]
 
     def set_load(self, t: float) -> None:
         self.push.value = -t * self.p.indentation
@@ -164,7 +198,8 @@ class PunchFoundation(TwoBodyScene):
         scores = {"edge_peak": float(np.max(p, initial=0.0)) * 2.0 * self.p.b / force}
         if self.rigid():
             scores["normalised_pressure_error"] = normalised_pressure_error(
-                x, p, force, self.flat_half_width)  # fmt: skip
+                x, p, force, self.flat_half_width
+            )
         return scores
 
     def pressure_profile(self, s, force):
@@ -175,27 +210,34 @@ class PunchFoundation(TwoBodyScene):
 @dataclass(frozen=True)
 class SlidingContactParams(two_elastic(1000.0, 0.3)):
     radius: float = param(1.0, "radius R of the rounded body", positive=True)
-    height: float = param(0.15, "height of the rounded body (the disk cut at y = height <= R)",
-                          positive=True)  # fmt: skip
-    press: float = param(2e-3, "prescribed downward displacement of the rounded body's top",
-                         positive=True)  # fmt: skip
-    slide: float = param(0.2, "tangential displacement of the top (along +x) after pressing",
-                         positive=True)  # fmt: skip
-    press_fraction: float = param(0.1, "fraction of the load program spent pressing, in "
-                                  "(0, 1)", positive=True)  # fmt: skip
-    left: float = param(0.8, "extent of the block left of the first contact point",
-                        positive=True)  # fmt: skip
-    right: float = param(1.2, "extent of the block right of the first contact point (> slide)",
-                         positive=True)  # fmt: skip
+    height: float = param(
+        0.15, "height of the rounded body (the disk cut at y = height <= R)", positive=True
+    )
+    press: float = param(
+        2e-3, "prescribed downward displacement of the rounded body's top", positive=True
+    )
+    slide: float = param(
+        0.2, "tangential displacement of the top (along +x) after pressing", positive=True
+    )
+    press_fraction: float = param(
+        0.1, "fraction of the load program spent pressing, in (0, 1)", positive=True
+    )
+    left: float = param(0.8, "extent of the block left of the first contact point", positive=True)
+    right: float = param(
+        1.2, "extent of the block right of the first contact point (> slide)", positive=True
+    )
     depth: float = param(0.5, "depth of the block", positive=True)
     h_contact: float = param(4e-3, "element size of the block along the track", positive=True)
     h_far: float = param(0.1, "element size far from the contact", positive=True)
-    refine: float = param(0.06, "distance from the track meshed with the contact sizes",
-                          positive=True)  # fmt: skip
-    ratio: float = param(0.8, "element size of the rounded body / that of the block",
-                         positive=True)  # fmt: skip
-    offset: float = param(0.3, "shift of the rounded body's contact nodes (fraction of an "
-                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    refine: float = param(
+        0.06, "distance from the track meshed with the contact sizes", positive=True
+    )
+    ratio: float = param(0.8, "element size of the rounded body / that of the block", positive=True)
+    offset: float = param(
+        0.3,
+        "shift of the rounded body's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -205,21 +247,34 @@ class SlidingContactParams(two_elastic(1000.0, 0.3)):
 
 class SlidingContact(TwoBodyScene):
     name = "sliding-contact"
-    summary = ("rounded body pressed into a block and dragged along it (frictionless); "
-               "Q / P = 0, P without jumps")  # fmt: skip
+    summary = (
+        "rounded body pressed into a block and dragged along it (frictionless); "
+        "Q / P = 0, P without jumps"
+    )
     Params = SlidingContactParams
     cells = {"lower": RoundedOnBlockCells.BLOCK, "upper": RoundedOnBlockCells.ROUNDED}
-    surfaces = {"lower": RoundedOnBlockFacets.BLOCK_TOP,
-                "upper": RoundedOnBlockFacets.ROUNDED_CONTACT}  # fmt: skip
+    surfaces = {
+        "lower": RoundedOnBlockFacets.BLOCK_TOP,
+        "upper": RoundedOnBlockFacets.ROUNDED_CONTACT,
+    }
     numerics_defaults = {"steps": 50}
 
     def mesh_builder(self):
         p = self.p
         builder = functools.partial(
-            rounded_on_block, radius=p.radius, height=p.height, left=p.left, right=p.right,
-            depth=p.depth, track=p.slide, h_contact=p.h_contact, h_far=p.h_far,
-            refine=p.refine, ratio=p.ratio, offset=p.offset,
-        )  # fmt: skip
+            rounded_on_block,
+            radius=p.radius,
+            height=p.height,
+            left=p.left,
+            right=p.right,
+            depth=p.depth,
+            track=p.slide,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
         return builder, 2
 
     def make_constants(self, mesh) -> None:
@@ -228,14 +283,18 @@ class SlidingContact(TwoBodyScene):
 
     def dirichlet(self, V, facet_tags) -> list:
         f = RoundedOnBlockFacets
-        return [*fix(V, facet_tags, f.BLOCK_BOTTOM),
-                prescribe_component(V, facet_tags, f.ROUNDED_TOP, 0, self.drag),
-                prescribe_component(V, facet_tags, f.ROUNDED_TOP, 1, self.push)]  # fmt: skip
+        return [
+            *fix(V, facet_tags, f.BLOCK_BOTTOM),
+            prescribe_component(V, facet_tags, f.ROUNDED_TOP, 0, self.drag),
+            prescribe_component(V, facet_tags, f.ROUNDED_TOP, 1, self.push),
+        ]
 
     def boundary_data(self) -> list[dict]:
         p = self.p
-        return [export.fixed("block_bottom", (0, 1)),
-                *press_then_drag("rounded_top", p.slide, -p.press, p.press_fraction)]  # fmt: skip
+        return [
+            export.fixed("block_bottom", (0, 1)),
+            *press_then_drag("rounded_top", p.slide, -p.press, p.press_fraction),
+        ]
 
     def top_displacement(self, t: float) -> tuple[float, float]:
         """(tangential, vertical) displacement of the top at load factor t: pressing on
@@ -270,21 +329,28 @@ class SlidingContact(TwoBodyScene):
 class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
     R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
     R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
-    depth: float = param(5e-3, "downward displacement of the upper body's top (pressing)",
-                         positive=True)  # fmt: skip
-    shift: float = param(1.5e-3, "displacement of the top along +x after pressing",
-                         nonnegative=True)  # fmt: skip
-    press_fraction: float = param(0.5, "fraction of the load program spent pressing, in "
-                                  "(0, 1)", positive=True)  # fmt: skip
-    h_contact: float = param(1e-3, "element size of the lower body in the contact zone",
-                             positive=True)  # fmt: skip
+    depth: float = param(
+        5e-3, "downward displacement of the upper body's top (pressing)", positive=True
+    )
+    shift: float = param(
+        1.5e-3, "displacement of the top along +x after pressing", nonnegative=True
+    )
+    press_fraction: float = param(
+        0.5, "fraction of the load program spent pressing, in (0, 1)", positive=True
+    )
+    h_contact: float = param(
+        1e-3, "element size of the lower body in the contact zone", positive=True
+    )
     h_far: float = param(0.1, "element size far from the contact zone", positive=True)
-    refine: float = param(0.045, "radius of the refined zone around the first contact point",
-                          positive=True)  # fmt: skip
-    ratio: float = param(0.75, "element size of the upper body / that of the lower",
-                         positive=True)  # fmt: skip
-    offset: float = param(0.3, "shift of the upper body's contact nodes (fraction of an "
-                          "element, in [0, 1))", nonnegative=True)  # fmt: skip
+    refine: float = param(
+        0.045, "radius of the refined zone around the first contact point", positive=True
+    )
+    ratio: float = param(0.75, "element size of the upper body / that of the lower", positive=True)
+    offset: float = param(
+        0.3,
+        "shift of the upper body's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -294,8 +360,10 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
 
 class CattaneoCylinders(HertzCylinders):
     name = "cattaneo-cylinders"
-    summary = ("two identical cylinders pressed, then sheared with Coulomb friction; "
-               "stick half-width c / a = sqrt(1 - Q / (mu P))")  # fmt: skip
+    summary = (
+        "two identical cylinders pressed, then sheared with Coulomb friction; "
+        "stick half-width c / a = sqrt(1 - Q / (mu P))"
+    )
     Params = CattaneoCylindersParams
     symmetry = 1.0
     numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 8}
@@ -306,9 +374,17 @@ class CattaneoCylinders(HertzCylinders):
 
     def mesh_builder(self):
         p = self.p
-        builder = functools.partial(cylinders, radius_lower=p.R_lower, radius_upper=p.R_upper,
-                                    h_contact=p.h_contact, h_far=p.h_far, refine=p.refine,
-                                    ratio=p.ratio, offset=p.offset, full=True)  # fmt: skip
+        builder = functools.partial(
+            cylinders,
+            radius_lower=p.R_lower,
+            radius_upper=p.R_upper,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+            full=True,
+        )
         return builder, 2
 
     def make_constants(self, mesh) -> None:
@@ -317,14 +393,18 @@ class CattaneoCylinders(HertzCylinders):
 
     def dirichlet(self, V, facet_tags) -> list:
         f = CylindersFacets
-        return [*fix(V, facet_tags, f.LOWER_BOTTOM),
-                prescribe_component(V, facet_tags, f.UPPER_TOP, 0, self.drag),
-                prescribe_component(V, facet_tags, f.UPPER_TOP, 1, self.push)]  # fmt: skip
+        return [
+            *fix(V, facet_tags, f.LOWER_BOTTOM),
+            prescribe_component(V, facet_tags, f.UPPER_TOP, 0, self.drag),
+            prescribe_component(V, facet_tags, f.UPPER_TOP, 1, self.push),
+        ]
 
     def boundary_data(self) -> list[dict]:
         p = self.p
-        return [export.fixed("lower_bottom", (0, 1)),
-                *press_then_drag("upper_top", p.shift, -p.depth, p.press_fraction)]  # fmt: skip
+        return [
+            export.fixed("lower_bottom", (0, 1)),
+            *press_then_drag("upper_top", p.shift, -p.depth, p.press_fraction),
+        ]
 
     def set_load(self, t: float) -> None:
         f = self.p.press_fraction

@@ -19,8 +19,14 @@ from contactfx.params import Params, param
 from contactfx.scenes import export
 from contactfx.scenes.base import Scene
 
-__all__ = ["two_elastic", "TwoBodyScene", "line_edge", "radial_edge", "contact_edge",
-           "CONTACT_EDGES"]  # fmt: skip
+__all__ = [
+    "two_elastic",
+    "TwoBodyScene",
+    "line_edge",
+    "radial_edge",
+    "contact_edge",
+    "CONTACT_EDGES",
+]
 
 #: the rules of :func:`contact_edge`
 CONTACT_EDGES = ("x-max", "x-band", "radial")
@@ -65,8 +71,9 @@ def radial_edge(r: np.ndarray, p: np.ndarray, width: float) -> float | None:
     return float(r2 + q2 * (r2 - r1) / (q1 - q2))
 
 
-def contact_edge(rule: str | None, x: np.ndarray, p: np.ndarray,
-                 ring: float | None = None) -> float | None:  # fmt: skip
+def contact_edge(
+    rule: str | None, x: np.ndarray, p: np.ndarray, ring: float | None = None
+) -> float | None:
     """The contact half-width / radius from the slave nodes x (all ranks) with the pressures
     p by the rule: ``x-max`` the edge on the side of growing x (:func:`line_edge`; a symmetric
     contact modelled on x >= 0), ``x-band`` half the distance between the edges on both sides
@@ -95,8 +102,11 @@ def two_elastic(E0: float, nu0: float) -> type:
         nu_lower: float = param(nu0, "Poisson's ratio of the lower body, in (-1, 0.5)")
         E_upper: float = param(E0, "Young's modulus of the upper body", positive=True)
         nu_upper: float = param(nu0, "Poisson's ratio of the upper body, in (-1, 0.5)")
-        slave: str = param("upper", "the slave surface of the contact pair (mortar "
-                           "multiplier, biased Nitsche)", choices=("upper", "lower"))  # fmt: skip
+        slave: str = param(
+            "upper",
+            "the slave surface of the contact pair (mortar multiplier, biased Nitsche)",
+            choices=("upper", "lower"),
+        )
 
         def __post_init__(self) -> None:
             super().__post_init__()
@@ -204,20 +214,24 @@ class TwoBodyScene(Scene):
         the contact edge rule) and the symmetry and contact size outputs."""
         other = "lower" if self.p.slave == "upper" else "upper"
         mats = self.materials()
-        pair = {"slave": self.surfaces[self.p.slave].name.lower(),
-                "master": self.surfaces[other].name.lower(), "h": float(self.h_contact()),
-                "force_on": self.cells["upper"].name.lower()}  # fmt: skip
+        pair = {
+            "slave": self.surfaces[self.p.slave].name.lower(),
+            "master": self.surfaces[other].name.lower(),
+            "h": float(self.h_contact()),
+            "force_on": self.cells["upper"].name.lower(),
+        }
         if self.edge_rule is not None:
             pair["edge"] = self.edge_rule
             if self.edge_ring() is not None:
                 pair["edge_ring"] = float(self.edge_ring())
         return {
-            "bodies": [export.body(self.cells[b].name.lower(), mats[b])
-                       for b in ("lower", "upper")],
+            "bodies": [
+                export.body(self.cells[b].name.lower(), mats[b]) for b in ("lower", "upper")
+            ],
             "boundary": self.boundary_data(),
             "contact": [pair],
             "output": {"symmetry": float(self.symmetry), "contact_size": self.size_rule},
-        }  # fmt: skip
+        }
 
     def reference(self, force: float) -> dict[str, float]:
         return {}

@@ -38,8 +38,9 @@ __all__ = ["Westergaard"]
 class WestergaardParams(elastic(1000.0, 0.3)):
     wavelength: float = param(1.0, "wavelength lambda of the rigid sinusoid", positive=True)
     amplitude: float = param(0.01, "amplitude Delta of the sinusoid", positive=True)
-    mean_pressure_ratio: float = param(0.5, "mean pressure p_m / p* (>= 1: full contact)",
-                                       positive=True)  # fmt: skip
+    mean_pressure_ratio: float = param(
+        0.5, "mean pressure p_m / p* (>= 1: full contact)", positive=True
+    )
     depth_ratio: float = param(2.0, "strip depth H / lambda", positive=True)
     h_contact: float = param(1.0 / 64, "element size at the surface", positive=True)
     h_far: float = param(1.0 / 8, "element size at depth", positive=True)
@@ -65,9 +66,15 @@ class Westergaard(ObstacleScene):
         half = 0.5 * p.wavelength
         return functools.partial(
             rectangle,
-            x0=0.0, x1=half, y0=-p.depth_ratio * p.wavelength, y1=0.0,
-            refine_x0=0.0, refine_x1=half, h_contact=p.h_contact, h_far=p.h_far,
-        ), 2  # fmt: skip
+            x0=0.0,
+            x1=half,
+            y0=-p.depth_ratio * p.wavelength,
+            y1=0.0,
+            refine_x0=0.0,
+            refine_x1=half,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+        ), 2
 
     def obstacle(self) -> Obstacle:
         return Sinusoid(self.p.amplitude, self.p.wavelength)
@@ -99,14 +106,22 @@ class Westergaard(ObstacleScene):
         strain = self.p_mean / numerics.steps / self.material().M
         return {
             "bodies": [export.body("domain", self.material())],
-            "boundary": [export.fixed("left", (0,)), export.fixed("right", (0,)),
-                         {"group": "bottom", "traction": [0.0, self.p_mean]}],
-            "obstacle": {"shape": "sinusoid", "contact": "top", "height": p.amplitude,
-                         "wavelength": p.wavelength, "h": p.h_contact},
+            "boundary": [
+                export.fixed("left", (0,)),
+                export.fixed("right", (0,)),
+                {"group": "bottom", "traction": [0.0, self.p_mean]},
+            ],
+            "obstacle": {
+                "shape": "sinusoid",
+                "contact": "top",
+                "height": p.amplitude,
+                "wavelength": p.wavelength,
+                "h": p.h_contact,
+            },
             # Newton's start: a rigid lift into the obstacle plus the strip's compression
             "initial": {"displacement": ["0.0", f"{lift!r} - {strain!r} * y"]},
             "output": {"contact_size": "measure"},
-        }  # fmt: skip
+        }
 
     def reference(self, force: float) -> dict[str, float]:
         r = self.p.mean_pressure_ratio

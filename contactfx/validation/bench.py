@@ -34,8 +34,16 @@ from contactfx.params import option_name
 from contactfx.results import MEASURES, measure
 from contactfx.scenes.base import resized
 
-__all__ = ["CASES", "MEASURES", "run_bench", "expand_methods", "method_label",
-           "linear_elastic_time", "observed_rates", "parallel_ceiling"]  # fmt: skip
+__all__ = [
+    "CASES",
+    "MEASURES",
+    "run_bench",
+    "expand_methods",
+    "method_label",
+    "linear_elastic_time",
+    "observed_rates",
+    "parallel_ceiling",
+]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,7 +89,7 @@ CASES: dict[str, BenchCase] = {
         {"mean_pressure_ratio": 1.5, "h_contact": 1 / 8, "h_far": 1 / 8},
         1.0,
         "Westergaard, full contact p_m = 1.5 p*, uniform mesh, exact displacement",
-    ),  # fmt: skip
+    ),
     "punch2d": BenchCase("punch2d", {}, 2.0, "flat rigid punch, plane strain"),
     "sliding-block": BenchCase("sliding-block", {}, 2.0, "Coulomb block dragged to gross slip"),
     "crack-sneddon": BenchCase("crack-sneddon", {}, 2.0, "pressurised crack, Sneddon opening"),
@@ -100,7 +108,7 @@ CASES: dict[str, BenchCase] = {
         {"net_pressure": 1e6},
         2.0,
         "propped fracture, open branch p_net > p* (Sneddon)",
-    ),  # fmt: skip
+    ),
     # the same cracks on a mesh that ignores them (P1 and nitsche only; the rest: n/a), beside
     # the fitted rows above
     "crack-sneddon-unfitted": BenchCase(
@@ -109,14 +117,14 @@ CASES: dict[str, BenchCase] = {
         2.0,
         "pressurised crack, unfitted, Sneddon",
         beside="crack-sneddon",
-    ),  # fmt: skip
+    ),
     "crack-inclined-unfitted": BenchCase(
         "crack-inclined",
         {"beta": 45.0, "crack": "unfitted"},
         2.0,
         "inclined crack, unfitted, compression, Coulomb mu 0.3",
         beside="crack-inclined",
-    ),  # fmt: skip
+    ),
     "crack-set": BenchCase(
         "crack-set", {}, 2.0, "three unfitted cracks under compression and shear, Coulomb"
     ),
@@ -131,7 +139,7 @@ CASES: dict[str, BenchCase] = {
         4.0,
         "circular fault, remote stress, fluid overpressure, Coulomb (3D)",
         p2_levels=2,
-    ),  # fmt: skip
+    ),
     "joint-column": BenchCase("joint-column", {}, 1.0, "Barton-Bandis joint column (exact)"),
     "patch-test": BenchCase("patch-test", {}, 1.0, "two blocks, non-matching meshes (exact)"),
     "hertz-cylinders": BenchCase("hertz-cylinders", {}, 2.0, "two elastic cylinders, Hertz"),
@@ -188,8 +196,9 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
         extra = {"quadrature": "nodal"} if nodal else {}
         if has_nested:
             if not nested.isdigit() or int(nested) < 1:
-                raise ValueError(f"--method {token}+nested{nested}: give the coarser levels, "
-                                 "e.g. +nested2")  # fmt: skip
+                raise ValueError(
+                    f"--method {token}+nested{nested}: give the coarser levels, e.g. +nested2"
+                )
             extra["nested"] = int(nested)
         key, defaults = method_class(name).sweep
         values = defaults if number is None else (number,)
@@ -204,9 +213,15 @@ def expand_methods(spec: str) -> list[tuple[str, dict]]:
 
 
 def run_case(
-    case_name: str, label: str, overrides: dict, degree: int, level: int, comm,
-    petsc_options: dict | None = None, solver: str = "lu",
-) -> tuple[dict, object, object]:  # fmt: skip
+    case_name: str,
+    label: str,
+    overrides: dict,
+    degree: int,
+    level: int,
+    comm,
+    petsc_options: dict | None = None,
+    solver: str = "lu",
+) -> tuple[dict, object, object]:
     """One bench row (and the scene and numerics it ran, for the yardsticks)."""
     from contactfx.scenes import SCENES
     from contactfx.solvers.snes import ConvergenceError
@@ -215,11 +230,18 @@ def run_case(
     scene_cls = SCENES[case.scene]
     params = resized(scene_cls.Params(**case.params), case.coarsen * 0.5**level)
     scene = scene_cls(params)
-    row: dict = {"case": case_name, "method": label, "degree": degree, "level": level,
-                 "h": scene.h_contact(), "ranks": comm.size}  # fmt: skip
+    row: dict = {
+        "case": case_name,
+        "method": label,
+        "degree": degree,
+        "level": level,
+        "h": scene.h_contact(),
+        "ranks": comm.size,
+    }
     try:
-        num = scene_cls.default_numerics(degree=degree, solver=solver,
-                                         **{**case.numerics, **overrides})  # fmt: skip
+        num = scene_cls.default_numerics(
+            degree=degree, solver=solver, **{**case.numerics, **overrides}
+        )
         scene.problem.check(scene, num, num.method_object())
     except ValueError as err:  # e.g. al-ssn or P2 between two bodies: not applicable, not failed
         row.update(status="n/a", reason=str(err))
@@ -231,12 +253,20 @@ def run_case(
         return row, scene, num
     t = res.timings
     row.update(
-        status="ok", reason="", dofs=res.dofs, newton=res.newton_iterations,
-        ksp=res.ksp_iterations, outer=res.outer_iterations,
+        status="ok",
+        reason="",
+        dofs=res.dofs,
+        newton=res.newton_iterations,
+        ksp=res.ksp_iterations,
+        outer=res.outer_iterations,
         newton_coarse=sum(step.coarse_newton for step in res.steps),
-        t_mesh=t["mesh"], t_compile=t["compile"], t_assembly=t["assembly"], t_solve=t["solve"],
-        t_run=t["assembly"] + t["solve"], memory_mib=res.memory_mib,
-    )  # fmt: skip
+        t_mesh=t["mesh"],
+        t_compile=t["compile"],
+        t_assembly=t["assembly"],
+        t_solve=t["solve"],
+        t_run=t["assembly"] + t["solve"],
+        memory_mib=res.memory_mib,
+    )
     if "contact" in t:  # two bodies: search + contact terms against bulk assembly + solve
         row["t_contact"] = t["contact"]
         row["contact_over_bulk"] = t["contact"] / max(row["t_run"] - t["contact"], 1e-12)
@@ -281,9 +311,14 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
     bcs = scene.dirichlet(V, facet_tags)
     comm.barrier()
     t0 = time.perf_counter()
-    linear = ContactSNES(dolfinx.fem.Function(V), bulk=LinearBulk(stiffness=a, load=L), bcs=bcs,
-                         prefix="contactfx_linear_", near_nullspace=solver == "gamg",
-                         options=GAMG_OPTIONS if solver == "gamg" else {})  # fmt: skip
+    linear = ContactSNES(
+        dolfinx.fem.Function(V),
+        bulk=LinearBulk(stiffness=a, load=L),
+        bcs=bcs,
+        prefix="contactfx_linear_",
+        near_nullspace=solver == "gamg",
+        options=GAMG_OPTIONS if solver == "gamg" else {},
+    )
     linear.assemble_load()
     linear.solve_linear(np.ones(owned_size(V), dtype=bool))
     comm.barrier()
@@ -311,10 +346,19 @@ def parallel_ceiling(comm, n: int = 3_000_000, repeats: int = 3) -> float:
     return comm.size * alone / together
 
 
-def run_bench(cases: list[str], variants: list[tuple[str, dict]], degrees: list[int],
-              levels: int, comm, petsc_options: dict, *, solver: str = "lu",
-              linear: bool = False, speedup: bool = False,
-              repeat: int = 1) -> list[dict]:  # fmt: skip
+def run_bench(
+    cases: list[str],
+    variants: list[tuple[str, dict]],
+    degrees: list[int],
+    levels: int,
+    comm,
+    petsc_options: dict,
+    *,
+    solver: str = "lu",
+    linear: bool = False,
+    speedup: bool = False,
+    repeat: int = 1,
+) -> list[dict]:
     """Every case x variant x degree x level; one row each (printed on rank 0 as it ends).
     With ``repeat`` > 1 every timed run (and the linear yardstick) is repeated and its
     shortest time kept: the least disturbed by other work on the machine."""
@@ -326,17 +370,21 @@ def run_bench(cases: list[str], variants: list[tuple[str, dict]], degrees: list[
             for degree in degrees:
                 n = min(levels, case.levels if degree == 1 else case.p2_levels)
                 for level in range(n):
-                    row, scene, num = run_case(case_name, label, overrides, degree, level, comm,
-                                               petsc_options, solver)  # fmt: skip
+                    row, scene, num = run_case(
+                        case_name, label, overrides, degree, level, comm, petsc_options, solver
+                    )
                     for _ in range(repeat - 1 if row["status"] == "ok" else 0):
-                        again = run_case(case_name, label, overrides, degree, level, comm,
-                                         petsc_options, solver)[0]  # fmt: skip
+                        again = run_case(
+                            case_name, label, overrides, degree, level, comm, petsc_options, solver
+                        )[0]
                         if again["status"] == "ok" and again["t_run"] < row["t_run"]:
                             row = again
                     # the yardstick loads the obstacle's contact boundary: obstacle scenes only
                     if row["status"] == "ok" and linear and hasattr(scene, "contact_tag"):
-                        lin = min(linear_elastic_time(scene, degree, comm, solver)[0]
-                                  for _ in range(repeat))  # fmt: skip
+                        lin = min(
+                            linear_elastic_time(scene, degree, comm, solver)[0]
+                            for _ in range(repeat)
+                        )
                         row["t_linear"] = lin
                         row["contact_over_linear"] = row["t_run"] / lin
                     if row["status"] == "ok" and speedup and comm.size > 1:

@@ -72,8 +72,7 @@ def _escape(text: str) -> str:
 
 def markdown_table(rows: list[dict], columns: list[tuple[str, str]]) -> str:
     """Rows as a Markdown table with the (key, heading) columns."""
-    lines = ["| " + " | ".join(_escape(h) for _, h in columns) + " |",
-             "|" + "---|" * len(columns)]  # fmt: skip
+    lines = ["| " + " | ".join(_escape(h) for _, h in columns) + " |", "|" + "---|" * len(columns)]
     for r in rows:
         lines.append("| " + " | ".join(_escape(_cell(r.get(k, ""))) for k, _ in columns) + " |")
     return "\n".join(lines)
@@ -98,16 +97,21 @@ def _series(rows: list[dict]) -> dict[tuple[str, int], list[dict]]:
 
 def _has(rows: list[dict], column: str, floor: float = 0.0) -> bool:
     """Some successful row has an error above ``floor`` in the column."""
-    return any(r.get("status") == "ok" and math.isfinite(r.get(column, math.nan)) and
-               r[column] > floor for r in rows)  # fmt: skip
+    return any(
+        r.get("status") == "ok" and math.isfinite(r.get(column, math.nan)) and r[column] > floor
+        for r in rows
+    )
 
 
 #: optional bench columns that are values, not errors (shown where some row has them)
 VALUE_COLUMNS = (
-    ("Q_over_bound", "Q / (mu P)"), ("c_over_a_computed", "stick c / a"),
-    ("t_contact", "t contact"), ("contact_over_bulk", "contact over bulk"),
-    ("contact_over_linear", "contact over linear"), ("speedup", "speedup"),
-)  # fmt: skip
+    ("Q_over_bound", "Q / (mu P)"),
+    ("c_over_a_computed", "stick c / a"),
+    ("t_contact", "t contact"),
+    ("contact_over_bulk", "contact over bulk"),
+    ("contact_over_linear", "contact over linear"),
+    ("speedup", "speedup"),
+)
 
 
 def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[Path]:
@@ -128,10 +132,15 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
         "bench.csv). Rates: least-squares slope of log(error) against log(h) over the levels "
         "(last pair in brackets).",
     ]
-    md += ["", "## Which method for which problem", "",
-           "From the tables below (generated): per case, the most accurate method at the finest "
-           "level every method reached, the fastest one whose error is within twice that, the "
-           "one with the fewest Newton iterations, and the runs that failed.", ""]  # fmt: skip
+    md += [
+        "",
+        "## Which method for which problem",
+        "",
+        "From the tables below (generated): per case, the most accurate method at the finest "
+        "level every method reached, the fastest one whose error is within twice that, the "
+        "one with the fewest Newton iterations, and the runs that failed.",
+        "",
+    ]
     md += method_guide(rows)
     for case_name in dict.fromkeys(r["case"] for r in rows):
         case_rows = [r for r in rows if r["case"] == case_name]
@@ -139,18 +148,30 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
         # exact by construction (e.g. the force under force control): tabulated, not plotted
         plotted = [m for m in measures if _has(case_rows, m, ROUNDOFF)]
         md += ["", f"## {case_name}: {CASES[case_name].summary}", ""]
-        cols = [("method", "method"), ("degree", "P"), ("level", "level"), ("h", "h"),
-                ("dofs", "dofs"), ("newton", "Newton"), ("ksp", "KSP"),
-                ("t_mesh", "t mesh"), ("t_compile", "t compile"), ("t_assembly", "t assembly"),
-                ("t_solve", "t solve"), ("memory_mib", "memory MiB")]  # fmt: skip
+        cols = [
+            ("method", "method"),
+            ("degree", "P"),
+            ("level", "level"),
+            ("h", "h"),
+            ("dofs", "dofs"),
+            ("newton", "Newton"),
+            ("ksp", "KSP"),
+            ("t_mesh", "t mesh"),
+            ("t_compile", "t compile"),
+            ("t_assembly", "t assembly"),
+            ("t_solve", "t solve"),
+            ("memory_mib", "memory MiB"),
+        ]
         cols += [(m, MEASURES[m][0]) for m in measures]
         cols += [(k, heading) for k, heading in VALUE_COLUMNS if any(k in r for r in case_rows)]
         cols.append(("status", "status"))
         md.append(markdown_table(case_rows, cols))
         bad = [r for r in case_rows if r["status"] != "ok"]
         if bad:
-            md += [""] + [f"- {r['method']} P{r['degree']} level {r['level']}: {r['status']}"
-                          f" ({r['reason']})" for r in bad]  # fmt: skip
+            md += [""] + [
+                f"- {r['method']} P{r['degree']} level {r['level']}: {r['status']} ({r['reason']})"
+                for r in bad
+            ]
         series = _series(case_rows)
         if not measures:
             continue
@@ -163,15 +184,23 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
             rate_rows.append(rr)
         if any(len(s) > 1 for s in series.values()):
             md += ["", "Observed rates:", ""]
-            md.append(markdown_table(rate_rows, [("method", "method"), ("degree", "P")] +
-                                     [(m, MEASURES[m][0]) for m in plotted]))  # fmt: skip
+            md.append(
+                markdown_table(
+                    rate_rows,
+                    [("method", "method"), ("degree", "P")]
+                    + [(m, MEASURES[m][0]) for m in plotted],
+                )
+            )
         for m in plotted:
             for kind in ("time", "h"):
                 path = out / f"{case_name}_{m[4:]}_{kind}.png"
                 _plot(plt, series, m, kind, f"{case_name}: {MEASURES[m][0]}", path)
                 written.append(path)
-            md += ["", f"![{case_name} {m} vs time]({case_name}_{m[4:]}_time.png)"
-                   f" ![{case_name} {m} vs h]({case_name}_{m[4:]}_h.png)"]  # fmt: skip
+            md += [
+                "",
+                f"![{case_name} {m} vs time]({case_name}_{m[4:]}_time.png)"
+                f" ![{case_name} {m} vs h]({case_name}_{m[4:]}_h.png)",
+            ]
         md += _beside(plt, rows, case_name, plotted, out, written)
     path = out / "bench.md"
     path.write_text("\n".join(md) + "\n")
@@ -179,8 +208,9 @@ def write_bench(rows: list[dict], out: Path, ranks: int, total: float) -> list[P
     return written
 
 
-def _beside(plt, rows: list[dict], case_name: str, plotted: list[str], out: Path,
-            written: list[Path]) -> list[str]:  # fmt: skip
+def _beside(
+    plt, rows: list[dict], case_name: str, plotted: list[str], out: Path, written: list[Path]
+) -> list[str]:
     """The case with the one it is benched beside (``BenchCase.beside``, e.g. an unfitted
     crack beside the fitted one) in common figures: the measures both have, every series
     labelled with its case. Returns the Markdown lines."""
@@ -207,9 +237,26 @@ def _beside(plt, rows: list[dict], case_name: str, plotted: list[str], out: Path
 
 
 #: one colour per method variant (tab10 and eight more of distinct hue), in order of appearance
-PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
-           "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8", "#ffbb78", "#98df8a",
-           "#c5b0d5", "#c49c94", "#f7b6d2", "#dbdb8d")  # fmt: skip
+PALETTE = (
+    "#1f77b4",
+    "#ff7f0e",
+    "#2ca02c",
+    "#d62728",
+    "#9467bd",
+    "#8c564b",
+    "#e377c2",
+    "#7f7f7f",
+    "#bcbd22",
+    "#17becf",
+    "#000000",
+    "#aec7e8",
+    "#ffbb78",
+    "#98df8a",
+    "#c5b0d5",
+    "#c49c94",
+    "#f7b6d2",
+    "#dbdb8d",
+)
 #: one line style and marker per degree
 DEGREE_STYLE = {1: ("-", "o"), 2: ("--", "s"), 3: (":", "^")}
 
@@ -219,8 +266,10 @@ def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
     legend beside the axes (off the data)."""
     from contactfx.validation.bench import observed_rates
 
-    colours = {label: PALETTE[i % len(PALETTE)]
-               for i, label in enumerate(dict.fromkeys(label for label, _ in series))}  # fmt: skip
+    colours = {
+        label: PALETTE[i % len(PALETTE)]
+        for i, label in enumerate(dict.fromkeys(label for label, _ in series))
+    }
     fig, ax = plt.subplots(figsize=(8.4, 4.4))
     for (label, degree), srs in series.items():
         pts = [(r["t_run"] if kind == "time" else r["h"], r[column]) for r in srs]
@@ -232,8 +281,9 @@ def _plot(plt, series, column: str, kind: str, title: str, path: Path) -> None:
         if kind == "h" and len(pts) > 1:
             name += f" (rate {observed_rates(srs, column)[0]:.2f})"
         line, marker = DEGREE_STYLE.get(degree, ("-.", "v"))
-        ax.loglog(x, e, linestyle=line, marker=marker, color=colours[label], label=name,
-                  markersize=4)  # fmt: skip
+        ax.loglog(
+            x, e, linestyle=line, marker=marker, color=colours[label], label=name, markersize=4
+        )
     ax.set_xlabel("wall time, assembly + solve [s]" if kind == "time" else "h (contact zone)")
     ax.set_ylabel("relative error")
     ax.set_title(title)
@@ -255,13 +305,17 @@ def method_guide(rows: list[dict]) -> list[str]:
     from contactfx.results import PRIMARY
     from contactfx.validation.bench import MEASURES, ROUNDOFF
 
-    lines = ["| case | yardstick | most accurate | fastest within 2x its error | "
-             "fewest Newton | failed |", "|---|---|---|---|---|---|"]  # fmt: skip
+    lines = [
+        "| case | yardstick | most accurate | fastest within 2x its error | "
+        "fewest Newton | failed |",
+        "|---|---|---|---|---|---|",
+    ]
     for case in dict.fromkeys(r["case"] for r in rows):
         case_rows = [r for r in rows if r["case"] == case]
         measures = [m for m in MEASURES if _has(case_rows, m)]
-        failed = sorted({f"{r['method']} P{r['degree']}" for r in case_rows
-                         if r["status"] not in ("ok", "n/a")})  # fmt: skip
+        failed = sorted(
+            {f"{r['method']} P{r['degree']}" for r in case_rows if r["status"] not in ("ok", "n/a")}
+        )
         above = [m for m in measures if _has(case_rows, m, ROUNDOFF)]
         if not above:
             continue
@@ -318,11 +372,20 @@ def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[
         "the computed force (p L2: pressure in L2 on the contact boundary; punch p: "
         "pi sqrt(a^2 - x^2) p / P - 1 on |x| <= 0.8 a; Q = mu P: gross-slip force).",
     ]
-    cols = [("case", "case"), ("method", "method"), ("status", "status"),
-            ("newton", "Newton"), ("cutbacks", "cut-backs"),
-            ("penetration_over_h", "penetration / h"), ("complementarity", "|g p| / (p0 h)"),
-            ("error_measure", "error of"), ("error", "error"), ("p0_error", "p0 error"),
-            ("time", "time [s]"), ("reason", "reason")]  # fmt: skip
+    cols = [
+        ("case", "case"),
+        ("method", "method"),
+        ("status", "status"),
+        ("newton", "Newton"),
+        ("cutbacks", "cut-backs"),
+        ("penetration_over_h", "penetration / h"),
+        ("complementarity", "|g p| / (p0 h)"),
+        ("error_measure", "error of"),
+        ("error", "error"),
+        ("p0_error", "p0 error"),
+        ("time", "time [s]"),
+        ("reason", "reason"),
+    ]
     for axis in dict.fromkeys(r["axis"] for r in rows):
         md += ["", f"## {axis}", "", markdown_table([r for r in rows if r["axis"] == axis], cols)]
     if any(r["axis"] == "gamma0" for r in rows):
@@ -375,9 +438,13 @@ def write_results_page(folder: Path, page: Path) -> Path:
     """The results page: the bench and stress Markdown of ``folder`` (bench/, stress/) under
     one heading, headings demoted one level and image links made relative to the page."""
     folder, page = Path(folder), Path(page)
-    parts = ["# contactfx results", "",
-             "Made by `make results` (`contactfx bench` and `contactfx stress`); the CSV files "
-             "beside the plots hold every number.", ""]  # fmt: skip
+    parts = [
+        "# contactfx results",
+        "",
+        "Made by `make results` (`contactfx bench` and `contactfx stress`); the CSV files "
+        "beside the plots hold every number.",
+        "",
+    ]
     for sub in ("bench", "stress"):
         md = folder / sub / f"{sub}.md"
         if not md.exists():

@@ -63,49 +63,103 @@ def cases() -> list[StressCase]:
     hz = dict(_COARSE)
     for theta in (1, 0, -1):
         for g in GAMMA0S:
-            out.append(StressCase(f"gamma0 theta={theta} g0={g:g}", "gamma0", "hertz2d", hz,
-                                  {"method": "nitsche", "theta": theta, "gamma0": g},
-                                  quick=g in (1e-3, 10.0, 1e4)))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"gamma0 theta={theta} g0={g:g}",
+                    "gamma0",
+                    "hertz2d",
+                    hz,
+                    {"method": "nitsche", "theta": theta, "gamma0": g},
+                    quick=g in (1e-3, 10.0, 1e4),
+                )
+            )
     for g in GAMMA0S:
-        out.append(StressCase(f"gamma0 theta=1 g0={g:g} nodal", "gamma0, nodal quadrature",
-                              "hertz2d", hz, {"method": "nitsche", "theta": 1, "gamma0": g,
-                                              "quadrature": "nodal"}, quick=g == 1e4))  # fmt: skip
+        out.append(
+            StressCase(
+                f"gamma0 theta=1 g0={g:g} nodal",
+                "gamma0, nodal quadrature",
+                "hertz2d",
+                hz,
+                {"method": "nitsche", "theta": 1, "gamma0": g, "quadrature": "nodal"},
+                quick=g == 1e4,
+            )
+        )
     for k in (1.0, 10.0, 1e2, 1e3, 1e4):
         num = {"method": "penalty", "penalty": k}
-        out.append(StressCase(f"penalty {k:g}", "penalty", "hertz2d", hz, num,
-                              quick=k in (10.0, 1e4)))  # fmt: skip
+        out.append(
+            StressCase(f"penalty {k:g}", "penalty", "hertz2d", hz, num, quick=k in (10.0, 1e4))
+        )
     for nu in (0.3, 0.49, 0.4999):
         for name, extra in (
             ("P1", {"degree": 1}),
             ("P2", {"degree": 2}),
             ("P2/P1 mixed u-p", {"degree": 2, "formulation": "mixed-up"}),
         ):
-            out.append(StressCase(f"nu={nu:g} {name}", "Poisson ratio", "hertz2d",
-                                  {**hz, "nu": nu}, {"method": "nitsche", **extra},
-                                  quick=nu == 0.4999 and name != "P2"))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"nu={nu:g} {name}",
+                    "Poisson ratio",
+                    "hertz2d",
+                    {**hz, "nu": nu},
+                    {"method": "nitsche", **extra},
+                    quick=nu == 0.4999 and name != "P2",
+                )
+            )
     for ratio in (1.0, 1e3, 1e6, 1e-3, 1e-6):
         layer = {"layer_thickness": 0.02, "layer_E": 1000.0 / ratio}
         kind = "soft layer" if ratio > 1 else "stiff layer" if ratio < 1 else "same"
-        out.append(StressCase(f"E/E_layer={ratio:g} ({kind})", "stiffness contrast",
-                              "hertz2d", {**hz, **layer}, {"method": "nitsche"},
-                              quick=ratio == 1e6))  # fmt: skip
+        out.append(
+            StressCase(
+                f"E/E_layer={ratio:g} ({kind})",
+                "stiffness contrast",
+                "hertz2d",
+                {**hz, **layer},
+                {"method": "nitsche"},
+                quick=ratio == 1e6,
+            )
+        )
     for mu in (0.0, 0.3, 0.6, 1.0):
         for method in ({"method": "nitsche"}, {"method": "penalty"}, {"method": "al-ssn"}):
-            out.append(StressCase(f"mu={mu:g} {method['method']}", "friction", "sliding-block",
-                                  {"h": 0.1}, {**method, "friction": "coulomb", "mu": mu},
-                                  quick=mu == 1.0 and method["method"] == "nitsche"))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"mu={mu:g} {method['method']}",
+                    "friction",
+                    "sliding-block",
+                    {"h": 0.1},
+                    {**method, "friction": "coulomb", "mu": mu},
+                    quick=mu == 1.0 and method["method"] == "nitsche",
+                )
+            )
     # a stick 100 times stiffer than the defaults (see test_friction.py)
     stiff = {"nitsche": "gamma0", "penalty": "penalty", "al-uzawa": "r0", "al-ssn": "r0"}
     for method, key in stiff.items():
-        out.append(StressCase(f"mu=0.3 {method} {key}=1000", "friction", "sliding-block",
-                              {"h": 0.1}, {"method": method, key: 1000.0,
-                                           "friction": "coulomb", "mu": 0.3}))  # fmt: skip
+        out.append(
+            StressCase(
+                f"mu=0.3 {method} {key}=1000",
+                "friction",
+                "sliding-block",
+                {"h": 0.1},
+                {"method": method, key: 1000.0, "friction": "coulomb", "mu": 0.3},
+            )
+        )
         # partial slip under a curved indenter (the vertex rule where a method has a choice)
         nodal = {"quadrature": "nodal"} if method_class(method).supports.nodal_quadrature else {}
-        out.append(StressCase(f"hertz2d shift mu=0.3 {method} {key}=1000", "friction",
-                              "hertz2d", {"shift": 5e-4},
-                              {"method": method, key: 1000.0, "friction": "coulomb", "mu": 0.3,
-                               "steps": 8, **nodal}))  # fmt: skip
+        out.append(
+            StressCase(
+                f"hertz2d shift mu=0.3 {method} {key}=1000",
+                "friction",
+                "hertz2d",
+                {"shift": 5e-4},
+                {
+                    "method": method,
+                    key: 1000.0,
+                    "friction": "coulomb",
+                    "mu": 0.3,
+                    "steps": 8,
+                    **nodal,
+                },
+            )
+        )
     onset = [
         ("zero initial gap, 1 step", {}, {"steps": 1}, True),
         ("grazing (a ~ h/2)", {"depth": 2e-5}, {"steps": 1}, True),
@@ -113,26 +167,67 @@ def cases() -> list[StressCase]:
         ("front crossing edges, 20 steps", {}, {"steps": 20}, False),
     ]
     for name, params, num, quick in onset:
-        out.append(StressCase(name, "contact onset", "hertz2d", {**hz, **params},
-                              {"method": "nitsche", **num}, quick=quick))  # fmt: skip
+        out.append(
+            StressCase(
+                name,
+                "contact onset",
+                "hertz2d",
+                {**hz, **params},
+                {"method": "nitsche", **num},
+                quick=quick,
+            )
+        )
     for method in ("nitsche", "al-ssn"):
-        out.append(StressCase(f"flat punch edge, {method}", "corners", "punch2d", {},
-                              {"method": method}, quick=method == "nitsche"))  # fmt: skip
-    for method in ({"method": "nitsche"}, {"method": "penalty", "penalty": 100.0},
-                   {"method": "al-ssn"}):  # fmt: skip
+        out.append(
+            StressCase(
+                f"flat punch edge, {method}",
+                "corners",
+                "punch2d",
+                {},
+                {"method": method},
+                quick=method == "nitsche",
+            )
+        )
+    for method in (
+        {"method": "nitsche"},
+        {"method": "penalty", "penalty": 100.0},
+        {"method": "al-ssn"},
+    ):
         for steps in (1, 20):
-            out.append(StressCase(f"depth 1.5e-2 in {steps} step(s), {method['method']}",
-                                  "load steps", "hertz2d", {**hz, "depth": 1.5e-2},
-                                  {**method, "steps": steps},
-                                  quick=steps == 1 and method["method"] == "nitsche"))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"depth 1.5e-2 in {steps} step(s), {method['method']}",
+                    "load steps",
+                    "hertz2d",
+                    {**hz, "depth": 1.5e-2},
+                    {**method, "steps": steps},
+                    quick=steps == 1 and method["method"] == "nitsche",
+                )
+            )
     for method in ("nitsche", "al-ssn"):
-        out.append(StressCase(f"interference gap0=-3e-3, {method}", "initial penetration",
-                              "hertz2d", {**hz, "gap0": -3e-3}, {"method": method, "steps": 4},
-                              quick=method == "nitsche"))  # fmt: skip
+        out.append(
+            StressCase(
+                f"interference gap0=-3e-3, {method}",
+                "initial penetration",
+                "hertz2d",
+                {**hz, "gap0": -3e-3},
+                {"method": method, "steps": 4},
+                quick=method == "nitsche",
+            )
+        )
     out += _interface_cases()
     for ranks in (1, 2, 3):
-        out.append(StressCase(f"{ranks} rank(s)", "parallel", "hertz2d", hz,
-                              {"method": "nitsche"}, quick=ranks < 3, ranks=ranks))  # fmt: skip
+        out.append(
+            StressCase(
+                f"{ranks} rank(s)",
+                "parallel",
+                "hertz2d",
+                hz,
+                {"method": "nitsche"},
+                quick=ranks < 3,
+                ranks=ranks,
+            )
+        )
     return out
 
 
@@ -142,18 +237,38 @@ def _interface_cases() -> list[StressCase]:
     crack = {"h_crack": 0.05, "h_tip": 0.005, "h_far": 1.0, "grading": 0.3}
     for mu in (0.0, 0.3, 0.6, 1.0):
         for method in ("nitsche", "al-ssn"):
-            out.append(StressCase(f"crack beta=45 mu={mu:g}, {method}", "crack friction",
-                                  "crack-inclined", crack, {"method": method, "mu": mu},
-                                  quick=mu == 0.3 and method == "nitsche"))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"crack beta=45 mu={mu:g}, {method}",
+                    "crack friction",
+                    "crack-inclined",
+                    crack,
+                    {"method": method, "mu": mu},
+                    quick=mu == 0.3 and method == "nitsche",
+                )
+            )
     for beta in (5.0, 85.0):  # nearly normal and nearly parallel to the compression
-        out.append(StressCase(f"crack beta={beta:g} mu=0.3", "crack friction", "crack-inclined",
-                              {**crack, "beta": beta}, {"method": "nitsche"}))  # fmt: skip
+        out.append(
+            StressCase(
+                f"crack beta={beta:g} mu=0.3",
+                "crack friction",
+                "crack-inclined",
+                {**crack, "beta": beta},
+                {"method": "nitsche"},
+            )
+        )
     for p_net in (6e5, 3e5, -1e6, -20e6):  # p* = 3.08e5: open, barely propped, closing
         for method in ("nitsche", "al-ssn"):
-            out.append(StressCase(f"proppant p_net={p_net:g}, {method}", "proppant",
-                                  "propped-fracture", {**crack, "net_pressure": p_net},
-                                  {"method": method},
-                                  quick=p_net == -1e6 and method == "nitsche"))  # fmt: skip
+            out.append(
+                StressCase(
+                    f"proppant p_net={p_net:g}, {method}",
+                    "proppant",
+                    "propped-fracture",
+                    {**crack, "net_pressure": p_net},
+                    {"method": method},
+                    quick=p_net == -1e6 and method == "nitsche",
+                )
+            )
     # an unfitted crack's position against the nodes of the structured plate (h = a / 20
     # around the crack): along the edges, 1e-6 h off them, between them, through the nodes
     # diagonally; and the unfitted crack on the graded mesh at a shallow angle
@@ -166,12 +281,25 @@ def _interface_cases() -> list[StressCase]:
         ("along diagonal edges, beta=45 mu=0", "crack-inclined", {"beta": 45.0}),
     ):
         numerics = {"method": "nitsche", **({"mu": 0.0} if scene == "crack-inclined" else {})}
-        out.append(StressCase(f"unfitted crack {name}", "unfitted crack position", scene,
-                              {**grid, **params}, numerics,
-                              quick=name == "1e-6 h off the nodes"))  # fmt: skip
-    out.append(StressCase("unfitted crack beta=10 mu=0.3 (graded)", "unfitted crack position",
-                          "crack-inclined", {**crack, "beta": 10.0, "crack": "unfitted"},
-                          {"method": "nitsche"}))  # fmt: skip
+        out.append(
+            StressCase(
+                f"unfitted crack {name}",
+                "unfitted crack position",
+                scene,
+                {**grid, **params},
+                numerics,
+                quick=name == "1e-6 h off the nodes",
+            )
+        )
+    out.append(
+        StressCase(
+            "unfitted crack beta=10 mu=0.3 (graded)",
+            "unfitted crack position",
+            "crack-inclined",
+            {**crack, "beta": 10.0, "crack": "unfitted"},
+            {"method": "nitsche"},
+        )
+    )
     # the 3D cracks on the coarse penny mesh (h_front = a / 5, P2): closing under suction,
     # sliding without friction, sticking (penny-shear at mu 1.2 > tan 45; the fault at dip 80,
     # where abs(tau) = 2.05 MPa < 0.3 sigma_n = 2.51 MPa), a fault held by 0.5 MPa of
@@ -184,13 +312,24 @@ def _interface_cases() -> list[StressCase]:
         ("fault-block dip=80 (stick)", "fault-block", {"dip": 80.0}, {}),
         ("fault-block overpressure=10.5e6", "fault-block", {"overpressure": 10.5e6}, {}),
     ):
-        out.append(StressCase(name, "3D crack", scene, {**penny, **params},
-                              {"method": "nitsche", **numerics}))  # fmt: skip
+        out.append(
+            StressCase(
+                name, "3D crack", scene, {**penny, **params}, {"method": "nitsche", **numerics}
+            )
+        )
     for s_c, p in ((30e6, 10e6), (3e9, 0.0), (30e6, 29.9e6), (30e6, 40e6)):
         # the last: fluid pressure above the load, no equilibrium (refused)
-        out.append(StressCase(f"joint s_c={s_c:g} p={p:g}", "joint closure", "joint-column",
-                              {"closure_stress": s_c, "fluid_pressure": p}, {"method": "nitsche"},
-                              quick=s_c == 3e9, refused=p > s_c))  # fmt: skip
+        out.append(
+            StressCase(
+                f"joint s_c={s_c:g} p={p:g}",
+                "joint closure",
+                "joint-column",
+                {"closure_stress": s_c, "fluid_pressure": p},
+                {"method": "nitsche"},
+                quick=s_c == 3e9,
+                refused=p > s_c,
+            )
+        )
     return out
 
 
@@ -219,12 +358,18 @@ def _row(case: StressCase, res: RunSummary | None, error: str, wall: float) -> d
     h = res.h_contact
     p0 = max(res.peak_pressure, 1e-300)
     row.update(
-        status="converged", reason="", newton=res.newton_iterations, cutbacks=res.cutbacks,
+        status="converged",
+        reason="",
+        newton=res.newton_iterations,
+        cutbacks=res.cutbacks,
         penetration_over_h=abs(res.max_penetration) / h,
         complementarity=res.complementarity / (p0 * h),
-        error_measure=name, error=value, p0_error=measure(res, "err_p0"),
-        force=res.force, time=wall,
-    )  # fmt: skip
+        error_measure=name,
+        error=value,
+        p0_error=measure(res, "err_p0"),
+        force=res.force,
+        time=wall,
+    )
     return row
 
 
@@ -252,11 +397,24 @@ def run_child(case: StressCase, limit: float) -> dict:
     args = [f"--{k.replace('_', '-')}={v}" for k, v in {**case.params, **case.numerics}.items()]
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="contactfx-stress-") as tmp:
-        cmd = ["mpirun", "-n", str(case.ranks), sys.executable, "-m", "contactfx", "run",
-               case.scene, *args, "--quiet", "--out", tmp]  # fmt: skip
+        cmd = [
+            "mpirun",
+            "-n",
+            str(case.ranks),
+            sys.executable,
+            "-m",
+            "contactfx",
+            "run",
+            case.scene,
+            *args,
+            "--quiet",
+            "--out",
+            tmp,
+        ]
         try:
-            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=limit,
-                                  env=child_env())  # fmt: skip
+            proc = subprocess.run(
+                cmd, capture_output=True, text=True, timeout=limit, env=child_env()
+            )
         except subprocess.TimeoutExpired:
             return _row(case, None, "time limit exceeded", time.perf_counter() - t0)
         except OSError as err:

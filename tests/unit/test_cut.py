@@ -83,8 +83,9 @@ def test_cut_geometry_and_crack_quadrature(name, p0, p1):
     cut = np.flatnonzero(cells.cut).astype(np.int32)
     tags = dolfinx.mesh.meshtags(mesh, 2, cut, np.ones(len(cut), dtype=np.int32))
     dx = ufl.Measure("dx", domain=mesh, subdomain_data=tags)
-    ds = WeightedMeasure(dx(1, metadata={"quadrature_degree": 4, "quadrature_rule": "default"}),
-                         weight)  # fmt: skip
+    ds = WeightedMeasure(
+        dx(1, metadata={"quadrature_degree": 4, "quadrature_rule": "default"}), weight
+    )
     d, c0 = crack.direction, crack.centre
     psi = (Y[0] - c0[0]) * d[0] + (Y[1] - c0[1]) * d[1]
 

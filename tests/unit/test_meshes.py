@@ -374,8 +374,9 @@ def test_rectangle_interfaces() -> None:
     # the top layer (above the highest interface) is its own cell group
     layer = width * (p["y1"] - max(p["interfaces"]))
     assert _measure(data, RectangleCells.LAYER, "dx") == pytest.approx(layer, rel=1e-12)
-    assert _measure(data, RectangleCells.DOMAIN, "dx") == pytest.approx(width * height - layer,
-                                                                        rel=1e-12)  # fmt: skip
+    assert _measure(data, RectangleCells.DOMAIN, "dx") == pytest.approx(
+        width * height - layer, rel=1e-12
+    )
     mesh = data.mesh
     for y in p["interfaces"]:
         on_line = dolfinx.mesh.locate_entities(mesh, 1, lambda x, y=y: np.isclose(x[1], y))
@@ -580,8 +581,13 @@ def _arc_edges(
     return ends[np.all(np.abs(distance - radius) <= 1e-12 * radius, axis=1)]
 
 
-def _check_quarter_arc(data: MeshData, tag: int, centre: tuple[float, float], radius: float,
-                       angle: float = 0.5 * math.pi):  # fmt: skip
+def _check_quarter_arc(
+    data: MeshData,
+    tag: int,
+    centre: tuple[float, float],
+    radius: float,
+    angle: float = 0.5 * math.pi,
+):
     """The edges tagged ``tag`` that lie on the circle approximate a quarter arc; returns the
     global area between the arc and its chords (sum of the circular segments).
 
@@ -622,10 +628,15 @@ def test_stacked_blocks(stacked_blocks_mesh: MeshData) -> None:
     assert _measure(data, cells.LOWER, "dx") == pytest.approx(w * hl, rel=1e-12)
     assert _measure(data, cells.UPPER, "dx") == pytest.approx(wu * hu, rel=1e-12)
     lengths = {
-        facets.LOWER_BOTTOM: w, facets.LOWER_RIGHT: hl, facets.LOWER_TOP: w,
-        facets.LOWER_LEFT: hl, facets.UPPER_BOTTOM: wu, facets.UPPER_RIGHT: hu,
-        facets.UPPER_TOP: wu, facets.UPPER_LEFT: hu,
-    }  # fmt: skip
+        facets.LOWER_BOTTOM: w,
+        facets.LOWER_RIGHT: hl,
+        facets.LOWER_TOP: w,
+        facets.LOWER_LEFT: hl,
+        facets.UPPER_BOTTOM: wu,
+        facets.UPPER_RIGHT: hu,
+        facets.UPPER_TOP: wu,
+        facets.UPPER_LEFT: hu,
+    }
     for tag, length in lengths.items():
         assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
     _check_separate_bodies(data, cells.LOWER, cells.UPPER)
@@ -669,11 +680,19 @@ def test_stacked_boxes(stacked_boxes_mesh: MeshData) -> None:
     assert _measure(data, cells.LOWER, "dx") == pytest.approx(w * w * hl, rel=1e-12)
     assert _measure(data, cells.UPPER, "dx") == pytest.approx(wu * wu * hu, rel=1e-12)
     areas = {
-        facets.LOWER_X0: w * hl, facets.LOWER_X1: w * hl, facets.LOWER_Y0: w * hl,
-        facets.LOWER_Y1: w * hl, facets.LOWER_BOTTOM: w * w, facets.LOWER_TOP: w * w,
-        facets.UPPER_X0: wu * hu, facets.UPPER_X1: wu * hu, facets.UPPER_Y0: wu * hu,
-        facets.UPPER_Y1: wu * hu, facets.UPPER_BOTTOM: wu * wu, facets.UPPER_TOP: wu * wu,
-    }  # fmt: skip
+        facets.LOWER_X0: w * hl,
+        facets.LOWER_X1: w * hl,
+        facets.LOWER_Y0: w * hl,
+        facets.LOWER_Y1: w * hl,
+        facets.LOWER_BOTTOM: w * w,
+        facets.LOWER_TOP: w * w,
+        facets.UPPER_X0: wu * hu,
+        facets.UPPER_X1: wu * hu,
+        facets.UPPER_Y0: wu * hu,
+        facets.UPPER_Y1: wu * hu,
+        facets.UPPER_BOTTOM: wu * wu,
+        facets.UPPER_TOP: wu * wu,
+    }
     for tag, area in areas.items():
         assert _measure(data, tag) == pytest.approx(area, rel=1e-12), tag.name
     _check_separate_bodies(data, cells.LOWER, cells.UPPER)
@@ -685,8 +704,12 @@ def test_cylinders(cylinders_mesh: MeshData) -> None:
     r1, r2, h_far = p["radius_upper"], p["radius_lower"], p["h_far"]
     cells, facets = CylindersCells, CylindersFacets
     _check_boundary_tagged_once(data)
-    for tag, length in ((facets.LOWER_BOTTOM, r2), (facets.LOWER_SYMMETRY, r2),
-                        (facets.UPPER_TOP, r1), (facets.UPPER_SYMMETRY, r1)):  # fmt: skip
+    for tag, length in (
+        (facets.LOWER_BOTTOM, r2),
+        (facets.LOWER_SYMMETRY, r2),
+        (facets.UPPER_TOP, r1),
+        (facets.UPPER_SYMMETRY, r1),
+    ):
         assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
     for body, contact, centre, radius in (
         (cells.LOWER, facets.LOWER_CONTACT, (0.0, -r2), r2),
@@ -714,8 +737,12 @@ def test_cylinders_full() -> None:
     r1, r2, h_far = p["radius_upper"], p["radius_lower"], p["h_far"]
     cells, facets = CylindersCells, CylindersFacets
     _check_boundary_tagged_once(data)
-    for tag, length in ((facets.LOWER_BOTTOM, 2 * r2), (facets.UPPER_TOP, 2 * r1),
-                        (facets.LOWER_SYMMETRY, 0.0), (facets.UPPER_SYMMETRY, 0.0)):  # fmt: skip
+    for tag, length in (
+        (facets.LOWER_BOTTOM, 2 * r2),
+        (facets.UPPER_TOP, 2 * r1),
+        (facets.LOWER_SYMMETRY, 0.0),
+        (facets.UPPER_SYMMETRY, 0.0),
+    ):
         assert _measure(data, tag) == pytest.approx(length, rel=1e-12, abs=1e-14), tag.name
     for body, contact, centre, radius in (
         (cells.LOWER, facets.LOWER_CONTACT, (0.0, -r2), r2),
@@ -737,8 +764,10 @@ def test_cylinders_full() -> None:
 
 def test_cylinders_sizes(cylinders_mesh: MeshData) -> None:
     p, data = CYLINDERS, cylinders_mesh
-    for body, h in ((CylindersCells.LOWER, p["h_contact"]),
-                    (CylindersCells.UPPER, p["ratio"] * p["h_contact"])):  # fmt: skip
+    for body, h in (
+        (CylindersCells.LOWER, p["h_contact"]),
+        (CylindersCells.UPPER, p["ratio"] * p["h_contact"]),
+    ):
         sizes, midpoints = _cell_sizes(data, body)
         distance = np.linalg.norm(midpoints[:, :2], axis=1)
         graded = p["refine"] + (p["h_far"] - h) / p["grading"]
@@ -752,10 +781,14 @@ def test_punch_foundation(punch_foundation_mesh: MeshData) -> None:
     _check_boundary_tagged_once(data)
     assert _measure(data, cells.BLOCK, "dx") == pytest.approx(w * depth, rel=1e-12)
     lengths = {
-        facets.BLOCK_TOP: w, facets.BLOCK_RIGHT: depth, facets.BLOCK_BOTTOM: w,
-        facets.BLOCK_SYMMETRY: depth, facets.PUNCH_SIDE: hp - rho, facets.PUNCH_TOP: b,
+        facets.BLOCK_TOP: w,
+        facets.BLOCK_RIGHT: depth,
+        facets.BLOCK_BOTTOM: w,
+        facets.BLOCK_SYMMETRY: depth,
+        facets.PUNCH_SIDE: hp - rho,
+        facets.PUNCH_TOP: b,
         facets.PUNCH_SYMMETRY: hp,
-    }  # fmt: skip
+    }
     for tag, length in lengths.items():
         assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
     # The contact facets: the flat face (edges on y = 0) and the rounded edge (on the circle).
@@ -782,8 +815,10 @@ def test_punch_foundation(punch_foundation_mesh: MeshData) -> None:
 
 def test_punch_foundation_sizes(punch_foundation_mesh: MeshData) -> None:
     p, data = PUNCH_FOUNDATION, punch_foundation_mesh
-    for body, h in ((PunchFoundationCells.BLOCK, p["h_contact"]),
-                    (PunchFoundationCells.PUNCH, p["ratio"] * p["h_contact"])):  # fmt: skip
+    for body, h in (
+        (PunchFoundationCells.BLOCK, p["h_contact"]),
+        (PunchFoundationCells.PUNCH, p["ratio"] * p["h_contact"]),
+    ):
         sizes, midpoints = _cell_sizes(data, body)
         along = np.maximum(midpoints[:, 0] - p["b"], 0.0)
         distance = np.hypot(along, midpoints[:, 1])
@@ -803,9 +838,12 @@ def test_rounded_on_block(rounded_on_block_mesh: MeshData) -> None:
     _check_boundary_tagged_once(data)
     assert _measure(data, cells.BLOCK, "dx") == pytest.approx((left + right) * depth, rel=1e-12)
     lengths = {
-        facets.BLOCK_TOP: left + right, facets.BLOCK_RIGHT: depth,
-        facets.BLOCK_BOTTOM: left + right, facets.BLOCK_LEFT: depth, facets.ROUNDED_TOP: 2 * w,
-    }  # fmt: skip
+        facets.BLOCK_TOP: left + right,
+        facets.BLOCK_RIGHT: depth,
+        facets.BLOCK_BOTTOM: left + right,
+        facets.BLOCK_LEFT: depth,
+        facets.ROUNDED_TOP: 2 * w,
+    }
     for tag, length in lengths.items():
         assert _measure(data, tag) == pytest.approx(length, rel=1e-12), tag.name
     ends = _facet_vertices(data, facets.ROUNDED_CONTACT)
@@ -866,11 +904,21 @@ def test_spheres(spheres_mesh: MeshData) -> None:
     face_vertices = mesh.topology.connectivity(2, 0).array.reshape(-1, 3)
     coordinates = _vertex_coordinates(mesh)
     for body, contact, flats, centre, radius in (
-        (cells.LOWER, facets.LOWER_CONTACT, (facets.LOWER_BOTTOM, facets.LOWER_X0,
-         facets.LOWER_Y0), (0.0, 0.0, -r2), r2),
-        (cells.UPPER, facets.UPPER_CONTACT, (facets.UPPER_TOP, facets.UPPER_X0,
-         facets.UPPER_Y0), (0.0, 0.0, r1), r1),
-    ):  # fmt: skip
+        (
+            cells.LOWER,
+            facets.LOWER_CONTACT,
+            (facets.LOWER_BOTTOM, facets.LOWER_X0, facets.LOWER_Y0),
+            (0.0, 0.0, -r2),
+            r2,
+        ),
+        (
+            cells.UPPER,
+            facets.UPPER_CONTACT,
+            (facets.UPPER_TOP, facets.UPPER_X0, facets.UPPER_Y0),
+            (0.0, 0.0, r1),
+            r1,
+        ),
+    ):
         triangles = coordinates[face_vertices[data.facet_tags.find(contact)]]
         # every contact node is on the sphere
         distance = np.linalg.norm(triangles - np.asarray(centre), axis=2)
@@ -999,9 +1047,24 @@ def test_invalid_parameter_raises_on_every_rank(builder: Builder, gdim: int, mes
 def test_command_line(tmp_path) -> None:
     out = tmp_path / "block.msh"
     args = [
-        "rectangle", "--x0", "-1", "--x1", "1", "--y0", "-1", "--y1", "0",
-        "--refine-x0", "-0.1", "--refine-x1", "0.1", "--h-contact", "0.05", "--h-far", "0.2",
-    ]  # fmt: skip
+        "rectangle",
+        "--x0",
+        "-1",
+        "--x1",
+        "1",
+        "--y0",
+        "-1",
+        "--y1",
+        "0",
+        "--refine-x0",
+        "-0.1",
+        "--refine-x1",
+        "0.1",
+        "--h-contact",
+        "0.05",
+        "--h-far",
+        "0.2",
+    ]
     command = [sys.executable, "-m", "contactfx.meshes", *args]
     done = subprocess.run([*command, "--out", str(out)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
@@ -1023,13 +1086,25 @@ def test_command_line(tmp_path) -> None:
     "args",
     [
         [
-            "crack-plate", "--half-width", "1", "--crack-half-length", "0.4", "--angle", "-30",
-            "--h-crack", "0.05", "--h-far", "0.2", "--split-at", "-0.1", "0.2",
+            "crack-plate",
+            "--half-width",
+            "1",
+            "--crack-half-length",
+            "0.4",
+            "--angle",
+            "-30",
+            "--h-crack",
+            "0.05",
+            "--h-far",
+            "0.2",
+            "--split-at",
+            "-0.1",
+            "0.2",
         ],
         ["joint-column", "--width", "1", "--block-height", "0.5", "--h", "0.1"],
     ],
     ids=["crack-plate", "joint-column"],
-)  # fmt: skip
+)
 def test_command_line_interior_facets(tmp_path, args: list[str]) -> None:
     out = tmp_path / "mesh.msh"
     command = [sys.executable, "-m", "contactfx.meshes", *args, "--out", str(out)]
@@ -1048,41 +1123,147 @@ def test_command_line_interior_facets(tmp_path, args: list[str]) -> None:
     ("args", "cells", "group"),
     [
         (
-            ["stacked-blocks", "--width", "1", "--h-lower", "0.5", "--h-upper", "0.3",
-             "--h1", "0.1", "--ratio", "0.7", "--offset", "0.3"],
-            "triangles", '1 5 "upper_bottom"',
+            [
+                "stacked-blocks",
+                "--width",
+                "1",
+                "--h-lower",
+                "0.5",
+                "--h-upper",
+                "0.3",
+                "--h1",
+                "0.1",
+                "--ratio",
+                "0.7",
+                "--offset",
+                "0.3",
+            ],
+            "triangles",
+            '1 5 "upper_bottom"',
         ),
         (
-            ["stacked-boxes", "--width", "1", "--h-lower", "0.5", "--h-upper", "0.3",
-             "--h1", "0.25", "--ratio", "0.7", "--upper-width", "0.5"],
-            "tetrahedra", '2 11 "upper_bottom"',
+            [
+                "stacked-boxes",
+                "--width",
+                "1",
+                "--h-lower",
+                "0.5",
+                "--h-upper",
+                "0.3",
+                "--h1",
+                "0.25",
+                "--ratio",
+                "0.7",
+                "--upper-width",
+                "0.5",
+            ],
+            "tetrahedra",
+            '2 11 "upper_bottom"',
         ),
         (
-            ["cylinders", "--radius-lower", "2", "--radius-upper", "1", "--h-contact", "0.02",
-             "--h-far", "0.2", "--refine", "0.1", "--ratio", "0.6", "--offset", "0.5"],
-            "triangles", '1 4 "upper_contact"',
+            [
+                "cylinders",
+                "--radius-lower",
+                "2",
+                "--radius-upper",
+                "1",
+                "--h-contact",
+                "0.02",
+                "--h-far",
+                "0.2",
+                "--refine",
+                "0.1",
+                "--ratio",
+                "0.6",
+                "--offset",
+                "0.5",
+            ],
+            "triangles",
+            '1 4 "upper_contact"',
         ),
         (
-            ["spheres", "--radius-lower", "2", "--radius-upper", "1", "--h-contact", "0.1",
-             "--h-far", "0.4", "--refine", "0.1", "--ratio", "0.6"],
-            "tetrahedra", '2 5 "upper_contact"',
+            [
+                "spheres",
+                "--radius-lower",
+                "2",
+                "--radius-upper",
+                "1",
+                "--h-contact",
+                "0.1",
+                "--h-far",
+                "0.4",
+                "--refine",
+                "0.1",
+                "--ratio",
+                "0.6",
+            ],
+            "tetrahedra",
+            '2 5 "upper_contact"',
         ),
         (
-            ["punch-foundation", "--width", "3", "--depth", "2", "--b", "1", "--rho", "0.25",
-             "--h-punch", "0.8", "--h-contact", "0.02", "--h-far", "0.3", "--refine", "0.05",
-             "--ratio", "1.3"],
-            "triangles", '1 5 "punch_contact"',
+            [
+                "punch-foundation",
+                "--width",
+                "3",
+                "--depth",
+                "2",
+                "--b",
+                "1",
+                "--rho",
+                "0.25",
+                "--h-punch",
+                "0.8",
+                "--h-contact",
+                "0.02",
+                "--h-far",
+                "0.3",
+                "--refine",
+                "0.05",
+                "--ratio",
+                "1.3",
+            ],
+            "triangles",
+            '1 5 "punch_contact"',
         ),
         (
-            ["rounded-on-block", "--radius", "1", "--height", "0.2", "--left", "0.8",
-             "--right", "1", "--depth", "0.5", "--track", "0.2", "--h-contact", "0.02",
-             "--h-far", "0.2", "--refine", "0.05", "--ratio", "0.8", "--offset", "0.4"],
-            "triangles", '1 5 "rounded_contact"',
+            [
+                "rounded-on-block",
+                "--radius",
+                "1",
+                "--height",
+                "0.2",
+                "--left",
+                "0.8",
+                "--right",
+                "1",
+                "--depth",
+                "0.5",
+                "--track",
+                "0.2",
+                "--h-contact",
+                "0.02",
+                "--h-far",
+                "0.2",
+                "--refine",
+                "0.05",
+                "--ratio",
+                "0.8",
+                "--offset",
+                "0.4",
+            ],
+            "triangles",
+            '1 5 "rounded_contact"',
         ),
     ],
-    ids=["stacked-blocks", "stacked-boxes", "cylinders", "spheres", "punch-foundation",
-         "rounded-on-block"],
-)  # fmt: skip
+    ids=[
+        "stacked-blocks",
+        "stacked-boxes",
+        "cylinders",
+        "spheres",
+        "punch-foundation",
+        "rounded-on-block",
+    ],
+)
 def test_command_line_two_body(tmp_path, args: list[str], cells: str, group: str) -> None:
     out = tmp_path / "mesh.msh"
     command = [sys.executable, "-m", "contactfx.meshes", *args, "--out", str(out)]

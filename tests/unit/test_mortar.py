@@ -53,8 +53,9 @@ def test_mortar_partition_of_unity(seed):
 def test_mortar_off_master_is_uncovered():
     # the slave runs from 0 to 2, the master only from 0 to 1: the slave node at x = 2 has
     # no master (M row sum 0), the one at x = 1 half of its support covered
-    slave = Facets(np.array([[[1.0, 0.0], [0.0, 0.0]], [[2.0, 0.0], [1.0, 0.0]]]),
-                   np.array([[1, 0], [2, 1]]))  # fmt: skip
+    slave = Facets(
+        np.array([[[1.0, 0.0], [0.0, 0.0]], [[2.0, 0.0], [1.0, 0.0]]]), np.array([[1, 0], [2, 1]])
+    )
     master = Facets(np.array([[[0.0, 0.0], [1.0, 0.0]]]), np.array([[10, 11]]))
     pairs = FacetTree(master.x, 0.5).collide(FacetTree(slave.x, 0.0))
     D, _, (rows, cols, vals) = mortar_matrices(slave, master, pairs)
@@ -64,8 +65,9 @@ def test_mortar_off_master_is_uncovered():
 
 
 def test_facet_tree_candidates():
-    segments = np.array([[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [2.0, 0.0]],
-                         [[5.0, 0.0], [6.0, 0.0]]])  # fmt: skip
+    segments = np.array(
+        [[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [2.0, 0.0]], [[5.0, 0.0], [6.0, 0.0]]]
+    )
     tree = FacetTree(segments, 0.1)
     points = np.array([[0.5, 0.05], [1.0, 0.0], [3.0, 0.0]])
     rows, facets = tree.collide_points(points)
@@ -88,8 +90,12 @@ def _square(n: int, z: float, nodes0: int, rng, upward: bool) -> Facets:
     tris = []
     for a in range(n):
         for b in range(n):
-            v00, v10, v01, v11 = a * (n + 1) + b, (a + 1) * (n + 1) + b, a * (n + 1) + b + 1, (
-                a + 1) * (n + 1) + b + 1  # fmt: skip
+            v00, v10, v01, v11 = (
+                a * (n + 1) + b,
+                (a + 1) * (n + 1) + b,
+                a * (n + 1) + b + 1,
+                (a + 1) * (n + 1) + b + 1,
+            )
             if rng.random() < 0.5:
                 tris += [(v00, v10, v11), (v00, v11, v01)]
             else:
@@ -166,9 +172,12 @@ def test_triangle_overlaps_match_the_scalar_clip():
         # degree-2 rule exact), to round-off of O(1) quantities
         b = row[a]
         assert ov.area[b] == pytest.approx(one.area, rel=1e-12)
-        assert np.allclose(_moments(ov.fan_area[b], ov.slave_bary[b], ov.master_bary[b]),
-                           _moments(_areas(one.triangles), one.slave_bary, one.master_bary),
-                           rtol=0, atol=1e-14)  # fmt: skip
+        assert np.allclose(
+            _moments(ov.fan_area[b], ov.slave_bary[b], ov.master_bary[b]),
+            _moments(_areas(one.triangles), one.slave_bary, one.master_bary),
+            rtol=0,
+            atol=1e-14,
+        )
 
 
 def _areas(tri):

@@ -258,8 +258,10 @@ def test_pick_closest_ties_do_not_depend_on_the_candidate_order():
     dist = [closest_point_triangles(p, f[None]).distance[0] for f in facets]
     assert dist[0] == pytest.approx(dist[1], rel=1e-15)
     key = facet_order(facets)
-    picked = {int(pick_closest(p, np.array([order]), facets, fallback=True, key=key).index[0])
-              for order in ([0, 1], [1, 0])}  # fmt: skip
+    picked = {
+        int(pick_closest(p, np.array([order]), facets, fallback=True, key=key).index[0])
+        for order in ([0, 1], [1, 0])
+    }
     assert picked == {int(np.argmin(key))}
     # the key is the facets' own order: permuting the facets or their vertices keeps it
     assert np.array_equal(facet_order(facets[::-1]), key[::-1])

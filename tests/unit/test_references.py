@@ -224,8 +224,14 @@ def test_penny_opening_volume_and_front():
     t = np.linspace(0.0, 1.0, 201)
     w = penny_opening(a * np.sqrt(1.0 - t**2), a, p, E, nu)
     f = w * t
-    V = 2.0 * np.pi * a**2 * (t[1] - t[0]) / 3.0 * (f[0] + 4 * f[1:-1:2].sum() + 2 * f[2:-1:2].sum()
-                                                    + f[-1])  # fmt: skip
+    V = (
+        2.0
+        * np.pi
+        * a**2
+        * (t[1] - t[0])
+        / 3.0
+        * (f[0] + 4 * f[1:-1:2].sum() + 2 * f[2:-1:2].sum() + f[-1])
+    )
     assert V == pytest.approx(16.0 * (1.0 - nu**2) * p * a**3 / (3.0 * E), rel=1e-12)
     K = penny_stress_intensity(p, a)
     Ep = E / (1.0 - nu**2)

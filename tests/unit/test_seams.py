@@ -262,8 +262,9 @@ def test_one_hookes_law_for_ufl_and_the_couplings(gdim):
     rng = np.random.default_rng(3)
     n = rng.normal(size=gdim)
     n /= np.linalg.norm(n)
-    T = basis_tractions(grads[None], np.stack([n, np.zeros(gdim)]), np.full(2, lmbda),
-                        np.full(2, mu))  # fmt: skip
+    T = basis_tractions(
+        grads[None], np.stack([n, np.zeros(gdim)]), np.full(2, lmbda), np.full(2, mu)
+    )
     assert np.all(T[1] == 0.0)
     material = Elastic(E, nu)
     w = dolfinx.fem.Function(V)

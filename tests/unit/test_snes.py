@@ -97,9 +97,12 @@ def make_solver(prefix, bulk="linear", **kwargs):
         bulk = LinearBulk(stiffness=dolfinx.fem.form(a), load=load)
     else:
         f_int = E * ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx
-        bulk = NonlinearBulk(internal=dolfinx.fem.form(f_int),
-                             tangent=dolfinx.fem.form(ufl.derivative(f_int, u, du)), load=load,
-                             constant_jacobian=bulk == "constant")  # fmt: skip
+        bulk = NonlinearBulk(
+            internal=dolfinx.fem.form(f_int),
+            tangent=dolfinx.fem.form(ufl.derivative(f_int, u, du)),
+            load=load,
+            constant_jacobian=bulk == "constant",
+        )
     solver = ContactSNES(
         u,
         bulk=bulk,

@@ -69,8 +69,9 @@ def test_star_rule_singular_density():
     coordinates' Jacobian (zero at the tip) cancels the energy density's 1 / r."""
     X = np.array([[[0.0, 0.0], [1.0, 0.0], [0.5, 1.0]]])
     tip = np.array([[0.5, 0.0]])
-    pts, w, side, cut_side = star_rule(X, np.ones((1, 3)), np.array([False]),
-                                       np.array([1.0]), tip, 28)  # fmt: skip
+    pts, w, side, cut_side = star_rule(
+        X, np.ones((1, 3)), np.array([False]), np.array([1.0]), tip, 28
+    )
     assert np.all(np.isnan(cut_side)) and np.all(side == 1.0)
     r = np.linalg.norm(pts[0] - tip[0], axis=1)
     # the two mirror triangles (tip, (1, 0), (0.5, 1)) and (tip, (0.5, 1), (0, 0)): over each,

@@ -35,8 +35,7 @@ def test_writer_every_field_surface_and_split(tmp_path):
     DG0 = _compat.function_space(mesh, "DG", 0)
     scalar = _function(Q1, "pressure", lambda x: 1.0 + x[0] + 2.0 * x[1])
     u = _function(V1, "displacement", lambda x: np.vstack([x[0], x[1]]))
-    a = _function(V1, "enrichment",
-                  lambda x: np.vstack([0 * x[0], np.isclose(x[1], 0.5) * 1.0]))  # fmt: skip
+    a = _function(V1, "enrichment", lambda x: np.vstack([0 * x[0], np.isclose(x[1], 0.5) * 1.0]))
     quadratic = _function(V2, "quadratic", lambda x: np.vstack([x[0] ** 2, x[1]]))
     side = _function(DG0, "side", lambda x: np.where(x[1] > 0.5, 1.0, -1.0))
     cellwise = _function(DG0, "stress", lambda x: 3.0 + 0 * x[0])

@@ -46,10 +46,12 @@ def test_every_method_converges_on_default_case(case):
 def test_refusals_are_not_applicable():
     """What a problem kind refuses before any solve is n/a, not failed: methods without two-body
     contact, P2 between bodies, mortar against an obstacle."""
-    for case, method, degree, words in (("patch-test", "al-ssn", 1, "two meshed bodies"),
-                                        ("patch-test", "vi", 1, "two meshed bodies"),
-                                        ("patch-test", "nitsche", 2, "P1"),
-                                        ("hertz2d", "mortar", 1, "mortar")):  # fmt: skip
+    for case, method, degree, words in (
+        ("patch-test", "al-ssn", 1, "two meshed bodies"),
+        ("patch-test", "vi", 1, "two meshed bodies"),
+        ("patch-test", "nitsche", 2, "P1"),
+        ("hertz2d", "mortar", 1, "mortar"),
+    ):
         row, _, _ = run_case(case, method, {"method": method}, degree, 0, COMM)
         assert row["status"] == "n/a", (case, method, row)
         assert words in row["reason"], row["reason"]
@@ -69,8 +71,16 @@ def test_stress_refuses_joint_without_equilibrium(shared_dir):
 
 
 def test_bench_outputs_well_formed(shared_dir):
-    argv = ["--scene", "hertz2d,westergaard-full", "--method", "nitsche@1,al-ssn",
-            "--levels", "2", "--out", str(shared_dir)]  # fmt: skip
+    argv = [
+        "--scene",
+        "hertz2d,westergaard-full",
+        "--method",
+        "nitsche@1,al-ssn",
+        "--levels",
+        "2",
+        "--out",
+        str(shared_dir),
+    ]
     assert cmd_bench(argv, {}, COMM) == 0
     if COMM.rank == 0:
         rows = _read_csv(shared_dir / "bench.csv")
@@ -91,11 +101,14 @@ def test_westergaard_full_contact_rates():
     """Full contact: the exact solution is smooth, P1 must converge at O(h^2) in L2 and O(h)
     in H1. Levels 1/16 .. 1/64 (uniform); the observed rate between the two finest meshes is
     within 0.15 of optimal (the pre-asymptotic deviation measured is below 0.05)."""
-    for label, overrides in (("nitsche(1)", {"method": "nitsche", "theta": 1}),
-                             ("nitsche(-1)", {"method": "nitsche", "theta": -1}),
-                             ("al-ssn", {"method": "al-ssn"})):  # fmt: skip
-        rows = [run_case("westergaard-full", label, overrides, 1, level, COMM)[0]
-                for level in (1, 2, 3)]  # fmt: skip
+    for label, overrides in (
+        ("nitsche(1)", {"method": "nitsche", "theta": 1}),
+        ("nitsche(-1)", {"method": "nitsche", "theta": -1}),
+        ("al-ssn", {"method": "al-ssn"}),
+    ):
+        rows = [
+            run_case("westergaard-full", label, overrides, 1, level, COMM)[0] for level in (1, 2, 3)
+        ]
         assert all(r["status"] == "ok" for r in rows), label
         _, l2 = observed_rates(rows, "err_u_L2")
         _, h1 = observed_rates(rows, "err_u_H1")

@@ -39,8 +39,9 @@ def _bar_root(kappa0: float, m: float) -> tuple[float, float]:
 @pytest.mark.parametrize("kappa0", [1.0, 10.0])
 def test_bar_compliance_closed_form(kappa0, m):
     scene = Bar1D(BAR)
-    res = scene.run(scene.default_numerics(method="compliance", penalty=kappa0, exponent=m),
-                    verbose=False)  # fmt: skip
+    res = scene.run(
+        scene.default_numerics(method="compliance", penalty=kappa0, exponent=m), verbose=False
+    )
     d, p = _bar_root(kappa0, m)
     # nodally exact discretisation, Newton to rtol 1e-10: the root to 1e-9 (relative)
     assert res.max_penetration == pytest.approx(d, rel=1e-9)

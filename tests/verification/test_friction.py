@@ -37,12 +37,20 @@ def test_sliding_block_coulomb(method):
     assert all(b >= a - 1e-9 * P for a, b in zip(q, q[1:], strict=False))
 
 
-@pytest.mark.parametrize("method, stiff", [
-    ("nitsche", {"gamma0": 100.0}), ("nitsche", {"theta": -1, "gamma0": 100.0}),
-    ("penalty", {"penalty": 100.0}), ("al-uzawa", {"r0": 100.0}), ("al-ssn", {"r0": 100.0}),
-    ("nitsche", {"gamma0": 1000.0}), ("penalty", {"penalty": 1000.0}),
-    ("al-uzawa", {"r0": 1000.0}), ("al-ssn", {"r0": 1000.0}),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "method, stiff",
+    [
+        ("nitsche", {"gamma0": 100.0}),
+        ("nitsche", {"theta": -1, "gamma0": 100.0}),
+        ("penalty", {"penalty": 100.0}),
+        ("al-uzawa", {"r0": 100.0}),
+        ("al-ssn", {"r0": 100.0}),
+        ("nitsche", {"gamma0": 1000.0}),
+        ("penalty", {"penalty": 1000.0}),
+        ("al-uzawa", {"r0": 1000.0}),
+        ("al-ssn", {"r0": 1000.0}),
+    ],
+)
 def test_sliding_block_stiff_stick(method, stiff):
     """A stick 10 and 100 times stiffer than the defaults (gamma0, r0 or the penalty 100 and
     1000): at 100 a point sticks only while |du_T| < mu p / r = 1.5e-6, 1/2700 of the drag
@@ -96,8 +104,9 @@ def test_sliding_block_tresca(method):
     # Nitsche with Tresca keeps the soft skew stick (theta = -1, gamma0 = 1): with gamma0 = 10
     # it still stalls in the drag (DIVERGED_MAX_IT at load 0.61 after cut-backs, theta = 1)
     soft = {"theta": -1, "gamma0": 1.0} if method == "nitsche" else {}
-    num = SlidingBlock.default_numerics(method=method, friction="tresca", mu=0.0,
-                                        threshold=2.0, **soft)  # fmt: skip
+    num = SlidingBlock.default_numerics(
+        method=method, friction="tresca", mu=0.0, threshold=2.0, **soft
+    )
     res = SlidingBlock(BLOCK).run(num, verbose=False)
     Q, bound = abs(res.friction.tangential_force[0]), res.friction.bound
     assert bound <= 2.0 * BLOCK.width * (1 + 1e-12)
@@ -147,8 +156,9 @@ def test_penalty_stick_keeps_its_traction(quadrature):
     params = SlidingBlockParams(shift=1e-4)
     q = []
     for steps in (2, 10):
-        num = SlidingBlock.default_numerics(method="penalty", penalty=1.0, mu=2.0, steps=steps,
-                                            quadrature=quadrature)  # fmt: skip
+        num = SlidingBlock.default_numerics(
+            method="penalty", penalty=1.0, mu=2.0, steps=steps, quadrature=quadrature
+        )
         res = SlidingBlock(params).run(num, verbose=False)
         assert res.friction.slip_fraction == pytest.approx(0.0, abs=1e-12)  # all stick
         q.append(res.friction.tangential_force[0])
@@ -161,19 +171,24 @@ def test_cattaneo_mindlin_trend():
     """Hertz 2D, rigid cylinder shifted after the indentation. The stick zone shrinks as Q
     grows and vanishes at Q = mu P. Against c/a = sqrt(1 - Q/(mu P)) the comparison is only
     approximate (rigid-elastic pair, Dundurs beta = 0.29): reported, not asserted."""
-    num = Hertz2D.default_numerics(method="nitsche", theta=-1, gamma0=1.0, friction="coulomb",
-                                   mu=0.3, steps=8)  # fmt: skip
-    runs = [Hertz2D(Hertz2DParams(h_contact=4e-3, shift=s)).run(num, verbose=False)
-            for s in (2.5e-4, 5e-4, 3e-3)]  # fmt: skip
+    num = Hertz2D.default_numerics(
+        method="nitsche", theta=-1, gamma0=1.0, friction="coulomb", mu=0.3, steps=8
+    )
+    runs = [
+        Hertz2D(Hertz2DParams(h_contact=4e-3, shift=s)).run(num, verbose=False)
+        for s in (2.5e-4, 5e-4, 3e-3)
+    ]
     ratio = [r.reference["Q_over_bound"] for r in runs]
     stick = [r.friction.stick_size for r in runs]
     assert ratio[0] < ratio[1] < 1.0 and stick[0] > stick[1] > 0.0
     assert ratio[2] == pytest.approx(1.0, rel=1e-8) and stick[2] == 0.0
 
 
-STIFF_SHIFT = [("nitsche", {"gamma0": 1000.0, "quadrature": "nodal"}),
-               ("penalty", {"penalty": 1000.0, "quadrature": "nodal"}),
-               ("al-ssn", {"r0": 1000.0})]  # fmt: skip
+STIFF_SHIFT = [
+    ("nitsche", {"gamma0": 1000.0, "quadrature": "nodal"}),
+    ("penalty", {"penalty": 1000.0, "quadrature": "nodal"}),
+    ("al-ssn", {"r0": 1000.0}),
+]
 
 
 def test_cattaneo_stiff_stick_methods_agree():
@@ -191,8 +206,7 @@ def test_cattaneo_stiff_stick_methods_agree():
     params = Hertz2DParams(h_contact=1.5e-3, shift=5e-4)
     res = {}
     for method, stiff in STIFF_SHIFT:
-        num = Hertz2D.default_numerics(method=method, friction="coulomb", mu=0.3, steps=8,
-                                       **stiff)  # fmt: skip
+        num = Hertz2D.default_numerics(method=method, friction="coulomb", mu=0.3, steps=8, **stiff)
         res[method] = Hertz2D(params).run(num, verbose=False)
     c0 = res["nitsche"].friction.stick_size
     q0 = res["nitsche"].reference["Q_over_bound"]
@@ -208,8 +222,9 @@ def test_sphere_gross_slip():
     whole contact at |t_T| = mu p. Q_x = mu P up to the spread of the slip directions (the
     elastic field turns them slightly off x: measured 0.998 mu P)."""
     params = Hertz3DParams(h_contact=0.04, h_far=0.4, shift=0.02)
-    num = Hertz3D.default_numerics(method="nitsche", theta=-1, gamma0=1.0, friction="coulomb",
-                                   mu=0.3, steps=4)  # fmt: skip
+    num = Hertz3D.default_numerics(
+        method="nitsche", theta=-1, gamma0=1.0, friction="coulomb", mu=0.3, steps=4
+    )
     res = Hertz3D(params).run(num, verbose=False)
     assert res.friction.bound == pytest.approx(0.3 * res.force, rel=1e-9)
     assert 0.99 * res.friction.bound < res.friction.tangential_force[0] <= res.friction.bound

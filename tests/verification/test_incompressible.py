@@ -36,8 +36,9 @@ def test_mixed_hertz2d_incompressible(steps):
 
 
 def test_mixed_reproduces_displacement_formulation():
-    disp = Hertz2D(COARSE).run(dataclasses.replace(MIXED, formulation="displacement"),
-                               verbose=False)  # fmt: skip
+    disp = Hertz2D(COARSE).run(
+        dataclasses.replace(MIXED, formulation="displacement"), verbose=False
+    )
     mixed = Hertz2D(COARSE).run(MIXED, verbose=False)
     # same continuous problem, same displacement space: the only difference is the P1
     # pressure replacing lambda div u_h (discontinuous P1), a discretisation difference of the

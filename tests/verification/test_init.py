@@ -24,48 +24,69 @@ OBSTACLE_CASES = [
     ("hertz2d", {"h_contact": 0.01}, {}),
     ("hertz2d", {"h_contact": 0.01, "profile": "circle", "gap0": 5e-4}, {"steps": 2}),
     ("hertz2d", {"h_contact": 0.01, "layer_thickness": 0.02, "layer_E": 300.0}, {}),
-    ("hertz2d", {"h_contact": 0.01, "shift": 5e-4},
-     {"friction": "coulomb", "mu": 0.3, "steps": 4}),
+    ("hertz2d", {"h_contact": 0.01, "shift": 5e-4}, {"friction": "coulomb", "mu": 0.3, "steps": 4}),
     ("hertz3d", {"h_contact": 0.06, "h_far": 0.4}, {}),
     ("punch2d", {"h_contact": 0.01}, {}),
     ("punch3d", {"h_contact": 0.02, "h_far": 0.4}, {"method": "penalty"}),
     ("westergaard", {"h_contact": 1.0 / 32}, {}),
     ("sliding-block", {"h": 0.1}, {"steps": 4}),
     ("bar1d", {}, {}),
-]  # fmt: skip
+]
 _PLATE = {"plate_width": 8.0, "h_crack": 0.1, "h_tip": 0.05, "h_far": 1.0, "grading": 0.3}
 INTERFACE_CASES = [
     ("crack-sneddon", _PLATE, {}),
     ("crack-sneddon", {**_PLATE, "pressure": -1e6, "boundary": "remote"}, {}),
     ("crack-inclined", {**_PLATE, "beta": 30.0}, {}),
-    ("crack-inclined", {**_PLATE, "boundary": "remote"},
-     {"friction": "tresca", "mu": 0.0, "threshold": 1e6, "steps": 2}),
+    (
+        "crack-inclined",
+        {**_PLATE, "boundary": "remote"},
+        {"friction": "tresca", "mu": 0.0, "threshold": 1e6, "steps": 2},
+    ),
     ("propped-fracture", _PLATE, {}),
     ("propped-fracture", {**_PLATE, "net_pressure": 2e6}, {}),
     ("joint-column", {"h": 0.25}, {}),
     ("joint-column", {"h": 0.2, "fluid_pressure": 0.0}, {"method": "penalty", "steps": 2}),
-]  # fmt: skip
+]
 TWO_BODY_CASES = [
     ("patch-test", {"h": 0.25}, {"method": "mortar"}),
     ("patch-test", {"h": 0.5, "dim": 3, "slave": "lower"}, {"method": "mortar"}),
-    ("hertz-cylinders", {"h_contact": 0.01, "h_far": 0.3, "refine": 0.1, "E_lower": 2000.0},
-     {}),
+    ("hertz-cylinders", {"h_contact": 0.01, "h_far": 0.3, "refine": 0.1, "E_lower": 2000.0}, {}),
     ("hertz-spheres", {"h_contact": 0.04, "h_far": 0.5, "refine": 0.2, "depth": 0.03}, {}),
-    ("hertz-spheres", {"h_contact": 0.04, "h_far": 0.5, "refine": 0.2, "depth": 0.03},
-     {"method": "mortar"}),
-    ("punch-foundation", {"h_contact": 0.004, "h_far": 0.3, "refine": 0.02, "slave": "lower"},
-     {}),
-    ("sliding-contact", {"h_contact": 0.02, "h_far": 0.3, "refine": 0.1, "slide": 0.1},
-     {"steps": 6}),
-    ("cattaneo-cylinders", {"h_contact": 0.005, "h_far": 0.3, "refine": 0.06, "slave": "lower"},
-     {"steps": 4}),
-]  # fmt: skip
+    (
+        "hertz-spheres",
+        {"h_contact": 0.04, "h_far": 0.5, "refine": 0.2, "depth": 0.03},
+        {"method": "mortar"},
+    ),
+    ("punch-foundation", {"h_contact": 0.004, "h_far": 0.3, "refine": 0.02, "slave": "lower"}, {}),
+    (
+        "sliding-contact",
+        {"h_contact": 0.02, "h_far": 0.3, "refine": 0.1, "slide": 0.1},
+        {"steps": 6},
+    ),
+    (
+        "cattaneo-cylinders",
+        {"h_contact": 0.005, "h_far": 0.3, "refine": 0.06, "slave": "lower"},
+        {"steps": 4},
+    ),
+]
 CASES = OBSTACLE_CASES + INTERFACE_CASES + TWO_BODY_CASES
 
 #: what a problem-file run cannot report like the scene: its name and parameters, the
 #: closed-form references and scores, timings, file names
-SKIP = {"status", "scene", "parameters", "versions", "petsc_prefix", "timings", "reference",
-        "scores", "errors", "paraview", "paraview_surface", "plot"}  # fmt: skip
+SKIP = {
+    "status",
+    "scene",
+    "parameters",
+    "versions",
+    "petsc_prefix",
+    "timings",
+    "reference",
+    "scores",
+    "errors",
+    "paraview",
+    "paraview_surface",
+    "plot",
+}
 
 
 def _flat(data, prefix=""):
@@ -88,8 +109,9 @@ def _shared_dir(tmp_path: Path, comm) -> Path:
     return Path(comm.bcast(str(tmp_path), root=0))
 
 
-@pytest.mark.parametrize("name, params, numerics", CASES,
-                         ids=[f"{c[0]}-{i}" for i, c in enumerate(CASES)])  # fmt: skip
+@pytest.mark.parametrize(
+    "name, params, numerics", CASES, ids=[f"{c[0]}-{i}" for i, c in enumerate(CASES)]
+)
 def test_init_round_trip(tmp_path, name, params, numerics):
     comm = MPI.COMM_WORLD
     cls = get_scene(name)
@@ -114,8 +136,19 @@ def test_init_round_trip(tmp_path, name, params, numerics):
         if isinstance(va, float) or isinstance(vb, float):
             # round-off: 1e-10 relative, with a floor of 1e-12 of the quantity's natural scale
             # (h for lengths, the force / peak pressure otherwise) for values near zero
-            length = any(w in key for w in ("size", "width", "penetration", "gap", "aperture",
-                                            "slip", "opening", "h_contact"))  # fmt: skip
+            length = any(
+                w in key
+                for w in (
+                    "size",
+                    "width",
+                    "penetration",
+                    "gap",
+                    "aperture",
+                    "slip",
+                    "opening",
+                    "h_contact",
+                )
+            )
             floor = 1e-12 * (h if length else scale)
             assert abs(va - vb) <= 1e-10 * max(abs(va), abs(vb)) + floor, (key, va, vb)
         else:
@@ -144,8 +177,10 @@ def test_init_refuses_what_a_problem_file_cannot_say(tmp_path, name):
         write_problem(cls(cls.Params()), cls.default_numerics(), out, "init", MPI.COMM_WORLD)
 
 
-_RECTANGLE = ('builder = "rectangle"\nparameters = { x0 = -1.0, x1 = 1.0, y0 = -1.0, y1 = 0.0, '
-              'refine_x0 = -0.06, refine_x1 = 0.06, h_contact = 0.01, h_far = 0.1 }')  # fmt: skip
+_RECTANGLE = (
+    'builder = "rectangle"\nparameters = { x0 = -1.0, x1 = 1.0, y0 = -1.0, y1 = 0.0, '
+    "refine_x0 = -0.06, refine_x1 = 0.06, h_contact = 0.01, h_far = 0.1 }"
+)
 
 
 def _builder_file(tmp_path: Path, mesh: str) -> Path:
@@ -176,14 +211,22 @@ def test_mesh_from_a_builder_gives_the_scene(tmp_path):
     assert res.contact_size == pytest.approx(builtin.contact_size, rel=1e-10)
 
 
-@pytest.mark.parametrize("mesh, message", [
-    ('builder = "triangle"', "mesh.builder: must be one of interval, rectangle"),
-    (_RECTANGLE.replace("x1 = 1.0", "x1 = -2.0"), "mesh.parameters: rectangle: x0 must be < x1"),
-    (_RECTANGLE.replace("h_far = 0.1", "h_far = 0.1, colour = 1"),
-     "mesh.parameters: rectangle: rectangle() got an unexpected keyword argument 'colour'"),
-    (_RECTANGLE + '\nfile = "a.msh"', "mesh.file: give a mesh file or a builder"),
-    ('file = "hertz2d.msh"\nparameters = { x0 = 1.0 }', "mesh.parameters: parameters belong"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "mesh, message",
+    [
+        ('builder = "triangle"', "mesh.builder: must be one of interval, rectangle"),
+        (
+            _RECTANGLE.replace("x1 = 1.0", "x1 = -2.0"),
+            "mesh.parameters: rectangle: x0 must be < x1",
+        ),
+        (
+            _RECTANGLE.replace("h_far = 0.1", "h_far = 0.1, colour = 1"),
+            "mesh.parameters: rectangle: rectangle() got an unexpected keyword argument 'colour'",
+        ),
+        (_RECTANGLE + '\nfile = "a.msh"', "mesh.file: give a mesh file or a builder"),
+        ('file = "hertz2d.msh"\nparameters = { x0 = 1.0 }', "mesh.parameters: parameters belong"),
+    ],
+)
 def test_bad_builder(tmp_path, mesh, message):
     path = _builder_file(tmp_path, mesh)
     with pytest.raises(ValueError) as err:

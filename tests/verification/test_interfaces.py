@@ -77,8 +77,9 @@ def test_sneddon_opening_converges():
     assert min(rates) > 0.9, (errors, rates)
 
 
-@pytest.mark.parametrize("numerics", CONSISTENT + [dict(method="al-uzawa", degree=2)],
-                         ids=IDS + ["al-uzawa-P2"])  # fmt: skip
+@pytest.mark.parametrize(
+    "numerics", CONSISTENT + [dict(method="al-uzawa", degree=2)], ids=IDS + ["al-uzawa-P2"]
+)
 def test_sneddon_suction_closes_with_uniform_pressure(numerics):
     data = _run(CrackSneddon(CrackSneddon.Params(pressure=-1e6)), **numerics)
     # the faces touch everywhere and carry -p; the body is unstressed: exact on any mesh up to
@@ -95,8 +96,7 @@ def test_sneddon_suction_penalty_carries_the_tip_elements():
     """The penalty's law is continued over each tip's element (MethodBase.tip_continued), as
     al-uzawa's: the tip element carries its neighbour's kappa [-g]_+ instead of a traction
     falling to zero at the tip, where the jump vanishes identically."""
-    data = _run(CrackSneddon(CrackSneddon.Params(pressure=-1e6)), method="penalty",
-                penalty=1000.0)  # fmt: skip
+    data = _run(CrackSneddon(CrackSneddon.Params(pressure=-1e6)), method="penalty", penalty=1000.0)
     # what remains is the penalty's consistency error: the overlap p / kappa follows the
     # graded nodal mesh size, so the body is slightly stressed, O(1 / penalty): measured
     # 9.6e-4 at penalty 10 and 9.6e-6 at 1000. With the tip traction falling to zero the
@@ -150,8 +150,9 @@ def test_inclined_crack_pressure_converges_away_from_tips(method):
     errors = []
     for h in (0.05, 0.025, 0.0125):
         params = CrackInclined.Params(beta=45.0, h_crack=h, h_tip=h / 10, h_far=20 * h)
-        errors.append(_run(CrackInclined(params), method=method, mu=0.3)
-                      .errors["pressure_interior_L2_rel"])  # fmt: skip
+        errors.append(
+            _run(CrackInclined(params), method=method, mu=0.3).errors["pressure_interior_L2_rel"]
+        )
     rate = math.log2(errors[0] / errors[2]) / 2.0
     # O(h) expected. Measured over the three levels: 0.94 (al-ssn), 1.14 (Nitsche) and 0.79
     # (penalty 10, whose O(h) consistency error adds to the tips') on Debian 12's gmsh
@@ -161,8 +162,9 @@ def test_inclined_crack_pressure_converges_away_from_tips(method):
     assert rate > 0.6, errors
 
 
-@pytest.mark.parametrize("numerics", CONSISTENT[2:] + [dict(method="penalty")],
-                         ids=IDS[2:] + ["penalty"])  # fmt: skip
+@pytest.mark.parametrize(
+    "numerics", CONSISTENT[2:] + [dict(method="penalty")], ids=IDS[2:] + ["penalty"]
+)
 def test_inclined_crack_methods_agree(numerics):
     scene = CrackInclined(CrackInclined.Params(beta=45.0))
     data = _run(scene, mu=0.3, **numerics)

@@ -20,8 +20,7 @@ FINER = Hertz2DParams(h_contact=7.5e-4)
 def _pair(params, nested, **numerics):
     num = Hertz2D.default_numerics(**numerics)
     plain = Hertz2D(params).run(num, verbose=False)
-    chain = Hertz2D(params).run(Hertz2D.default_numerics(nested=nested, **numerics),
-                                verbose=False)  # fmt: skip
+    chain = Hertz2D(params).run(Hertz2D.default_numerics(nested=nested, **numerics), verbose=False)
     return plain, chain
 
 
@@ -32,8 +31,7 @@ def _assert_same(plain, chain):
     # value of the same solution
     assert chain.force == pytest.approx(plain.force, rel=1e-8)
     assert chain.contact_size == pytest.approx(plain.contact_size, rel=1e-12)
-    assert chain.quantities.peak_pressure == pytest.approx(plain.quantities.peak_pressure,
-                                                           rel=1e-8)  # fmt: skip
+    assert chain.quantities.peak_pressure == pytest.approx(plain.quantities.peak_pressure, rel=1e-8)
 
 
 @pytest.mark.parametrize("method", ["nitsche", "penalty", "al-ssn"])

@@ -41,15 +41,31 @@ def test_serial_and_parallel_agree(scene, num):
         (Hertz2D(Hertz2DParams()), Numerics(method="al-ssn", ncp="fb")),
         (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="nitsche")),
         (SlidingBlock(SlidingBlockParams()), SlidingBlock.default_numerics(method="al-ssn")),
-        (SlidingBlock(SlidingBlockParams(shift=1e-4)),
-         SlidingBlock.default_numerics(method="penalty", penalty=1.0, mu=2.0)),
-        (Hertz2D(Hertz2DParams(shift=5e-4)),
-         Hertz2D.default_numerics(method="nitsche", gamma0=1000.0, quadrature="nodal",
-                                  friction="coulomb", mu=0.3, steps=8)),
+        (
+            SlidingBlock(SlidingBlockParams(shift=1e-4)),
+            SlidingBlock.default_numerics(method="penalty", penalty=1.0, mu=2.0),
+        ),
+        (
+            Hertz2D(Hertz2DParams(shift=5e-4)),
+            Hertz2D.default_numerics(
+                method="nitsche",
+                gamma0=1000.0,
+                quadrature="nodal",
+                friction="coulomb",
+                mu=0.3,
+                steps=8,
+            ),
+        ),
     ],
-    ids=["hertz2d-al-uzawa", "hertz2d-al-ssn-fb", "sliding-nitsche", "sliding-al-ssn",
-         "sliding-penalty-stick", "hertz2d-shift-stiff"],
-)  # fmt: skip
+    ids=[
+        "hertz2d-al-uzawa",
+        "hertz2d-al-ssn-fb",
+        "sliding-nitsche",
+        "sliding-al-ssn",
+        "sliding-penalty-stick",
+        "hertz2d-shift-stiff",
+    ],
+)
 def test_serial_and_parallel_agree_al_and_friction(scene, num):
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
@@ -153,11 +169,15 @@ def test_serial_and_parallel_agree_interfaces(case):
     # Newton / Uzawa converged (rtol 1e-10, Uzawa 1e-8): the partition changes round-off only
     # (measured at most 6e-12 relative over these cases): required to 1e-8
     scale = max(abs(serial.force), 1.0)
-    pairs = {"force": (serial.force, parallel.force),
-             "tangential force": (serial.interface.tangential_force,
-                                  parallel.interface.tangential_force),
-             "closed length": (serial.contact_size, parallel.contact_size),
-             "peak pressure": (serial.peak_pressure, parallel.peak_pressure)}  # fmt: skip
+    pairs = {
+        "force": (serial.force, parallel.force),
+        "tangential force": (
+            serial.interface.tangential_force,
+            parallel.interface.tangential_force,
+        ),
+        "closed length": (serial.contact_size, parallel.contact_size),
+        "peak pressure": (serial.peak_pressure, parallel.peak_pressure),
+    }
     for key, (s, p) in pairs.items():
         assert p == pytest.approx(s, rel=1e-8, abs=1e-10 * scale), key
     for key, value in serial.errors.items():

@@ -23,8 +23,10 @@ def _run(params, **numerics):
 
 
 def test_penny_opening_and_front_K_converge():
-    runs = [_run(dict(h_front=hf, h_crack=hc, pressure=1e6, front_bins=3), method="nitsche",
-                 degree=2) for hf, hc in MESHES]  # fmt: skip
+    runs = [
+        _run(dict(h_front=hf, h_crack=hc, pressure=1e6, front_bins=3), method="nitsche", degree=2)
+        for hf, hc in MESHES
+    ]
     for data in runs:
         # p > 0 opens the whole crack: no node is closed, the contact force is exactly zero
         assert data.force == 0.0 and data.contact_size == 0.0
@@ -118,7 +120,8 @@ def test_fault_block_slips_with_overpressure():
     data = scene.run(scene.default_numerics(), verbose=False)
     ref = data.reference
     assert ref["sigma_n"] == pytest.approx(8e6) and ref["driving_shear"] == pytest.approx(
-        -(math.sqrt(3.0) / 4.0 * 12e6 - 0.3 * 8e6))  # fmt: skip
+        -(math.sqrt(3.0) / 4.0 * 12e6 - 0.3 * 8e6)
+    )
     # the stress drop, tau minus the face shear, is q: the face shear is mu (sigma_n - p) at
     # every node away from the front to the friction law's tolerance (measured 0.2 %)
     assert ref["stress_drop_rel_error"] < 0.01, ref

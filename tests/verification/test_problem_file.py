@@ -53,8 +53,9 @@ def test_contact_pair_problem_reactions_balance():
 
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
-@pytest.mark.parametrize("name", ["holed-pad.toml", "block-on-plinth.toml",
-                                  "pressurised-crack.toml", "bored-block.toml"])  # fmt: skip
+@pytest.mark.parametrize(
+    "name", ["holed-pad.toml", "block-on-plinth.toml", "pressurised-crack.toml", "bored-block.toml"]
+)
 def test_problem_file_ranks_agree(name):
     _, parallel = _solve(name)
     _, serial = _solve(name, comm=MPI.COMM_SELF)
@@ -67,8 +68,9 @@ def test_problem_file_ranks_agree(name):
 
 
 def test_set_overrides_a_key():
-    scene, res = _solve("holed-pad.toml", sets=["obstacle.motion=[0.0, -0.005]",
-                                                "numerics.steps=1"])  # fmt: skip
+    scene, res = _solve(
+        "holed-pad.toml", sets=["obstacle.motion=[0.0, -0.005]", "numerics.steps=1"]
+    )
     _, full = _solve("holed-pad.toml", sets=["numerics.steps=1"])
     assert len(res.steps) == 1
     # half the indentation: a smaller force (Hertz-like growth, faster than linear)
@@ -86,21 +88,32 @@ GOOD = (DEMOS / "holed-pad.toml").read_text()
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("edit, message", [
-    (lambda t: t + "\n[solver]\nx = 1\n", "solver: unknown section"),
-    (lambda t: t.replace('nu = 0.3', 'nu = 0.5'), "bodies.0.nu: Poisson's ratio"),
-    (lambda t: t.replace('E = 1000.0', 'E = -1.0'), "bodies.0.E: must be > 0"),
-    (lambda t: t.replace('E = 1000.0', 'E = "soft"'), "bodies.0.E: expected a number"),
-    (lambda t: t.replace('fix = ["x", "y"]', 'fix = ["x", "w"]'), "boundary.0.fix"),
-    (lambda t: t.replace('radius = 2.0', 'radius = 2.0\ncolour = 1'), "obstacle.colour: unknown"),
-    (lambda t: t.replace('method = "nitsche"', 'method = "magic"'), "numerics.method"),
-    (lambda t: t.replace('steps = 2', 'steps = 2\nspeed = 1'), "numerics.speed: unknown"),
-    (lambda t: t.replace("holed-pad.geo", "nowhere.geo"), "nowhere.geo' not found"),
-    (lambda t: t.replace('shape = "cylinder"', 'shape = "cone"'), "obstacle.shape: must be one"),
-    (lambda t: t.replace('[obstacle]', '[nothing]'), "nothing: unknown section"),
-    (lambda t: t.replace('fix = ["x", "y"]', 'traction = [0.0, -1.0]'), "boundary: the body has no "
-     "support"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (lambda t: t + "\n[solver]\nx = 1\n", "solver: unknown section"),
+        (lambda t: t.replace("nu = 0.3", "nu = 0.5"), "bodies.0.nu: Poisson's ratio"),
+        (lambda t: t.replace("E = 1000.0", "E = -1.0"), "bodies.0.E: must be > 0"),
+        (lambda t: t.replace("E = 1000.0", 'E = "soft"'), "bodies.0.E: expected a number"),
+        (lambda t: t.replace('fix = ["x", "y"]', 'fix = ["x", "w"]'), "boundary.0.fix"),
+        (
+            lambda t: t.replace("radius = 2.0", "radius = 2.0\ncolour = 1"),
+            "obstacle.colour: unknown",
+        ),
+        (lambda t: t.replace('method = "nitsche"', 'method = "magic"'), "numerics.method"),
+        (lambda t: t.replace("steps = 2", "steps = 2\nspeed = 1"), "numerics.speed: unknown"),
+        (lambda t: t.replace("holed-pad.geo", "nowhere.geo"), "nowhere.geo' not found"),
+        (
+            lambda t: t.replace('shape = "cylinder"', 'shape = "cone"'),
+            "obstacle.shape: must be one",
+        ),
+        (lambda t: t.replace("[obstacle]", "[nothing]"), "nothing: unknown section"),
+        (
+            lambda t: t.replace('fix = ["x", "y"]', "traction = [0.0, -1.0]"),
+            "boundary: the body has no support",
+        ),
+    ],
+)
 def test_bad_problem_files(tmp_path, edit, message):
     path = _write(tmp_path, edit(GOOD))
     with pytest.raises((ValueError, OSError)) as err:
@@ -111,17 +124,31 @@ def test_bad_problem_files(tmp_path, edit, message):
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("edit, message", [
-    (lambda t: t.replace('group = "bottom"', 'group = "base"'),
-     "boundary.0.group: no physical group 'base' in holed-pad.geo (it has: bottom (1D), top"),
-    (lambda t: t.replace('group = "bottom"', 'group = "pad"'),
-     "boundary.0.group: group 'pad' has dimension 2, expected 1"),
-    (lambda t: t.replace('group = "pad"', 'group = "top"'),
-     "bodies.0.group: group 'top' has dimension 1, expected 2"),
-    (lambda t: t.replace('contact = "top"', 'contact = "hull"'), "obstacle.contact: no physical"),
-    (lambda t: t.replace('contact = "top"', 'contact = "bottom"'),
-     "boundary.0.group: 'bottom' is a contact surface"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            lambda t: t.replace('group = "bottom"', 'group = "base"'),
+            "boundary.0.group: no physical group 'base' in holed-pad.geo (it has: bottom (1D), top",
+        ),
+        (
+            lambda t: t.replace('group = "bottom"', 'group = "pad"'),
+            "boundary.0.group: group 'pad' has dimension 2, expected 1",
+        ),
+        (
+            lambda t: t.replace('group = "pad"', 'group = "top"'),
+            "bodies.0.group: group 'top' has dimension 1, expected 2",
+        ),
+        (
+            lambda t: t.replace('contact = "top"', 'contact = "hull"'),
+            "obstacle.contact: no physical",
+        ),
+        (
+            lambda t: t.replace('contact = "top"', 'contact = "bottom"'),
+            "boundary.0.group: 'bottom' is a contact surface",
+        ),
+    ],
+)
 def test_problem_file_groups_checked_against_the_mesh(tmp_path, edit, message):
     scene, _, _ = load_problem(_write(tmp_path, edit(GOOD)))
     with pytest.raises(ValueError) as err:
@@ -145,18 +172,26 @@ def _pair_key(line: str):
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("edit, message", [
-    (_pair_key("h = -0.1"), "contact.0.h: must be > 0"),
-    (_pair_key('h = "fine"'), "contact.0.h: expected a number"),
-    (_pair_key('force_on = "pad"'), "contact.0.force_on: must be one of plinth, block, got 'pad'"),
-    (_pair_key('edge = "ellipse"'), "contact.0.edge: must be one of x-max, x-band, radial"),
-    (_pair_key('edge = "radial"'), "contact.0.edge_ring: missing"),
-    (_pair_key('edge = "radial"\nedge_ring = 0.0'), "contact.0.edge_ring: must be > 0"),
-    (_pair_key("edge_ring = 0.01"), "contact.0.edge_ring: the ring width of edge = 'radial'"),
-    (_pair_key("colour = 1"), "contact.0.colour: unknown key"),
-    (lambda t: t.replace('slave = "block_bottom"', 'slave = "both"'),
-     "contact.0.slave: the surface must bound one body, it bounds ['block', 'plinth']"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (_pair_key("h = -0.1"), "contact.0.h: must be > 0"),
+        (_pair_key('h = "fine"'), "contact.0.h: expected a number"),
+        (
+            _pair_key('force_on = "pad"'),
+            "contact.0.force_on: must be one of plinth, block, got 'pad'",
+        ),
+        (_pair_key('edge = "ellipse"'), "contact.0.edge: must be one of x-max, x-band, radial"),
+        (_pair_key('edge = "radial"'), "contact.0.edge_ring: missing"),
+        (_pair_key('edge = "radial"\nedge_ring = 0.0'), "contact.0.edge_ring: must be > 0"),
+        (_pair_key("edge_ring = 0.01"), "contact.0.edge_ring: the ring width of edge = 'radial'"),
+        (_pair_key("colour = 1"), "contact.0.colour: unknown key"),
+        (
+            lambda t: t.replace('slave = "block_bottom"', 'slave = "both"'),
+            "contact.0.slave: the surface must bound one body, it bounds ['block', 'plinth']",
+        ),
+    ],
+)
 def test_bad_contact_pair_keys(tmp_path, edit, message):
     path = _write_pair(tmp_path, edit(PAIR))
     with pytest.raises(ValueError) as err:
@@ -195,7 +230,8 @@ def test_contact_pair_keys(tmp_path):
     r = np.linspace(0.0, a, 300, endpoint=False)
     ring = np.column_stack([r * np.cos(r * 50), r * np.sin(r * 50)])
     assert contact_edge("radial", ring, np.sqrt(1.0 - (r / a) ** 2), 0.01) == pytest.approx(
-        a, rel=2e-2)  # fmt: skip
+        a, rel=2e-2
+    )
 
 
 def test_bad_set():
@@ -212,8 +248,20 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
     assert main(["check", str(DEMOS / "holed-pad.toml")]) == 0
     out = capsys.readouterr().out
     assert "valid" in out and "boundary   bottom: fixed x,y" in out
-    assert main(["solve", str(DEMOS / "holed-pad.toml"), "--set", "numerics.steps=1",
-                 "--out", str(tmp_path / "res"), "--quiet"]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "solve",
+                str(DEMOS / "holed-pad.toml"),
+                "--set",
+                "numerics.steps=1",
+                "--out",
+                str(tmp_path / "res"),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert "reaction on bottom" in out
     rows = (tmp_path / "res" / "history.csv").read_text().splitlines()
@@ -227,17 +275,22 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
     assert not (tmp_path / "bad" / "run.json").exists()
 
 
-@pytest.mark.parametrize("load, per_length", [("traction = [0.0, -2.0]", 2.0),
-                                              ("pressure = 3.0", 3.0)])  # fmt: skip
+@pytest.mark.parametrize(
+    "load, per_length", [("traction = [0.0, -2.0]", 2.0), ("pressure = 3.0", 3.0)]
+)
 def test_loads_and_amplitude_reach_the_support(tmp_path, load, per_length):
     """No contact (the obstacle stays 1 above the pad): the bottom carries the load on the top
     (length 2) scaled by the amplitude table at each step, exactly (to solver tolerance)."""
     # (the obstacle's surface is the sides: the top carries the load)
-    text = GOOD.replace("position = [0.0, 1.0]", "position = [0.0, 2.0]").replace(
-        'contact = "top"', 'contact = "sides"').replace(
-        '[obstacle]',
-        f'[[boundary]]\ngroup = "top"\n{load}\namplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 0.5]]'
-        '\n\n[obstacle]')  # fmt: skip
+    text = (
+        GOOD.replace("position = [0.0, 1.0]", "position = [0.0, 2.0]")
+        .replace('contact = "top"', 'contact = "sides"')
+        .replace(
+            "[obstacle]",
+            f'[[boundary]]\ngroup = "top"\n{load}\namplitude = [[0.0, 0.0], [0.5, 1.0], [1.0, 0.5]]'
+            "\n\n[obstacle]",
+        )
+    )
     path = _write(tmp_path, text)  # (each rank has its own tmp_path)
     scene, numerics, petsc = load_problem(path)
     res = scene.run(numerics, petsc_options=petsc, verbose=False)
@@ -300,18 +353,22 @@ def test_distance_expression_obstacle_matches_the_cylinder():
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("text, message", [
-    ("__import__('os').getcwd()", "is not allowed"),
-    ("sqrt(x**2 + w**2)", "'w' is not allowed"),
-    ("x +", "not an expression"),
-    ("r = sqrt(x**2 + y**2)", "not an expression"),
-    ("x = 1; x", "'x' cannot be redefined"),
-    ("r = 1; q", "'q' is not allowed"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("__import__('os').getcwd()", "is not allowed"),
+        ("sqrt(x**2 + w**2)", "'w' is not allowed"),
+        ("x +", "not an expression"),
+        ("r = sqrt(x**2 + y**2)", "not an expression"),
+        ("x = 1; x", "'x' cannot be redefined"),
+        ("r = 1; q", "'q' is not allowed"),
+    ],
+)
 def test_distance_expression_refused(text, message):
     with pytest.raises(ValueError, match=message):
-        load_problem(DEMOS / "holed-pad.toml", ["obstacle.shape=distance",
-                                                f'obstacle.distance="{text}"'])  # fmt: skip
+        load_problem(
+            DEMOS / "holed-pad.toml", ["obstacle.shape=distance", f'obstacle.distance="{text}"']
+        )
 
 
 def test_expression_definitions():
@@ -330,42 +387,82 @@ _EDGE = '[[boundary]]\ngroup = "top"\n'
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("edit, message", [
-    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1.0, 0.0]]\n[interface]"),
-     "boundary.2.stress: expected a square table"),
-    (lambda t: t.replace("[interface]", _EDGE + 'stress = [["sqrt(w)", 0], [0, 0]]\n'
-                         "[interface]"), "boundary.2.stress: 'w' is not allowed"),
-    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]"
-                         "\n[interface]"), "boundary.2.stress: expected 2 rows of 2"),
-    (lambda t: t.replace("[interface]", _EDGE + "stress = [[1, 0], [0, 1]]\n"
-                         "quadrature_degree = 0\n[interface]"),
-     "boundary.2.quadrature_degree: expected an integer"),
-    (lambda t: t + '\n[[pins]]\npoint = [0.123, 0.456]\nfix = ["x"]\n',
-     "pins.0.point: [0.123, 0.456] is not a vertex of the mesh"),
-    (lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0]\nfix = ["w"]\n', "pins.0.fix: expected"),
-    (lambda t: t + '\n[[pins]]\npoint = "corner"\nfix = ["x"]\n', "pins.0.point: expected"),
-    (lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0, 0.0]\nfix = ["x"]\n',
-     "pins.0.point: expected 2 coordinates"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\nh = -1.0"),
-     "interface.h: must be > 0"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 0]"),
-     "interface.direction: expected a nonzero vector"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 1]"),
-     "interface.direction: the group 'crack' is 1 off the line"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = [0, 0.5]"),
-     "interface.origin: the group 'crack' is 0.5 off the line"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = 0"),
-     "interface.origin: expected 2 numbers"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "proppant_zone = [-0.5, 0.5]"),
-     "interface.proppant_zone: a zone of the proppant layer: give its proppant_thickness"),
-    (lambda t: t.replace("fluid_pressure = 1e6", "proppant_thickness = 1e-4\n"
-                         "proppant_zone = [0.5, -0.5]"),
-     "interface.proppant_zone: expected [s0, s1] with s0 < s1"),
-    (lambda t: t + '\n[output]\nmean_displacement = { u = ["top", "w"] }\n',
-     "output.mean_displacement: expected a table name = [group, component]"),
-    (lambda t: t + '\n[output]\nmean_displacement = { u = ["nowhere", "y"] }\n',
-     "output.mean_displacement.u: no physical group 'nowhere'"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            lambda t: t.replace("[interface]", _EDGE + "stress = [[1.0, 0.0]]\n[interface]"),
+            "boundary.2.stress: expected a square table",
+        ),
+        (
+            lambda t: t.replace(
+                "[interface]", _EDGE + 'stress = [["sqrt(w)", 0], [0, 0]]\n[interface]'
+            ),
+            "boundary.2.stress: 'w' is not allowed",
+        ),
+        (
+            lambda t: t.replace(
+                "[interface]", _EDGE + "stress = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]\n[interface]"
+            ),
+            "boundary.2.stress: expected 2 rows of 2",
+        ),
+        (
+            lambda t: t.replace(
+                "[interface]",
+                _EDGE + "stress = [[1, 0], [0, 1]]\nquadrature_degree = 0\n[interface]",
+            ),
+            "boundary.2.quadrature_degree: expected an integer",
+        ),
+        (
+            lambda t: t + '\n[[pins]]\npoint = [0.123, 0.456]\nfix = ["x"]\n',
+            "pins.0.point: [0.123, 0.456] is not a vertex of the mesh",
+        ),
+        (lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0]\nfix = ["w"]\n', "pins.0.fix: expected"),
+        (lambda t: t + '\n[[pins]]\npoint = "corner"\nfix = ["x"]\n', "pins.0.point: expected"),
+        (
+            lambda t: t + '\n[[pins]]\npoint = [-10.0, -10.0, 0.0]\nfix = ["x"]\n',
+            "pins.0.point: expected 2 coordinates",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\nh = -1.0"),
+            "interface.h: must be > 0",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 0]"),
+            "interface.direction: expected a nonzero vector",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\ndirection = [0, 1]"),
+            "interface.direction: the group 'crack' is 1 off the line",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = [0, 0.5]"),
+            "interface.origin: the group 'crack' is 0.5 off the line",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "fluid_pressure = 1e6\norigin = 0"),
+            "interface.origin: expected 2 numbers",
+        ),
+        (
+            lambda t: t.replace("fluid_pressure = 1e6", "proppant_zone = [-0.5, 0.5]"),
+            "interface.proppant_zone: a zone of the proppant layer: give its proppant_thickness",
+        ),
+        (
+            lambda t: t.replace(
+                "fluid_pressure = 1e6", "proppant_thickness = 1e-4\nproppant_zone = [0.5, -0.5]"
+            ),
+            "interface.proppant_zone: expected [s0, s1] with s0 < s1",
+        ),
+        (
+            lambda t: t + '\n[output]\nmean_displacement = { u = ["top", "w"] }\n',
+            "output.mean_displacement: expected a table name = [group, component]",
+        ),
+        (
+            lambda t: t + '\n[output]\nmean_displacement = { u = ["nowhere", "y"] }\n',
+            "output.mean_displacement.u: no physical group 'nowhere'",
+        ),
+    ],
+)
 def test_bad_interface_problem_files(tmp_path, edit, message):
     """The keys of the interface problems (boundary stress, pins, the interface's h, frame
     and proppant zone, mean displacements): a bad value is one error naming the file and
@@ -381,12 +478,19 @@ def test_bad_interface_problem_files(tmp_path, edit, message):
 
 
 @pytest.mark.serial_only
-@pytest.mark.parametrize("edit, message", [
-    (lambda t: t + '\n[[pins]]\npoint = [0.0, 0.0]\nfix = ["x"]\n',
-     "pins: pinned points are offered with an [interface]"),
-    (lambda t: t.replace("[output]", '[output]\nmean_displacement = { u = ["top", "y"] }'),
-     "output.mean_displacement: reported with an [interface]"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            lambda t: t + '\n[[pins]]\npoint = [0.0, 0.0]\nfix = ["x"]\n',
+            "pins: pinned points are offered with an [interface]",
+        ),
+        (
+            lambda t: t.replace("[output]", '[output]\nmean_displacement = { u = ["top", "y"] }'),
+            "output.mean_displacement: reported with an [interface]",
+        ),
+    ],
+)
 def test_interface_keys_refused_elsewhere(tmp_path, edit, message):
     path = _write(tmp_path, edit(GOOD))
     with pytest.raises(ValueError, match=re.escape(message)):
@@ -482,9 +586,16 @@ def test_petsc_table_reaches_the_solver():
     Newton step and, solved to 1e-12, gives the LU run's force (Newton stops at snes_rtol
     1e-10: 1e-8)."""
     _, lu = _solve("holed-pad.toml", sets=["numerics.steps=1"])
-    _, it = _solve("holed-pad.toml", sets=["numerics.steps=1", "petsc.ksp_type=gmres",
-                                           "petsc.pc_type=jacobi", "petsc.ksp_rtol=1e-12",
-                                           "petsc.ksp_max_it=20000"])  # fmt: skip
+    _, it = _solve(
+        "holed-pad.toml",
+        sets=[
+            "numerics.steps=1",
+            "petsc.ksp_type=gmres",
+            "petsc.pc_type=jacobi",
+            "petsc.ksp_rtol=1e-12",
+            "petsc.ksp_max_it=20000",
+        ],
+    )
     assert lu.ksp_iterations == lu.newton_iterations
     assert it.ksp_iterations > 10 * it.newton_iterations
     assert it.force == pytest.approx(lu.force, rel=1e-8)

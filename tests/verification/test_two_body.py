@@ -123,8 +123,9 @@ def test_mortar_patch_test_searched_each_newton(dim):
     res = scene.run(Numerics(method="mortar", search_update="newton"), verbose=False)
     # as test_mortar_patch_test (per current area the deviation is 3.9e-4 in 2D)
     assert res.scores["pressure_deviation"] < 1e-10
-    assert res.contact_size == pytest.approx(scene.contact_size(scene.p.width ** (dim - 1)),
-                                             rel=1e-10)  # fmt: skip
+    assert res.contact_size == pytest.approx(
+        scene.contact_size(scene.p.width ** (dim - 1)), rel=1e-10
+    )
 
 
 _COARSE_SPHERES = HertzSpheres.Params(h_contact=0.04, h_far=0.5, refine=0.2, depth=0.03)
@@ -139,9 +140,14 @@ _COARSE_SPHERES = HertzSpheres.Params(h_contact=0.04, h_far=0.5, refine=0.2, dep
         (HertzSpheres(_COARSE_SPHERES), Numerics(method="nitsche")),
         (HertzSpheres(_COARSE_SPHERES), Numerics(method="penalty")),
     ],
-    ids=["patch-test", "hertz-cylinders-fb", "patch-test-3d", "hertz-spheres-nitsche",
-         "hertz-spheres-penalty"],
-)  # fmt: skip
+    ids=[
+        "patch-test",
+        "hertz-cylinders-fb",
+        "patch-test-3d",
+        "hertz-spheres-nitsche",
+        "hertz-spheres-penalty",
+    ],
+)
 def test_two_body_serial_and_parallel_agree(scene, num):
     serial = scene.run(num, comm=MPI.COMM_SELF, verbose=False)
     parallel = scene.run(num, comm=MPI.COMM_WORLD, verbose=False)
@@ -173,15 +179,20 @@ def test_distribution_keeps_the_contact_surfaces():
 @pytest.mark.parametrize(
     "scene, num, message",
     [
-        (PatchTest(PatchTest.Params()), Numerics(method="vi"),
-         "not offered between two meshed bodies"),
-        (PatchTest(PatchTest.Params()), Numerics(method="nitsche", friction="tresca",
-                                                 threshold=0.3),
-         "Tresca friction between two meshed bodies"),
+        (
+            PatchTest(PatchTest.Params()),
+            Numerics(method="vi"),
+            "not offered between two meshed bodies",
+        ),
+        (
+            PatchTest(PatchTest.Params()),
+            Numerics(method="nitsche", friction="tresca", threshold=0.3),
+            "Tresca friction between two meshed bodies",
+        ),
         (PatchTest(PatchTest.Params()), Numerics(method="mortar", degree=2), "P1"),
     ],
     ids=["vi", "tresca", "mortar-P2"],
-)  # fmt: skip
+)
 def test_two_body_refuses(scene, num, message):
     with pytest.raises(ValueError, match=message):
         scene.run(num, verbose=False)
@@ -255,10 +266,13 @@ def test_unbiased_nitsche_patch_force(dim):
 
 @pytest.mark.parametrize(
     "num",
-    [Numerics(method="nitsche", theta=1), Numerics(method="penalty"),
-     Numerics(method="mortar", friction="coulomb", mu=0.3)],
+    [
+        Numerics(method="nitsche", theta=1),
+        Numerics(method="penalty"),
+        Numerics(method="mortar", friction="coulomb", mu=0.3),
+    ],
     ids=["nitsche", "penalty", "mortar-coulomb"],
-)  # fmt: skip
+)
 def test_hertz_spheres_coarse(num):
     """Hertz between two spheres on a coarse mesh (h_contact 0.013, 5.8k dofs)."""
     scene = HertzSpheres(HertzSpheres.Params(h_contact=0.013))
@@ -287,8 +301,9 @@ def _jacobian_check(scene, num, displace):
 
     pb = setup(scene, num)
     forms = pb.forms()
-    solver = ContactSNES(pb.state, bulk=forms.bulk(), bcs=[], prefix=f"fd_{num.method}_",
-                         coupling=pb.coupling())  # fmt: skip
+    solver = ContactSNES(
+        pb.state, bulk=forms.bulk(), bcs=[], prefix=f"fd_{num.method}_", coupling=pb.coupling()
+    )
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     rng = np.random.default_rng(7)
     X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
@@ -330,8 +345,7 @@ def _jacobian_check(scene, num, displace):
 
 def _check_both_friction_branches(num, c) -> None:
     """Closed points in stick and in slip are both present (Coulomb)."""
-    sticks = ([c.stick[c.xi > 0]] if num.method == "mortar"
-              else [s[3][s[0] > 0] for s in c.state])  # fmt: skip
+    sticks = [c.stick[c.xi > 0]] if num.method == "mortar" else [s[3][s[0] > 0] for s in c.state]
     comm = MPI.COMM_WORLD
     assert comm.allreduce(any(np.any(s) for s in sticks), op=MPI.LOR)
     assert comm.allreduce(any(np.any(~s) for s in sticks), op=MPI.LOR)
@@ -339,14 +353,27 @@ def _check_both_friction_branches(num, c) -> None:
 
 @pytest.mark.parametrize(
     "num",
-    [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=-1, sides="unbiased"),
-     Numerics(method="penalty"), Numerics(method="mortar", ncp="fb"), Numerics(method="mortar"),
-     Numerics(method="nitsche", friction="coulomb", mu=0.3),
-     Numerics(method="nitsche", theta=0, sides="unbiased", friction="coulomb", mu=0.5),
-     Numerics(method="mortar", friction="coulomb", mu=0.3)],
-    ids=["nitsche", "unbiased-skew", "penalty", "mortar-fb", "mortar", "nitsche-coulomb",
-         "unbiased-incomplete-coulomb", "mortar-coulomb"],
-)  # fmt: skip
+    [
+        Numerics(method="nitsche", theta=1),
+        Numerics(method="nitsche", theta=-1, sides="unbiased"),
+        Numerics(method="penalty"),
+        Numerics(method="mortar", ncp="fb"),
+        Numerics(method="mortar"),
+        Numerics(method="nitsche", friction="coulomb", mu=0.3),
+        Numerics(method="nitsche", theta=0, sides="unbiased", friction="coulomb", mu=0.5),
+        Numerics(method="mortar", friction="coulomb", mu=0.3),
+    ],
+    ids=[
+        "nitsche",
+        "unbiased-skew",
+        "penalty",
+        "mortar-fb",
+        "mortar",
+        "nitsche-coulomb",
+        "unbiased-incomplete-coulomb",
+        "mortar-coulomb",
+    ],
+)
 def test_coupling_jacobian_is_consistent(num):
     """J du against the central difference of the residual at a state with open and closed
     points, on a coarse hertz-cylinders mesh."""
@@ -381,13 +408,23 @@ def test_coupling_jacobian_is_consistent(num):
 
 @pytest.mark.parametrize(
     "num",
-    [Numerics(method="nitsche", theta=1), Numerics(method="nitsche", theta=0, sides="unbiased"),
-     Numerics(method="penalty"), Numerics(method="mortar"),
-     Numerics(method="nitsche", theta=-1, friction="coulomb", mu=0.3),
-     Numerics(method="mortar", friction="coulomb", mu=0.3)],
-    ids=["nitsche", "unbiased-incomplete", "penalty", "mortar", "nitsche-coulomb",
-         "mortar-coulomb"],
-)  # fmt: skip
+    [
+        Numerics(method="nitsche", theta=1),
+        Numerics(method="nitsche", theta=0, sides="unbiased"),
+        Numerics(method="penalty"),
+        Numerics(method="mortar"),
+        Numerics(method="nitsche", theta=-1, friction="coulomb", mu=0.3),
+        Numerics(method="mortar", friction="coulomb", mu=0.3),
+    ],
+    ids=[
+        "nitsche",
+        "unbiased-incomplete",
+        "penalty",
+        "mortar",
+        "nitsche-coulomb",
+        "mortar-coulomb",
+    ],
+)
 def test_coupling_jacobian_is_consistent_3d(num):
     """The same in 3D, on the coarse stacked boxes: the upper box tilted into the lower one
     and, with friction, moved along x where x > 0.5 (stick on x < 0.5, slip beyond)."""
@@ -428,9 +465,11 @@ class _Moved(PatchTest):
     def build_mesh(self, comm):
         mesh, facet_tags = super().build_mesh(comm)
         upper = self.cell_tags.indices[self.cell_tags.values == self.cells["upper"]]
-        nodes = np.unique(mesh.geometry.dofmap.array.reshape(-1, 3)[upper]
-                          if hasattr(mesh.geometry.dofmap, "array")
-                          else mesh.geometry.dofmap[upper])  # fmt: skip
+        nodes = np.unique(
+            mesh.geometry.dofmap.array.reshape(-1, 3)[upper]
+            if hasattr(mesh.geometry.dofmap, "array")
+            else mesh.geometry.dofmap[upper]
+        )
         mesh.geometry.x[nodes, 1] += self.lift
         return mesh, facet_tags
 
@@ -489,7 +528,8 @@ def test_sliding_contact_coulomb_serial_and_parallel_agree(method):
     # every step converged to the relative residual 1e-10: forces agree to the tolerance
     assert parallel.force == pytest.approx(serial.force, rel=1e-8)
     assert parallel.friction.tangential_force[0] == pytest.approx(
-        serial.friction.tangential_force[0], rel=1e-8)  # fmt: skip
+        serial.friction.tangential_force[0], rel=1e-8
+    )
 
 
 def test_mortar_slip_is_objective_under_translation():
@@ -501,8 +541,9 @@ def test_mortar_slip_is_objective_under_translation():
     scene = HertzCylinders(HertzCylinders.Params(h_contact=0.01, refine=0.1, h_far=0.2))
     pb = setup(scene, Numerics(method="mortar", friction="coulomb", mu=0.3))
     forms = pb.forms()
-    solver = ContactSNES(pb.state, bulk=forms.bulk(), bcs=[], prefix="objective_",
-                         coupling=pb.coupling())  # fmt: skip
+    solver = ContactSNES(
+        pb.state, bulk=forms.bulk(), bcs=[], prefix="objective_", coupling=pb.coupling()
+    )
     x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
     X = pb.layout.X.getArray().reshape(-1, 2)
     # the last converged state presses the bodies together; the new one moves both by c
@@ -591,16 +632,26 @@ def _mirrored_blocks(model, *, width: float, height: float, h: float, split: boo
     if split:
         F = StackedBlocksFacets
         groups = {StackedBlocksCells.LOWER: [1], StackedBlocksCells.UPPER: [2]}
-        curves = {F.LOWER_BOTTOM: [low["bottom"]], F.LOWER_RIGHT: [low["right"]],
-                  F.LOWER_TOP: [low["top"]], F.LOWER_LEFT: [low["left"]],
-                  F.UPPER_BOTTOM: [high["bottom"]], F.UPPER_RIGHT: [high["right"]],
-                  F.UPPER_TOP: [high["top"]], F.UPPER_LEFT: [high["left"]]}  # fmt: skip
+        curves = {
+            F.LOWER_BOTTOM: [low["bottom"]],
+            F.LOWER_RIGHT: [low["right"]],
+            F.LOWER_TOP: [low["top"]],
+            F.LOWER_LEFT: [low["left"]],
+            F.UPPER_BOTTOM: [high["bottom"]],
+            F.UPPER_RIGHT: [high["right"]],
+            F.UPPER_TOP: [high["top"]],
+            F.UPPER_LEFT: [high["left"]],
+        }
     else:
         F = JointColumnFacets
         groups = {JointColumnCells.DOMAIN: [1, 2]}
-        curves = {F.BOTTOM: [low["bottom"]], F.RIGHT: [low["right"], high["right"]],
-                  F.TOP: [high["top"]], F.LEFT: [low["left"], high["left"]],
-                  F.JOINT: [low["top"]]}  # fmt: skip
+        curves = {
+            F.BOTTOM: [low["bottom"]],
+            F.RIGHT: [low["right"], high["right"]],
+            F.TOP: [high["top"]],
+            F.LEFT: [low["left"], high["left"]],
+            F.JOINT: [low["top"]],
+        }
     for group, entities in groups.items():
         model.addPhysicalGroup(2, entities, group.value)
     for k, (group, parts) in enumerate(curves.items(), start=1):
@@ -650,8 +701,9 @@ class _FittedStack(InterfaceScene):
 
     def build_mesh(self, comm):
         p = self.p
-        return gmsh_mesh(comm, _mirrored_blocks, 2, self.name, width=p.width, height=p.height,
-                         h=p.h, split=False)  # fmt: skip
+        return gmsh_mesh(
+            comm, _mirrored_blocks, 2, self.name, width=p.width, height=p.height, h=p.h, split=False
+        )
 
     def length_scale(self) -> float:
         return self.p.height
@@ -688,8 +740,9 @@ class _SplitStack(TwoBodyScene):
 
     def build_mesh(self, comm):
         p = self.p
-        builder = functools.partial(_mirrored_blocks, width=p.width, height=p.height, h=p.h,
-                                    split=True)  # fmt: skip
+        builder = functools.partial(
+            _mirrored_blocks, width=p.width, height=p.height, h=p.h, split=True
+        )
         return self.mesh_of(comm, builder, 2)
 
     def h_contact(self) -> float:
@@ -699,7 +752,8 @@ class _SplitStack(TwoBodyScene):
         f = StackedBlocksFacets
         return [fix_component(V, facet_tags, f.LOWER_BOTTOM, 1)] + [
             fix_component(V, facet_tags, tag, 0)
-            for tag in (f.LOWER_LEFT, f.LOWER_RIGHT, f.UPPER_LEFT, f.UPPER_RIGHT)]  # fmt: skip
+            for tag in (f.LOWER_LEFT, f.LOWER_RIGHT, f.UPPER_LEFT, f.UPPER_RIGHT)
+        ]
 
     def load(self, v, ds, t):
         return _top_load(self.p, v, ds, t, StackedBlocksFacets.UPPER_TOP)
@@ -744,9 +798,13 @@ def _nodes_fitted(pb, height: float) -> np.ndarray:
     on = np.abs(X[:, 1] - height) < 1e-9 * height
     off = ~on
     side = np.sign(X[off, 1] - height)
-    return np.vstack([np.column_stack([side, X[off], u[off]]),
-                      np.column_stack([-np.ones(on.sum()), X[on], u[on] - a[on]]),
-                      np.column_stack([np.ones(on.sum()), X[on], u[on] + a[on]])])  # fmt: skip
+    return np.vstack(
+        [
+            np.column_stack([side, X[off], u[off]]),
+            np.column_stack([-np.ones(on.sum()), X[on], u[on] - a[on]]),
+            np.column_stack([np.ones(on.sum()), X[on], u[on] + a[on]]),
+        ]
+    )
 
 
 def _nodes_two_body(pb, scene) -> np.ndarray:
@@ -799,10 +857,12 @@ def _matching_pair(theta: int, sides: str):
     out = None
     if comm.rank == 0:
         # the same cells and nodes: coordinates equal to round-off of the tabulation
-        same = cells_i.shape == cells_b.shape and np.allclose(cells_i, cells_b, rtol=0.0,
-                                                              atol=1e-12 * L)  # fmt: skip
+        same = cells_i.shape == cells_b.shape and np.allclose(
+            cells_i, cells_b, rtol=0.0, atol=1e-12 * L
+        )
         same &= nodes_i.shape == nodes_b.shape and np.allclose(
-            nodes_i[:, :3], nodes_b[:, :3], rtol=0.0, atol=1e-12 * L)  # fmt: skip
+            nodes_i[:, :3], nodes_b[:, :3], rtol=0.0, atol=1e-12 * L
+        )
         du = np.max(np.abs(nodes_i[:, 3:] - nodes_b[:, 3:])) / np.max(np.abs(nodes_i[:, 3:]))
         out = same, float(du)
     same, du = comm.bcast(out, root=0)
@@ -817,8 +877,9 @@ def _slave_h(coupling) -> list[np.ndarray]:
     out = []
     for dr in coupling.dirs:
         X = dr.slave.X
-        rows = np.column_stack([X.mean(axis=1)[:, 0], np.linalg.norm(X[:, 1] - X[:, 0], axis=1),
-                                dr.h])  # fmt: skip
+        rows = np.column_stack(
+            [X.mean(axis=1)[:, 0], np.linalg.norm(X[:, 1] - X[:, 0], axis=1), dr.h]
+        )
         rows = comm.gather(rows, root=0)
         if comm.rank == 0:
             rows = np.vstack(rows)
@@ -857,8 +918,9 @@ def test_nitsche_matches_fitted_interface():
     # length-weighted sum of the slave cells' h (round-off); h varies along the interface
     # (measured 0.052 to 0.097: the mesh is graded), so gamma is not one constant
     rows = _slave_h(coupling)
-    H_int = global_sum(dolfinx.fem.form(fitted.solved.surface.h * fitted.solved.dS(
-        fitted.interface_tag)), comm)  # fmt: skip
+    H_int = global_sum(
+        dolfinx.fem.form(fitted.solved.surface.h * fitted.solved.dS(fitted.interface_tag)), comm
+    )
     if comm.rank == 0:
         lower, upper = rows
         assert np.allclose(lower[:, :2], upper[:, :2], rtol=0.0, atol=1e-12 * p.width)

@@ -24,8 +24,9 @@ def _run(scene, **numerics):
 
 
 def test_unfitted_sneddon_opening_and_K_converge():
-    coarse = CrackSneddon(CrackSneddon.Params(crack="unfitted", h_crack=0.05, h_tip=0.005,
-                                              h_far=1.0))  # fmt: skip
+    coarse = CrackSneddon(
+        CrackSneddon.Params(crack="unfitted", h_crack=0.05, h_tip=0.005, h_far=1.0)
+    )
     fine = CrackSneddon(CrackSneddon.Params(crack="unfitted"))
     runs = [_run(s, method="nitsche") for s in (coarse, fine)]
     for data in runs:
@@ -114,11 +115,13 @@ def test_unfitted_al_uzawa_suction_is_exact():
 
 @pytest.mark.parametrize(
     "scene, mu",
-    [(CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")), 0.0),
-     (CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")), 0.3),
-     (ProppedFracture(ProppedFracture.Params(crack="unfitted")), 0.0)],
+    [
+        (CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")), 0.0),
+        (CrackInclined(CrackInclined.Params(beta=45.0, crack="unfitted")), 0.3),
+        (ProppedFracture(ProppedFracture.Params(crack="unfitted")), 0.0),
+    ],
     ids=["inclined-mu0", "inclined-mu0.3", "propped"],
-)  # fmt: skip
+)
 def test_unfitted_al_ssn_solves_al_uzawas_equations(scene, mu):
     """al-ssn on an unfitted crack: its multiplier is the grid's projection of the augmented
     traction, which the faces carry (contactfx.driver.grid_multiplier), al-uzawa's fixed
@@ -130,13 +133,15 @@ def test_unfitted_al_ssn_solves_al_uzawas_equations(scene, mu):
     kwargs = {"mu": mu} if mu > 0.0 else {}
     ssn, uzawa = (_run(scene, method=m, **kwargs) for m in ("al-ssn", "al-uzawa"))
     assert ssn.force == pytest.approx(uzawa.force, rel=2e-5)
-    assert ssn.interface.tangential_force == pytest.approx(uzawa.interface.tangential_force,
-                                                           rel=2e-5, abs=1e-6)  # fmt: skip
+    assert ssn.interface.tangential_force == pytest.approx(
+        uzawa.interface.tangential_force, rel=2e-5, abs=1e-6
+    )
     if uzawa.interface.proppant_force is not None:
         # the share of the proppant zone, whose ends carry a traction singularity where the
         # two multipliers differ most: measured 4.6e-5
-        assert ssn.interface.proppant_force == pytest.approx(uzawa.interface.proppant_force,
-                                                             rel=1e-4)  # fmt: skip
+        assert ssn.interface.proppant_force == pytest.approx(
+            uzawa.interface.proppant_force, rel=1e-4
+        )
     else:
         p_ssn, p_uz = (d.errors["pressure_interior_L2_rel"] for d in (ssn, uzawa))
         # the interior pressure's error (0.059 % at mu 0.3, 0.084 % at mu 0 on Debian 12's
@@ -169,10 +174,13 @@ def test_unfitted_KII_at_30_degrees_converges():
     """The table's beta 30 (1.33 % on the default mesh) on the mesh refined once more
     (h_crack = a / 80, h_tip = a / 800)."""
     runs = [
-        _run(CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted", **h)),
-             method="nitsche", mu=0.3)
+        _run(
+            CrackInclined(CrackInclined.Params(beta=30.0, crack="unfitted", **h)),
+            method="nitsche",
+            mu=0.3,
+        )
         for h in ({}, {"h_crack": 0.0125, "h_tip": 0.00125})
-    ]  # fmt: skip
+    ]
     errors = [r.reference["K_rel_error"] for r in runs]
     # measured 1.33 % and 0.58 % (2.6 % at a / 20): about O(h)
     assert errors[1] < 0.008 and errors[0] > 1.8 * errors[1], errors
@@ -225,13 +233,25 @@ def test_unfitted_refuses_what_it_does_not_implement(params, overrides, message)
 
 @pytest.mark.parametrize(
     "numerics",
-    [dict(method="nitsche", theta=1), dict(method="nitsche", theta=0),
-     dict(method="nitsche", theta=-1, friction="coulomb"), dict(method="al-uzawa"),
-     dict(method="al-uzawa", friction="tresca"), dict(method="al-ssn"),
-     dict(method="al-ssn", friction="coulomb")],
-    ids=["nitsche1", "nitsche0", "nitsche-1-coulomb", "al-uzawa", "al-uzawa-tresca", "al-ssn",
-         "al-ssn-coulomb"],
-)  # fmt: skip
+    [
+        dict(method="nitsche", theta=1),
+        dict(method="nitsche", theta=0),
+        dict(method="nitsche", theta=-1, friction="coulomb"),
+        dict(method="al-uzawa"),
+        dict(method="al-uzawa", friction="tresca"),
+        dict(method="al-ssn"),
+        dict(method="al-ssn", friction="coulomb"),
+    ],
+    ids=[
+        "nitsche1",
+        "nitsche0",
+        "nitsche-1-coulomb",
+        "al-uzawa",
+        "al-uzawa-tresca",
+        "al-ssn",
+        "al-ssn-coulomb",
+    ],
+)
 @pytest.mark.parametrize("offset", [0.0, 0.0123, -0.2])
 def test_unfitted_joint_column_is_exact(numerics, offset):
     """The Barton-Bandis joint as a crack through the column (its ends on the lateral
@@ -277,8 +297,9 @@ def test_unfitted_crack_positions_converge_alike():
     errors = {}
     for h in (0.05, 0.025):
         for k in OFFSETS:
-            params = dict(crack="unfitted", background="structured", h_crack=h, h_tip=h,
-                          crack_offset=k * h)  # fmt: skip
+            params = dict(
+                crack="unfitted", background="structured", h_crack=h, h_tip=h, crack_offset=k * h
+            )
             scene = CrackSneddon(CrackSneddon.Params(**params))
             data = _run(scene, method="nitsche")
             errors[h, k] = (data.errors["opening_L2_rel"], data.reference["K_rel_error"])
@@ -337,8 +358,10 @@ def test_crack_set_refuses_bad_layouts(params, message):
 def test_crossing_cracks_are_refused():
     class Crossing(CrackSet):
         def crack_segments(self):
-            return [CrackSegment(np.array([-1.0, 0.0]), np.array([1.0, 0.0])),
-                    CrackSegment(np.array([0.0, -1.0]), np.array([0.0, 1.0]))]  # fmt: skip
+            return [
+                CrackSegment(np.array([-1.0, 0.0]), np.array([1.0, 0.0])),
+                CrackSegment(np.array([0.0, -1.0]), np.array([0.0, 1.0])),
+            ]
 
     scene = Crossing(CrackSet.Params(angles="0"))
     with pytest.raises(ValueError, match="cross or share a cell"):
