@@ -47,6 +47,8 @@ lint: install
 	@test -x $(VENV)/bin/ruff || $(PY) -m pip install -q --disable-pip-version-check ruff
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	@$(PY) -m mypy --version >/dev/null 2>&1 || apt-get install -y -q mypy >/dev/null
+	$(PY) -m mypy
 
 clean:
 	rm -rf $(VENV) results .pytest_cache .ruff_cache build dist *.egg-info

@@ -19,7 +19,9 @@ doi:10.1016/0045-7930(73)90027-3.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import ufl
@@ -28,14 +30,17 @@ from contactfx.references import oedometric_modulus
 
 __all__ = ["Elastic", "lame", "hooke", "basis_tractions"]
 
+#: a UFL expression (ufl has no type stubs)
+Expr = Any
 
-def lame(E, nu):
+
+def lame(E: Any, nu: Any) -> tuple[Any, Any]:
     """(lambda, mu) of Young's modulus E and Poisson's ratio nu: numbers, NumPy arrays (a
     modulus per cell) or UFL expressions alike."""
     return E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), E / (2.0 * (1.0 + nu))
 
 
-def hooke(eps, lmbda, mu, trace, identity):
+def hooke(eps: Any, lmbda: Any, mu: Any, trace: Callable[[Any], Any], identity: Any) -> Any:
     """Hooke's law sigma = 2 mu eps + lambda tr(eps) I, for UFL (``trace`` = ufl.tr,
     ``identity`` = ufl.Identity(d)) or NumPy arrays of strains (..., d, d) (``trace`` over the
     last two axes, keeping them; ``identity`` = np.eye(d)): the one Hooke's law of the code
@@ -114,14 +119,14 @@ class Elastic:
         """Oedometric (uniaxial-strain) modulus E (1 - nu) / ((1 + nu)(1 - 2 nu))."""
         return oedometric_modulus(self.E, self.nu)
 
-    def _moduli(self):
+    def _moduli(self) -> tuple[Any, Any, Any]:
         """(E, mu, lambda) of the stress: floats, or UFL expressions of the modulus field."""
         E = self.E if self.modulus is None else self.modulus
         nu = self.nu if self.poisson is None else self.poisson
         lmbda, mu = lame(E, nu)
         return E, mu, lmbda
 
-    def sigma(self, u, p=None):
+    def sigma(self, u: Expr, p: Expr | None = None) -> Expr:
         """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
         (p the pressure -lambda div u): 2 mu eps(u) - p I."""
         eps = ufl.sym(ufl.grad(u))
@@ -130,39 +135,43 @@ class Elastic:
         return self.stress(eps)
 
     # -- the Material protocol -----------------------------------------------------------------
-    def weak_stress(self, u, p=None):
+    def weak_stress(self, u: Expr, p: Expr | None = None) -> Expr:
         """sigma(u, p): small strain, the weak form's stress is the Cauchy stress."""
         return self.sigma(u, p)
 
-    def weak_stress_derivative(self, u, p, v, q=None):
+    def weak_stress_derivative(
+        self, u: Expr, p: Expr | None, v: Expr, q: Expr | None = None
+    ) -> Expr:
         """sigma(v, q): the stress is linear, its derivative in the direction (v, q) is the
         stress of (v, q)."""
         return self.sigma(v, q)
 
-    def traction(self, u, p, N):
+    def traction(self, u: Expr, p: Expr | None, N: Expr) -> Expr:
         """sigma(u, p) N."""
         return ufl.dot(self.sigma(u, p), N)
 
-    def traction_derivative(self, u, p, v, q, N):
+    def traction_derivative(
+        self, u: Expr, p: Expr | None, v: Expr, q: Expr | None, N: Expr
+    ) -> Expr:
         """sigma(v, q) N."""
         return ufl.dot(self.sigma(v, q), N)
 
-    def cauchy(self, u, p=None):
+    def cauchy(self, u: Expr, p: Expr | None = None) -> Expr:
         return self.sigma(u, p)
 
-    def stress(self, eps):
+    def stress(self, eps: Expr) -> Expr:
         """Stress of the strain eps (a UFL tensor)."""
         E, mu, lmbda = self._moduli()
         if ufl.shape(eps) == (1, 1):
             return E * eps
         return hooke(eps, lmbda, mu, ufl.tr, ufl.Identity(ufl.shape(eps)[0]))
 
-    def pressure_law(self, u, p, q):
+    def pressure_law(self, u: Expr, p: Expr, q: Expr) -> Expr:
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u
         tested with q (mixed u-p formulation; needs lambda > 0)."""
         return -(ufl.div(u) + p / self._moduli()[2]) * q
 
-    def von_mises(self, u, p=None):
+    def von_mises(self, u: Expr, p: Expr | None = None) -> Expr:
         """von Mises stress of u, or of the mixed pair (u, p)."""
         s = self.sigma(u, p)
         d = ufl.shape(s)[0]

@@ -23,13 +23,16 @@ forms read the unknown's Function, which the solver keeps equal to the iterate.
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 from petsc4py import PETSc
 
 from contactfx import _compat
 
 __all__ = ["Bulk", "LinearBulk", "NonlinearBulk"]
+
+#: a compiled dolfinx form (``dolfinx.fem.form``)
+Form = Any
 
 
 @runtime_checkable
@@ -61,7 +64,7 @@ class _BulkBase:
 
     constant_jacobian = True
 
-    def __init__(self, load, K: PETSc.Mat) -> None:
+    def __init__(self, load: Form, K: PETSc.Mat) -> None:
         self.load_form = load
         self.K = K
         self.load = _compat.create_vector(load)
@@ -83,7 +86,7 @@ class LinearBulk(_BulkBase):
 
     constant_jacobian = True
 
-    def __init__(self, *, stiffness, load) -> None:
+    def __init__(self, *, stiffness: Form, load: Form) -> None:
         super().__init__(load, _compat.assemble_matrix(_compat.create_matrix(stiffness), stiffness))
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
@@ -102,7 +105,9 @@ class NonlinearBulk(_BulkBase):
     With ``constant_jacobian=True`` the tangent is assembled at the first call only (a form
     whose derivative does not depend on u, e.g. a linear body written as a residual)."""
 
-    def __init__(self, *, internal, tangent, load, constant_jacobian: bool = False) -> None:
+    def __init__(
+        self, *, internal: Form, tangent: Form, load: Form, constant_jacobian: bool = False
+    ) -> None:
         super().__init__(load, _compat.create_matrix(tangent))
         self.internal, self.tangent = internal, tangent
         self.constant_jacobian = constant_jacobian

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import dolfinx
 import numpy as np
@@ -29,6 +30,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.contact.coupling import Coupling
 from contactfx.solvers.base import ConvergenceError, SolveStats, TimeLimitExceeded, Timer
 from contactfx.solvers.bulk import Bulk
 from contactfx.solvers.mumps import MumpsWorkspace
@@ -93,19 +95,19 @@ def snes_reason_name(reason: int) -> str:
     return _REASONS.get(reason, str(reason))
 
 
-def owned_size(space) -> int:
+def owned_size(space: dolfinx.fem.FunctionSpace) -> int:
     """Number of owned (unrolled) dofs of a function space on this rank."""
     return space.dofmap.index_map.size_local * space.dofmap.index_map_bs
 
 
-def owned_bc_dofs(bcs, n_owned: int) -> np.ndarray:
+def owned_bc_dofs(bcs: Sequence[Any], n_owned: int) -> np.ndarray:
     """The owned dofs (local indices, each once) that the DirichletBCs ``bcs`` fix."""
     dofs = [np.asarray(_compat.bc_dofs(bc)) for bc in bcs]
     rows = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, dtype=np.int32)
     return rows[rows < n_owned].astype(np.int32)
 
 
-def rigid_body_modes(V) -> PETSc.NullSpace:
+def rigid_body_modes(V: dolfinx.fem.FunctionSpace) -> PETSc.NullSpace:
     """Orthonormalised rigid-body modes of a 2D / 3D vector space (near-nullspace for AMG)."""
     mesh = V.mesh
     gdim = mesh.geometry.dim
@@ -142,7 +144,9 @@ class _KeptPreconditioner:
     PCSetUp compares the matrix state). ``coupled``: J's pattern may grow between refreshes
     (a two-body coupling's search)."""
 
-    def __init__(self, J: PETSc.Mat, nullspace, rebuild_it: int, coupled: bool) -> None:
+    def __init__(
+        self, J: PETSc.Mat, nullspace: PETSc.NullSpace | None, rebuild_it: int, coupled: bool
+    ) -> None:
         self.rebuild_it, self.coupled = rebuild_it, coupled
         self.P = J.duplicate(copy=True)
         if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
@@ -184,7 +188,7 @@ class _ReversalGuard:
     def remember(self) -> None:
         self.iterate.x.array[:] = self.u.x.array
 
-    def _monitor(self, snes, its: int, norm: float) -> None:
+    def _monitor(self, snes: PETSc.SNES, its: int, norm: float) -> None:
         if its == 0:
             self.initial_norm = norm
 
@@ -230,15 +234,15 @@ class ContactSNES:
         u: dolfinx.fem.Function,
         *,
         bulk: Bulk,
-        contact_residual=None,
-        contact_jacobian=None,
-        bcs=(),
+        contact_residual: Any = None,
+        contact_jacobian: Any = None,
+        bcs: Sequence[Any] = (),
         prefix: str,
         options: Mapping[str, object] | None = None,
         user_options: Mapping[str, object] | None = None,
         near_nullspace: bool = False,
-        coupling=None,
-        confined=(),
+        coupling: Coupling | None = None,
+        confined: Sequence[Any] = (),
         iterate: dolfinx.fem.Function | None = None,
         deadline: float | None = None,
     ) -> None:
@@ -380,7 +384,7 @@ class ContactSNES:
         self.bulk.assemble_load()
         self.timer.assembly += time.perf_counter() - t0
 
-    def _residual(self, snes, x: PETSc.Vec, F: PETSc.Vec) -> None:
+    def _residual(self, snes: PETSc.SNES, x: PETSc.Vec, F: PETSc.Vec) -> None:
         t0 = time.perf_counter()
         if self.deadline is not None and self.comm.allreduce(t0 > self.deadline, op=MPI.LOR):
             # stop SNES through its own divergence test (a NaN residual): raising here would
@@ -436,10 +440,12 @@ class ContactSNES:
         reset the preconditioner so that the factorisation is set up anew (PETSc 3.22 reuses
         the symbolic LU of the old pattern after the coupling's MatAXPY with a different
         pattern, and MUMPS fails)."""
+        if self.coupling is None:
+            return
         self.coupling.update(self.u.x.array)
         self.snes.getKSP().getPC().reset()
 
-    def _jacobian(self, snes, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
+    def _jacobian(self, snes: PETSc.SNES, x: PETSc.Vec, J: PETSc.Mat, P: PETSc.Mat) -> None:
         t0 = time.perf_counter()
         self._sync(x)
         red = self.reduced
@@ -471,7 +477,7 @@ class ContactSNES:
         if self.guard is not None:
             self.guard.remember()
 
-    def solve_linear(self, free: np.ndarray, extra=None) -> None:
+    def solve_linear(self, free: np.ndarray, extra: Any = None) -> None:
         """u = the solution of (K + extra) u = f_ext with the owned dofs not marked ``free``
         (and the Dirichlet dofs) fixed to zero, by this solver's linear solver (its options
         prefix and the command line apply): a linear start for the Newton solve (a linear bulk
@@ -641,7 +647,8 @@ class ContactSNES:
         try:
             self._residual(self.snes, xs, F)
             rtol, atol = self.snes.getTolerances()[:2]
-            return F.norm() <= max(atol, rtol * self.guard.initial_norm)
+            initial = 0.0 if self.guard is None else self.guard.initial_norm
+            return F.norm() <= max(atol, rtol * initial)
         finally:
             F.destroy()
 
@@ -654,7 +661,9 @@ class ContactSNES:
 
     def _searched_all(self) -> bool:
         """Whether a search at the current u finds no contact point that the last search
-        missed (collective)."""
+        missed (collective; True without a coupling)."""
+        if self.coupling is None:
+            return True
         t0 = time.perf_counter()
         missed = self.coupling.missed(self.u.x.array)
         dt = time.perf_counter() - t0

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 from petsc4py import PETSc
 
@@ -68,6 +68,16 @@ class Snapshot:
     def destroy(self) -> None:
         for copy in self.copies:
             copy.destroy()
+
+
+class SteppedSolver(Protocol):
+    """What :func:`march` asks of a solver (a :class:`contactfx.solvers.base.Solver` has it)."""
+
+    u: Any
+
+    def assemble_load(self) -> None: ...
+
+    def solve(self) -> SolveStats: ...
 
 
 class Stepper(Protocol):
@@ -197,7 +207,7 @@ class QuasiStatic:
 
 def march(
     stepper: Stepper,
-    solver,
+    solver: SteppedSolver,
     apply_load: Callable[[float], None],
     *,
     on_step: Callable[[StepRecord], None] | None = None,
@@ -235,7 +245,7 @@ def march(
 
 
 def run_load_program(
-    solver,
+    solver: SteppedSolver,
     apply_load: Callable[[float], None],
     *,
     steps: int,

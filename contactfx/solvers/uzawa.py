@@ -3,6 +3,9 @@ the nodal multiplier update, until the update stops changing the multiplier."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
+import dolfinx
 import numpy as np
 from mpi4py import MPI
 
@@ -33,9 +36,18 @@ class Uzawa(SolverWrapper):
     STEP_TOL = 1e-12
 
     def __init__(
-        self, inner: ContactSNES, multiplier, update, mask: np.ndarray, *, tol: float, max_it: int
+        self,
+        inner: ContactSNES,
+        multiplier: dolfinx.fem.Function,
+        update: Callable[[dolfinx.fem.Function], None],
+        mask: np.ndarray,
+        *,
+        tol: float,
+        max_it: int,
     ) -> None:
         super().__init__(inner)
+        #: the Newton solver itself (its tolerances are adjusted during the loop)
+        self.newton = inner
         self.multiplier = multiplier
         self.update = update
         self.mask = mask
@@ -56,15 +68,17 @@ class Uzawa(SolverWrapper):
         bs = self.multiplier.function_space.dofmap.index_map_bs
         mask = np.repeat(self.mask, bs) if bs > 1 else self.mask.copy()
         mask[imap.size_local * bs :] = False  # owned dofs decide; ghosts follow
-        stol = self.inner.tolerances()["stol"]
-        if not self.inner.user_sets("snes_stol"):
-            self.inner.set_tolerances(stol=max(stol, self.STEP_TOL))
+        stol = self.newton.tolerances()["stol"]
+        if not self.newton.user_sets("snes_stol"):
+            self.newton.set_tolerances(stol=max(stol, self.STEP_TOL))
         try:
             return self._iterate(lam, saved, mask, total)
         finally:
-            self.inner.set_tolerances(stol=stol)
+            self.newton.set_tolerances(stol=stol)
 
-    def _iterate(self, lam, saved, mask, total) -> SolveStats:
+    def _iterate(
+        self, lam: np.ndarray, saved: np.ndarray, mask: np.ndarray, total: SolveStats
+    ) -> SolveStats:
         for k in range(1, self.max_it + 1):
             try:
                 stats = self.inner.solve()
