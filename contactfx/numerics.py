@@ -3,8 +3,11 @@
 Its fields are the general choices (method, friction law, quadrature, degree, formulation,
 load steps, linear solver) followed by every registered method's parameters
 (:mod:`contactfx.contact.registry`), so that a new method's options appear here, on the
-command line and in run.json without further code. Whether a combination is supported is
-asked of the method (:class:`contactfx.contact.method.Supports`).
+command line and in run.json without further code. Each method's own parameter set is its
+dataclass (``method_object()``); an option several methods declare (``r0``, ``ncp``,
+``penalty``) means the same thing in each of them, checked at import (:func:`_shared`).
+Whether a combination is supported is asked of the method
+(:class:`contactfx.contact.method.Supports`).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from contactfx.contact.laws import friction_law
 from contactfx.contact.registry import METHODS, method_class, methods_supporting
 from contactfx.params import option_name, param, validate
 
-__all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS"]
+__all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS", "method_parameters"]
 
 FRICTION_LAWS = ("none", "tresca", "coulomb")
 FORMULATIONS = ("displacement", "mixed-up")
@@ -62,15 +65,49 @@ class _General:
     )
 
 
-def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
-    """Every registered method's parameters under their option names (first one wins)."""
-    out: dict[str, tuple[str, type, dataclasses.Field]] = {}
+def method_parameters() -> dict[str, list[tuple[str, dataclasses.Field]]]:
+    """Every registered method's parameters by option name: (method, field) of each method
+    that declares the option. Each method's own parameter set is its dataclass
+    (:meth:`_Checks.method_object` builds it from the options)."""
+    out: dict[str, list[tuple[str, dataclasses.Field]]] = {}
     for name in METHODS:
         for f in dataclasses.fields(method_class(name)):
-            key = option_name(f)
-            meta = {**f.metadata, "option": None}
-            out.setdefault(key, (key, f.type, dataclasses.field(default=f.default, metadata=meta)))
-    return list(out.values())
+            out.setdefault(option_name(f), []).append((name, f))
+    return out
+
+
+def _shared(key: str, declared: list[tuple[str, dataclasses.Field]]) -> dataclasses.Field:
+    """The Numerics field of an option that one or more methods declare. Methods that share
+    an option share its meaning: the same type, default and rule (else the option needs two
+    names: a developer's error, raised at import); the help names every method that reads it,
+    with each one's own text where they differ."""
+    first = declared[0][1]
+    rule = ("positive", "nonnegative", "choices")
+    for method, f in declared[1:]:
+        same = (f.type, f.default) == (first.type, first.default) and all(
+            f.metadata.get(r) == first.metadata.get(r) for r in rule
+        )
+        if not same:
+            raise TypeError(
+                f"option --{key}: methods {declared[0][0]} and {method} declare it with "
+                "different types, defaults or rules; give one of them another name"
+            )
+    helps = list(dict.fromkeys(f.metadata["help"] for _, f in declared))
+    names = ", ".join(m for m, _ in declared)
+    if len(helps) == 1:
+        text = helps[0] + (f" ({names})" if len(declared) > 1 else "")
+    else:
+        text = "; ".join(f"{m}: {f.metadata['help']}" for m, f in declared)
+    meta = {**first.metadata, "option": None, "help": text}
+    return dataclasses.field(default=first.default, metadata=meta)
+
+
+def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
+    """Every registered method's parameters under their option names (:func:`_shared`)."""
+    return [
+        (key, declared[0][1].type, _shared(key, declared))
+        for key, declared in method_parameters().items()
+    ]
 
 
 def _unsupported(what: str, test, reason_key: str, method: str) -> str:

@@ -177,7 +177,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     r0: float = param(10.0, _R0, positive=True)
     ncp: str = param(
         "min",
-        "al-ssn complementarity function: min (Alart-Curnier) or fb (Fischer-Burmeister)",
+        "complementarity function: min (Alart-Curnier) or fb (Fischer-Burmeister)",
         choices=("min", "fb"),
     )
     name = "al-ssn"

@@ -30,7 +30,7 @@ class NormalCompliance(MethodBase):
     """kappa0 > 0 (the ``penalty`` option), exponent m > 0."""
 
     kappa0: float = param(
-        10.0, "penalty parameter, kappa = penalty E / h", positive=True, option="penalty"
+        10.0, "stiffness factor, p = penalty E ([-g]_+ / h)^m", positive=True, option="penalty"
     )
     exponent: float = param(
         2.0, "normal compliance exponent m: p = penalty E ([-g]_+ / h)^m", positive=True

@@ -102,8 +102,7 @@ class Mortar(MethodBase):
     r0: float = param(10.0, "augmented Lagrangian augmentation, r = r0 E / h", positive=True)
     ncp: str = param(
         "min",
-        "complementarity function of al-ssn / mortar: min "
-        "(Alart-Curnier) or fb (Fischer-Burmeister)",
+        "complementarity function: min (Alart-Curnier) or fb (Fischer-Burmeister)",
         choices=("min", "fb"),
     )
     name = "mortar"

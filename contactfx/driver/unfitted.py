@@ -367,7 +367,7 @@ class UnfittedProblem(InterfaceProblem):
                 "unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                 "integration is exact for constant strains only"
             )
-        if method.multiplier == "field" and getattr(method, "ncp", "min") != "min":
+        if method.multiplier == "field" and numerics.ncp != "min":
             raise ValueError(
                 "al-ssn on unfitted cracks projects its multiplier's law (--ncp min); the "
                 "Fischer-Burmeister function is not a projection"

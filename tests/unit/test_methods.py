@@ -272,3 +272,32 @@ def test_nitsche_coulomb_jacobian_2d(slide):
     # piecewise affine again (t = mu P sign(T) when slipping; the regularised |T| adds a
     # relative 1e-24 / T^2) with P, |T| - mu P >= 0.08 away from the kinks: as in 1D
     assert worst < 1e-8 * max(1.0, scale)
+
+
+def test_shared_method_options_mean_one_thing():
+    """An option several methods declare (r0: al-uzawa, al-ssn, mortar; ncp: al-ssn, mortar;
+    penalty: penalty, compliance) has one type, default and rule, and its help names every
+    method that reads it; two methods declaring one option differently is refused."""
+    import dataclasses
+
+    from contactfx.numerics import Numerics, _shared, method_parameters
+    from contactfx.params import param
+
+    shared = {k: [m for m, _ in v] for k, v in method_parameters().items() if len(v) > 1}
+    assert shared["r0"] == ["al-uzawa", "al-ssn", "mortar"]
+    assert shared["ncp"] == ["al-ssn", "mortar"]
+    helps = {f.name: f.metadata["help"] for f in dataclasses.fields(Numerics)}
+    for key, methods in shared.items():
+        assert all(m in helps[key] for m in methods), helps[key]
+
+    @dataclasses.dataclass(frozen=True)
+    class A:
+        r0: float = param(10.0, "augmentation", positive=True)
+
+    @dataclasses.dataclass(frozen=True)
+    class B:
+        r0: float = param(1.0, "augmentation", positive=True)
+
+    declared = [("a", dataclasses.fields(A)[0]), ("b", dataclasses.fields(B)[0])]
+    with pytest.raises(TypeError, match="--r0: methods a and b"):
+        _shared("r0", declared)
