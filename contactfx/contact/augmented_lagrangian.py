@@ -50,7 +50,7 @@ from contactfx.contact.laws import (
     positive_part,
     tangential,
 )
-from contactfx.contact.method import MethodBase, Supports
+from contactfx.contact.method import MULTIPLIER_FIELD, NODAL_MULTIPLIER, MethodBase, Supports
 from contactfx.contact.surface import Surface
 from contactfx.params import param, validate
 
@@ -112,7 +112,7 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
     al_max_it: int = param(100, "al-uzawa maximal outer iterations", positive=True)
     name = "al-uzawa"
     sweep = ("r0", ())
-    multiplier = "nodal"
+    multiplier = NODAL_MULTIPLIER
     #: at a crack tip the gap and the slip vanish identically, so the augmented traction
     #: there would be the held multiplier alone: the tip's element takes its neighbour's
     #: augmented traction instead (``tip_extended``), with its derivative in the Jacobian
@@ -182,7 +182,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
     )
     name = "al-ssn"
     sweep = ("r0", ())
-    multiplier = "field"
+    multiplier = MULTIPLIER_FIELD
     supports = Supports(
         friction=_FRICTION,
         interfaces=True,

@@ -7,9 +7,11 @@ parameters; they become command-line options and fields of
 (:class:`contactfx.contact.surface.Surface`): the residual, the pressure and, with friction,
 the tangential traction. Everything else the driver needs is declared here with a default:
 
-* ``multiplier``: ``"none"`` (displacement only), ``"field"`` (a P1 multiplier solved with the
-  displacement, one mixed unknown), or ``"nodal"`` (a P1 multiplier updated between Newton
-  solves by :meth:`update`; an outer loop, see :meth:`attach`);
+* ``multiplier``: what the method asks of a problem kind beyond the displacement, a
+  :class:`Multiplier` strategy: :data:`NO_MULTIPLIER` (displacement only),
+  :data:`MULTIPLIER_FIELD` (a P1 multiplier solved with the displacement, one mixed unknown),
+  or :data:`NODAL_MULTIPLIER` (a P1 multiplier updated between Newton solves by
+  :meth:`update`; an outer loop, see :meth:`attach`);
 * :meth:`snes_options`: PETSc options the method needs (e.g. an SNES-VI type);
 * :meth:`attach`: wrap the nonlinear solver (an outer loop, bound constraints);
 * ``sweep``: the option that distinguishes its variants in bench and stress tables;
@@ -29,7 +31,44 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 from contactfx.contact.laws import active, ball_projection, norm
 
-__all__ = ["Supports", "ContactMethod", "MethodBase", "TrialFriction"]
+__all__ = [
+    "Supports",
+    "ContactMethod",
+    "MethodBase",
+    "TrialFriction",
+    "Multiplier",
+    "NO_MULTIPLIER",
+    "MULTIPLIER_FIELD",
+    "NODAL_MULTIPLIER",
+]
+
+
+@dataclass(frozen=True)
+class Multiplier:
+    """What a method asks of a problem kind beyond the displacement (a strategy the method
+    provides; the kind builds what it says and reads its own state afterwards). ``name``: as
+    the documentation says it; ``field``: the unknown gains a P1 multiplier field solved with
+    the displacement (its equations collocated at the surface's nodes); ``nodal``: the kind
+    keeps a P1 multiplier Function on the surface that the method's outer loop updates between
+    Newton solves (the progress shows the outer iterations)."""
+
+    name: str
+    field: bool = False
+    nodal: bool = False
+
+    def field_shape(self, traction: tuple[int, ...]) -> tuple[int, ...] | None:
+        """The value shape of the multiplier field the unknown gains (``traction``: () for a
+        normal pressure, (gdim,) for a traction with friction), None without one."""
+        return traction if self.field else None
+
+    def nodal_shape(self, traction: tuple[int, ...]) -> tuple[int, ...] | None:
+        """The value shape of the nodal multiplier Function, None without one."""
+        return traction if self.nodal else None
+
+
+NO_MULTIPLIER = Multiplier("none")
+MULTIPLIER_FIELD = Multiplier("field", field=True)
+NODAL_MULTIPLIER = Multiplier("nodal", nodal=True)
 
 
 @dataclass(frozen=True)
@@ -57,7 +96,7 @@ class ContactMethod(Protocol):
     """The members the driver and the post-processing use (see the module docstring)."""
 
     name: ClassVar[str]
-    multiplier: ClassVar[str]
+    multiplier: ClassVar[Multiplier]
     supports: ClassVar[Supports]
 
     def residual(self, s) -> Any: ...
@@ -74,7 +113,7 @@ class ContactMethod(Protocol):
 class MethodBase:
     """Defaults of the protocol for the dataclass methods."""
 
-    multiplier: ClassVar[str] = "none"
+    multiplier: ClassVar[Multiplier] = NO_MULTIPLIER
     #: with friction, whether the method's law needs the tangential traction of the last
     #: converged step (the surface's ``traction_prev``, kept by the driver)
     traction_history: ClassVar[bool] = False

@@ -34,7 +34,7 @@ from contactfx.driver.fields import (
     zero_pattern,
 )
 from contactfx.driver.interface_post import InterfacePost
-from contactfx.driver.problem import Problem
+from contactfx.driver.problem import Problem, SurfaceSetup
 from contactfx.io.vtk import Split
 from contactfx.solvers.snes import owned_size
 
@@ -114,7 +114,7 @@ class InterfaceProblem(Problem):
         """On the interface and not on a tip or front."""
         return surface_mask(Q, self.fdim, self.contact_facets, self.on_front)
 
-    def make_surface(self) -> InterfaceSurface:
+    def make_surface(self) -> SurfaceSetup:
         mesh, scene, tag = self.mesh, self.scene, self.scene.interface_tag
         self.w, self.dw, self.v_load = (self.total(X) for X in (self.U, self.dU, self.V_test))
         self.dS = ufl.Measure("dS", domain=mesh, subdomain_data=self.facet_tags)
@@ -126,7 +126,7 @@ class InterfaceProblem(Problem):
         self.fluid_value = scene.fluid_pressure()
         self.fluid = None if self.fluid_value is None else dolfinx.fem.Constant(mesh, 0.0)
         mat = self.material
-        return InterfaceSurface(
+        surface = InterfaceSurface(
             self.w,
             self.v_load,
             self.H,
@@ -141,11 +141,12 @@ class InterfaceProblem(Problem):
             friction=self.friction,
             u_prev=None if self.prev is None else self.total(self.previous()),
             traction_prev=None if self.t_prev is None else self.t_prev("+"),
-            ds_nodal=self.dS_nodal if self.method.multiplier == "field" else None,
+            ds_nodal=self.dS_nodal if self.multiplier_field else None,
             multiplier=None if self.lam is None else self.lam("+"),
             multiplier_test=None if self.lam_test is None else self.lam_test("+"),
             **self._tip_terms(),
         )
+        return SurfaceSetup(surface, self.ds, self.v_load)
 
     def _tip_terms(self) -> dict:
         """What the methods need at the crack tips: ``tip_step``, the vector from each tip's
@@ -297,7 +298,7 @@ class InterfaceProblem(Problem):
             # or the load-step predictor) can already be the solution, e.g. of a uniformly
             # compressed joint, and rtol then cannot be met
             solver.set_tolerances(atol=1e-11 * solver.bulk.load.norm())
-        if self.method.multiplier != "field" and not solver.user_sets("snes_stol"):
+        if not self.multiplier_field and not solver.user_sets("snes_stol"):
             # and a Newton step below 1e-12 of the displacement is converged too (the
             # residual's round-off floor grows with the conditioning, e.g. P2 on graded tips);
             # not for a multiplier field, whose unknown mixes displacements and multipliers

@@ -29,7 +29,7 @@ from contactfx.driver.fields import (
     vertex_rule,
     zero_pattern,
 )
-from contactfx.driver.problem import Problem
+from contactfx.driver.problem import Problem, SurfaceSetup
 from contactfx.results import Friction, Quantities
 
 __all__ = ["ObstacleProblem", "closed_form_errors"]
@@ -72,7 +72,7 @@ class ObstacleProblem(Problem):
         supports = self.scene.dirichlet(self.V, self.facet_tags)
         return supports + self.confine_multiplier(supports=supports)
 
-    def make_surface(self) -> ContactSurface:
+    def make_surface(self) -> SurfaceSetup:
         mesh, scene, mat = self.mesh, self.scene, self.material
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
         self.dsc = self.ds(scene.contact_tag, metadata=self.contact_rule())
@@ -82,7 +82,7 @@ class ObstacleProblem(Problem):
         if self.friction is not None:
             self.offset_prev = dolfinx.fem.Constant(mesh, np.zeros(self.gdim))
         self.v_load = self.V_test
-        return ContactSurface(
+        surface = ContactSurface(
             self.U,
             self.V_test,
             self.dsc,
@@ -96,10 +96,11 @@ class ObstacleProblem(Problem):
             u_prev=None if self.prev is None else self.previous(),
             offset_prev=self.offset_prev,
             traction_prev=self.t_prev,
-            ds_nodal=self.nodal_rule()[0] if self.method.multiplier == "field" else None,
+            ds_nodal=self.nodal_rule()[0] if self.multiplier_field else None,
             multiplier=self.lam,
             multiplier_test=self.lam_test,
         )
+        return SurfaceSetup(surface, self.ds, self.v_load)
 
     def nodal_rule(self):
         return self.ds(self.scene.contact_tag, metadata=vertex_rule(self.fdim)), None
@@ -122,7 +123,7 @@ class ObstacleProblem(Problem):
 
     def tangent_pattern(self):
         """A multiplier field's couplings with every cell's dofs (zero)."""
-        if self.method.multiplier != "field":
+        if not self.multiplier_field:
             return None
         return zero_pattern(self.mesh, self.trial, self.test, [(ufl.dx, lambda f: f)])
 

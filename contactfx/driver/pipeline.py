@@ -244,7 +244,7 @@ class _Run:
                         writer.write(rec.time, post.fields())
                 problem.converged()
                 solver.converged()
-                self.say(_progress(steps[-1], problem.method.multiplier == "nodal"))
+                self.say(_progress(steps[-1], problem.method.multiplier.nodal))
 
             t0 = time.perf_counter()
             a0 = solver.timer.assembly

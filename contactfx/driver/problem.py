@@ -2,13 +2,14 @@
 unfitted interface, and two meshed bodies.
 
 :class:`Problem` builds what every kind shares: the unknown (the kind's displacement field,
-extended by a multiplier field for a ``"field"`` method or by the pressure of the mixed u-p
-formulation), the friction history (the last converged state, and the last tangential traction
-for a method that keeps it), the nodal multiplier of a ``"nodal"`` method, and the forms (the
-bulk, :mod:`contactfx.solvers.bulk`, linear or not as the material is; the load; the contact
-residual). A kind adds its unknowns' meaning, its boundary conditions and measures, its
-:class:`contactfx.contact.surface.Surface`, its load program and its post-processing; the hooks
-are listed in docs/architecture.md ("Adding a problem kind").
+extended by a multiplier field when the method's :class:`contactfx.contact.method.Multiplier`
+asks for one, or by the pressure of the mixed u-p formulation), the friction history (the last
+converged state, and the last tangential traction for a method that keeps it), a nodal
+multiplier (likewise), and the forms (the bulk, :mod:`contactfx.solvers.bulk`, linear or not
+as the material is; the load; the contact residual). A kind adds its unknowns' meaning, its
+boundary conditions and measures, its :class:`contactfx.contact.surface.Surface`, its load
+program and its post-processing; the hooks are listed in docs/architecture.md ("Adding a
+problem kind").
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 from collections.abc import Callable
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import dolfinx
 import numpy as np
@@ -25,11 +26,23 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.contact.laws import reversal
+from contactfx.contact.surface import Surface
 from contactfx.driver.fields import NodalProjection, at_nodes, confine, surface_mask, vertex_rule
 from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
-__all__ = ["Forms", "Problem"]
+__all__ = ["Forms", "Problem", "SurfaceSetup"]
+
+
+class SurfaceSetup(NamedTuple):
+    """What a kind's ``make_surface`` gives: the :class:`contactfx.contact.surface.Surface`
+    the methods write against (None for two bodies: their contact is the solver's coupling),
+    ``ds`` the boundary measure the scene's loads integrate over, ``v_load`` the test function
+    they act on (the total displacement's on an interface)."""
+
+    surface: Surface | None
+    ds: ufl.Measure
+    v_load: Any
 
 
 class Forms(NamedTuple):
@@ -81,12 +94,17 @@ class Problem:
         if self.friction is not None and method.traction_history:
             space = self.surface_space((self.gdim,))
             self.t_prev = dolfinx.fem.Function(space, name="traction_history")
+        #: a nodal multiplier (the method's outer loop updates it), or None
         self.multiplier = None
-        if method.multiplier == "nodal":
-            space = self.surface_space(self.mult_shape)
+        nodal = method.multiplier.nodal_shape(self.mult_shape)
+        if nodal is not None:
+            space = self.surface_space(nodal)
             self.multiplier = dolfinx.fem.Function(space, name="multiplier")
             self.lam = self.multiplier
-        self.surface = self.make_surface()
+        setup = self.make_surface()
+        #: the Surface the methods write against (None: two bodies, a coupling instead), the
+        #: boundary measure the scene's loads integrate over, the test function they act on
+        self.surface, self.ds, self.v_load = setup.surface, setup.ds, setup.v_load
         if self.surface is not None and method.nodal_size:
             self.surface = dataclasses.replace(self.surface, h_nodal=self._nodal_size())
         #: Newton's previous iterate (the friction law's reversal guard), or None
@@ -98,19 +116,56 @@ class Problem:
         return _compat.function_space(self.mesh, "Lagrange", 1, shape or None)
 
     def material_of(self, mesh):
+        """The material of the body (or bodies) on ``mesh``: the scene's."""
         return self.scene.material()
+
+    # -- the hooks every kind provides (docs/architecture.md, "Adding a problem kind") -----
+    def boundary_conditions(self) -> list:
+        """The DirichletBCs: the scene's supports, and ``confine_multiplier`` for a
+        multiplier field (called before ``make_surface``; ``contact_facets`` is set)."""
+        raise NotImplementedError(f"{type(self).__name__} has no boundary conditions")
+
+    def make_surface(self) -> SurfaceSetup:
+        """The contact surface and the loads' measure and test function."""
+        raise NotImplementedError(f"{type(self).__name__} has no contact surface")
+
+    def apply_load(self, t: float) -> None:
+        """Set the load program's constants for time (load factor) t."""
+        raise NotImplementedError(f"{type(self).__name__} has no load program")
+
+    def start(self, solver) -> None:
+        """Set the state the first Newton solve starts from (``solver``: the kind's
+        ContactSNES, for a linear start)."""
+        raise NotImplementedError(f"{type(self).__name__} has no start")
+
+    def post_processor(self):
+        """An object with ``evaluate(solver) -> Quantities``, ``fields()`` and
+        ``finish(quantities, out) -> dict``."""
+        raise NotImplementedError(f"{type(self).__name__} has no post-processing")
+
+    @property
+    def multiplier_mask(self) -> np.ndarray:
+        """A nodal multiplier's dofs on the contact surface (bool per local dof)."""
+        raise NotImplementedError(f"{type(self).__name__} has no nodal multiplier")
+
+    def nodal_update(self, expr):
+        """The filler of a nodal multiplier with the values of ``expr`` at its nodes."""
+        raise NotImplementedError(f"{type(self).__name__} has no nodal multiplier")
 
     # -- unknowns ------------------------------------------------------------------------
     def _spaces(self) -> None:
-        """The unknown: [P_k]^(c d), or a mixed space with a P1 multiplier (``"field"``
-        methods) or the P1 pressure (mixed u-p formulation) as second field."""
+        """The unknown: [P_k]^(c d), or a mixed space with a P1 multiplier (a method whose
+        strategy asks for a multiplier field) or the P1 pressure (mixed u-p formulation) as
+        second field."""
         num, mesh = self.num, self.mesh
         n = self.components_per_dim * self.gdim
-        field = self.method.multiplier == "field"
+        shape = self.method.multiplier.field_shape(self.mult_shape)
+        #: whether the unknown carries a multiplier field (its second field)
+        self.multiplier_field = field = shape is not None
         self.up = num.formulation == "mixed-up"
         self.split = field or self.up
         if self.split:
-            W = _compat.mixed_space(mesh, num.degree, n, self.mult_shape if field else ())
+            W = _compat.mixed_space(mesh, num.degree, n, shape if field else ())
             self.V = W.sub(0)
         else:
             W = self.V = _compat.function_space(mesh, "Lagrange", num.degree, (n,))
@@ -130,13 +185,13 @@ class Problem:
     multiplier_excluded = None
 
     def confine_multiplier(self, supports=()) -> list:
-        """The ``"field"`` multiplier is zero away from the contact surface, and a traction
+        """A multiplier field is zero away from the contact surface, and a traction
         multiplier's component i is zero where the displacement's component i is held by one
         of the ``supports`` (a symmetry plane through the contact zone): there that component
         of the contact law has no displacement left to act on, and its row and column of the
         Jacobian would be zero (a singular system). On a symmetry plane the traction component
         normal to the plane vanishes anyway."""
-        if self.method.multiplier != "field":
+        if not self.multiplier_field:
             return []
         W1 = self.state.function_space.sub(1)
 

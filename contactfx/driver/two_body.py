@@ -26,7 +26,7 @@ from contactfx.contact.pair import ContactPair, side_of
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
-from contactfx.driver.problem import Problem
+from contactfx.driver.problem import Problem, SurfaceSetup
 from contactfx.mechanics.elasticity import lame
 from contactfx.results import Friction, Quantities
 
@@ -82,7 +82,9 @@ class TwoBodyProblem(Problem):
     def boundary_conditions(self) -> list:
         return self.scene.dirichlet(self.V, self.facet_tags)
 
-    def make_surface(self):
+    def make_surface(self) -> SurfaceSetup:
+        """No UFL surface: the contact is the solver's coupling of the pair (``pair``, its
+        ``layout``)."""
         mesh, scene, comm = self.mesh, self.scene, self.mesh.comm
         self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
         self.v_load = self.V_test
@@ -108,7 +110,7 @@ class TwoBodyProblem(Problem):
             self.pair.mu, self.pair.previous = self.friction.mu, self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)
-        return None
+        return SurfaceSetup(None, self.ds, self.v_load)
 
     def _lame(self, side) -> np.ndarray:
         """(m, 3): E, lambda, mu of the cell of each facet of ``side``."""

@@ -65,7 +65,7 @@ from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
 from contactfx.driver.grid_multiplier import GridMultiplier
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, InterfacePost, Profile
-from contactfx.driver.problem import Problem
+from contactfx.driver.problem import Problem, SurfaceSetup
 from contactfx.io.vtk import Split
 from contactfx.results import InterfaceQuantities, Quantities
 
@@ -367,7 +367,7 @@ class UnfittedProblem(InterfaceProblem):
                 "unfitted cracks are P1 (--degree 1): the cut cells' area-fraction "
                 "integration is exact for constant strains only"
             )
-        if method.multiplier == "field" and numerics.ncp != "min":
+        if method.multiplier.field and numerics.ncp != "min":
             raise ValueError(
                 "al-ssn on unfitted cracks projects its multiplier's law (--ncp min); the "
                 "Fischer-Burmeister function is not a projection"
@@ -433,7 +433,7 @@ class UnfittedProblem(InterfaceProblem):
 
     def confine_multiplier(self, supports=()) -> list:
         """al-ssn's multiplier lives on the nodes of the cracks' cut cells."""
-        if self.method.multiplier != "field":
+        if not self.multiplier_field:
             return []
         return self.confine(self.state.function_space.sub(1), self._on_cracks)
 
@@ -441,13 +441,13 @@ class UnfittedProblem(InterfaceProblem):
     def coupling(self):
         """al-ssn: its multiplier's equations (:class:`contactfx.driver.grid_multiplier.
         GridMultiplier`); no coupling for the other methods."""
-        if self.method.multiplier != "field":
+        if not self.multiplier_field:
             return None
         return GridMultiplier(self, self.method.projected_law)
 
     def _start_multiplier(self) -> None:
         """al-ssn: the projection of the start's traction; al-uzawa: as a fitted crack's."""
-        if self.method.multiplier != "field":
+        if not self.multiplier_field:
             return super()._start_multiplier()
         coupling = self.coupling()
         vec = _compat.petsc_vec(self.state)
@@ -582,7 +582,7 @@ class UnfittedProblem(InterfaceProblem):
         tip = ufl.outer(aT, ufl.as_vector(t.gR)) + (t.R - 1.0) * t.part_grad(a)
         return mean + self.material.stress((2.0 * crack.fraction - 1.0) * ufl.sym(tip))
 
-    def make_surface(self) -> CutSurface:
+    def make_surface(self) -> SurfaceSetup:
         """The surface of each crack (``surfaces``); the first is the kind's ``surface``."""
         mesh, scene = self.mesh, self.scene
         self.w, self.dw = self.total(self.U), self.total(self.dU)
@@ -635,7 +635,7 @@ class UnfittedProblem(InterfaceProblem):
         first = self.cracks[0]
         self.dSc = self.dS_fine = first.ds
         self.s_coord = first.s_coord
-        return self.surfaces[0]
+        return SurfaceSetup(self.surfaces[0], self.ds, self.v_load)
 
     def _refuse_loaded_crossings(self) -> None:
         """Raise if a crack crosses a boundary facet that carries a load: the load on that

@@ -62,7 +62,7 @@ def bar(method, uL):
     ds = ufl.Measure(
         "ds", domain=mesh, subdomain_data=_tagged(mesh, 0, lambda x: np.isclose(x[0], L), 2)
     )
-    mixed = method.multiplier == "field"
+    mixed = method.multiplier.field
     extra = {}
     if mixed:  # (u, lambda) in [P1]^1 x P1
         state = dolfinx.fem.Function(_compat.mixed_space(mesh, 1, 1, ()))
@@ -150,7 +150,7 @@ def test_residual_1d(name, state):
     F, x = bar(method, STATES[state])
     b = assemble(F)
     vec = [lambda x, h=h: h(x)[None, :] for h in _hats()]  # [P1]^1 fields
-    if method.multiplier == "field":  # (u, lambda) rows: a hat in one component, zero in the other
+    if method.multiplier.field:  # (u, lambda) rows: a hat in one component, zero in the other
         zero = lambda x: np.zeros(x.shape[1])  # noqa: E731
         fields = [(h, zero) for h in vec] + [(lambda x: zero(x)[None, :], h) for h in _hats()]
     else:
