@@ -4,6 +4,7 @@ the user's own mesh (:mod:`contactfx.scenes.problem_file`)."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -75,7 +76,7 @@ def _last_reactions(scene) -> dict[str, list[float]]:
     if not scene.reaction_rows:
         return {}
     row = scene.reaction_rows[-1]
-    return {g: [row[f"{g}_{c}"] for c in "xyz"[: scene.gdim]] for g in scene.spec.reactions}
+    return {g: [row[f"{g}_{c}"] for c in "xyz"[: scene.gdim]] for g in scene.spec.output.reactions}
 
 
 def _write_reactions(scene, out: Path, comm) -> Path | None:
@@ -132,14 +133,13 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     pb = scene.spec
     print(f"{ns.problem}: valid")
     where = (
-        f"{pb.mesh_file} (size factor {pb.size})"
-        if pb.builder is None
-        else f"the {pb.builder[0]} builder"
+        f"{pb.mesh.file} (size factor {pb.mesh.size})" if pb.mesh.builder is None else pb.mesh.label
     )
     print(f"  mesh       {where}, {scene.gdim}D, {problem.dofs()} dofs")
     print("  groups     " + scene.group_list())
-    for group, mat in pb.bodies:
-        print(f"  body       {group}: E = {mat.E:g}, nu = {mat.nu:g}")
+    for body in pb.bodies:
+        mat = body.material
+        print(f"  body       {body.group}: E = {mat.E:g}, nu = {mat.nu:g}")
     for b in pb.boundary:
         what = []
         if b.fix:
@@ -156,39 +156,48 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         if b.stress is not None:
             exact = all(isinstance(v, int | float) for row in b.stress for v in row)
             what.append(f"stress {b.stress}" if exact else "stress (expressions in x, y)")
-        amp = "" if b.amplitude == [(0.0, 0.0), (1.0, 1.0)] else f" x amplitude {b.amplitude}"
+        ramp = ((0.0, 0.0), (1.0, 1.0))
+        amp = "" if b.amplitude == ramp else f" x amplitude {[list(r) for r in b.amplitude]}"
         print(f"  boundary   {b.group}: {'; '.join(what)}{amp}")
     if pb.obstacle is not None:
         ob = pb.obstacle
         size = ", ".join(
-            f"{k} {ob[k]:g}"
+            f"{k} {getattr(ob, k):g}"
             for k in ("radius", "edge_radius", "height", "wavelength", "h")
-            if k in ob
+            if getattr(ob, k) is not None
         )
         moves = (
-            f"along the path {ob['path']}" if "path" in ob else f"moving by {scene.motion.tolist()}"
+            f"along the path {[list(r) for r in ob.path]}"
+            if ob.path is not None
+            else f"moving by {scene.motion.tolist()}"
         )
         print(
-            f"  obstacle   {ob['shape']}{' (' + size + ')' if size else ''} touching "
-            f"{ob['contact']}, from {scene.position.tolist()} {moves}"
+            f"  obstacle   {ob.shape}{' (' + size + ')' if size else ''} touching "
+            f"{ob.contact}, from {scene.position.tolist()} {moves}"
         )
-    for group, force, _ in pb.body_forces:
-        print(f"  body force {group}: {force.tolist()}")
+    for body in pb.bodies:
+        if body.force is not None:
+            print(f"  body force {body.group}: {body.force.tolist()}")
     if pb.initial is not None:
         print("  initial    displacement given (Newton's start)")
-    if pb.contact is not None:
-        print(f"  contact    slave {pb.contact[0]}, master {pb.contact[1]}")
-    for point, comps in pb.pins:
-        print(f"  pin        {point.tolist()}: fixed {','.join('xyz'[c] for c in comps)}")
+    if pb.pair is not None:
+        print(f"  contact    slave {pb.pair.slave}, master {pb.pair.master}")
+    for pin in pb.pins:
+        print(f"  pin        {pin.point.tolist()}: fixed {','.join('xyz'[c] for c in pin.fix)}")
     if pb.interface is not None:
-        keys = [k for k in pb.interface if k != "group"]
-        print(f"  interface  {pb.interface['group']}" + (f" ({', '.join(keys)})" if keys else ""))
+        spec = pb.interface
+        keys = [
+            f.name
+            for f in dataclasses.fields(spec)
+            if f.name != "group" and getattr(spec, f.name) is not None
+        ]
+        print(f"  interface  {spec.group}" + (f" ({', '.join(keys)})" if keys else ""))
     print(
         f"  numerics   method {numerics.method}, friction {numerics.friction}, "
         f"{numerics.steps} step(s), solver {numerics.solver}"
     )
     if file_petsc:
         print(f"  petsc      {file_petsc}")
-    if pb.reactions:
-        print(f"  output     reactions of {', '.join(pb.reactions)}")
+    if pb.output.reactions:
+        print(f"  output     reactions of {', '.join(pb.output.reactions)}")
     return 0

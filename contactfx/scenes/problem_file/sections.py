@@ -1,0 +1,508 @@
+"""One reader per section of a problem file, each returning its frozen spec
+(:mod:`.specs`); :func:`read` runs them in the file's order and checks what joins sections
+(one contact kind, pins and mean displacements with an interface, the bodies a pair or an
+interface needs). Every error is one line naming the file and the key."""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from contactfx.contact.interface import BartonBandis
+from contactfx.mechanics.elasticity import Elastic
+from contactfx.meshes import BUILDERS
+from contactfx.numerics import Numerics
+from contactfx.scenes.problem_file.expressions import parse_expression
+from contactfx.scenes.problem_file.reader import ProblemError, Reader, apply_sets, numbers
+from contactfx.scenes.problem_file.specs import (
+    AXES,
+    BodySpec,
+    BoundarySpec,
+    InterfaceSpec,
+    MeshSpec,
+    ObstacleSpec,
+    OutputSpec,
+    PairSpec,
+    PinSpec,
+    ProblemFile,
+)
+from contactfx.scenes.two_body_base import CONTACT_EDGES
+
+__all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read"]
+
+SECTIONS = (
+    "title",
+    "mesh",
+    "bodies",
+    "boundary",
+    "pins",
+    "obstacle",
+    "contact",
+    "interface",
+    "initial",
+    "numerics",
+    "petsc",
+    "output",
+)
+KEYS = {
+    "mesh": ("file", "size", "builder", "parameters"),
+    "bodies": ("group", "E", "nu", "body_force", "amplitude"),
+    "boundary": (
+        "group",
+        "fix",
+        "displacement",
+        "traction",
+        "pressure",
+        "stress",
+        "amplitude",
+        "quadrature_degree",
+    ),
+    "pins": ("point", "fix"),
+    "obstacle": (
+        "shape",
+        "contact",
+        "radius",
+        "distance",
+        "position",
+        "motion",
+        "amplitude",
+        "path",
+        "height",
+        "wavelength",
+        "edge_radius",
+        "h",
+    ),
+    "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring"),
+    "interface": (
+        "group",
+        "fluid_pressure",
+        "proppant_thickness",
+        "proppant_zone",
+        "joint",
+        "h",
+        "origin",
+        "direction",
+    ),
+    "initial": ("displacement",),
+    "output": (
+        "reactions",
+        "probes",
+        "symmetry",
+        "tangential_symmetry",
+        "contact_size",
+        "mean_displacement",
+    ),
+}
+SHAPES = (
+    "plane",
+    "circle",
+    "cylinder",
+    "sphere",
+    "parabola",
+    "paraboloid",
+    "sinusoid",
+    "punch",
+    "distance",
+)
+#: the contact size reported from the measure m of the contact set (times the symmetry)
+CONTACT_SIZES = ("half-measure", "measure", "disc-radius")
+#: the shapes with a radius
+_ROUND = ("circle", "cylinder", "sphere", "parabola", "paraboloid", "punch")
+
+
+def read_mesh(r: Reader, data: dict) -> MeshSpec:
+    mesh = r.table(data.get("mesh", {}), "mesh", KEYS["mesh"])
+    if "builder" in mesh:
+        for k in ("file", "size"):
+            if k in mesh:
+                r.fail(f"mesh.{k}", "give a mesh file or a builder with its parameters, not both")
+        name = r.string(mesh, "mesh", "builder", tuple(BUILDERS))
+        params = mesh.get("parameters", {})
+        if not isinstance(params, dict):
+            r.fail(
+                "mesh.parameters", f"expected a table of the builder's parameters, got {params!r}"
+            )
+        params = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+        return MeshSpec(None, 1.0, (name, params))
+    if "parameters" in mesh:
+        r.fail("mesh.parameters", "parameters belong to a builder: give mesh.builder")
+    mesh_file = (r.path.parent / r.string(mesh, "mesh", "file")).resolve()
+    return MeshSpec(mesh_file, r.number(mesh, "mesh", "size", 1.0, positive=True))
+
+
+def read_bodies(r: Reader, data: dict) -> tuple[BodySpec, ...]:
+    bodies_data = data.get("bodies")
+    if not isinstance(bodies_data, list) or not bodies_data:
+        r.fail("bodies", "expected at least one [[bodies]] table (group, E, nu)")
+    bodies = []
+    for i, b in enumerate(bodies_data):
+        key = f"bodies.{i}"
+        b = r.table(b, key, KEYS["bodies"])
+        group = r.string(b, key, "group")
+        E = r.number(b, key, "E", positive=True)
+        nu = r.number(b, key, "nu")
+        if not -1.0 < nu < 0.5:
+            r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
+        force, amplitude = None, ()
+        if "body_force" in b:
+            if not numbers(b["body_force"], minimum=1):
+                r.fail(f"{key}.body_force", f"expected a list of numbers, got {b['body_force']!r}")
+            force, amplitude = np.asarray(b["body_force"], dtype=np.float64), r.amplitude(b, key)
+        elif "amplitude" in b:
+            r.fail(f"{key}.amplitude", "an amplitude scales a body_force: give one")
+        bodies.append(BodySpec(group, Elastic(E, nu), force, amplitude))
+    return tuple(bodies)
+
+
+def _boundary(r: Reader, b: Any, key: str) -> BoundarySpec:
+    b = r.table(b, key, KEYS["boundary"])
+    group, amplitude = r.string(b, key, "group"), r.amplitude(b, key)
+    if not any(k in b for k in ("fix", "displacement", "traction", "pressure", "stress")):
+        r.fail(key, "give one of fix, displacement, traction, pressure, stress")
+    fix = r.components(b["fix"], f"{key}.fix", AXES) if "fix" in b else ()
+    displacement = {}
+    if "displacement" in b:
+        disp = b["displacement"]
+        if not isinstance(disp, dict) or not disp or any(c not in AXES for c in disp):
+            r.fail(
+                f"{key}.displacement",
+                f"expected a table of components, e.g. {{ y = -0.01 }}, got {disp!r}",
+            )
+        displacement = {AXES.index(c): r.number(disp, f"{key}.displacement", c) for c in disp}
+        both = set(fix) & set(displacement)
+        if both:
+            r.fail(key, f"component {AXES[min(both)]} is both fixed and prescribed")
+    traction = None
+    if "traction" in b:
+        if not numbers(b["traction"]):
+            r.fail(f"{key}.traction", f"expected a list of numbers, got {b['traction']!r}")
+        traction = np.asarray(b["traction"], dtype=np.float64)
+    pressure = r.optional_number(b, key, "pressure")
+    stress = _stress(r, b["stress"], f"{key}.stress") if "stress" in b else None
+    degree = None
+    if "quadrature_degree" in b:
+        degree = b["quadrature_degree"]
+        if isinstance(degree, bool) or not isinstance(degree, int) or not 1 <= degree <= 30:
+            r.fail(f"{key}.quadrature_degree", f"expected an integer in 1..30, got {degree!r}")
+    return BoundarySpec(group, fix, displacement, traction, pressure, amplitude, stress, degree)
+
+
+def read_boundary(r: Reader, data: dict) -> tuple[BoundarySpec, ...]:
+    return tuple(_boundary(r, b, f"boundary.{i}") for i, b in enumerate(data.get("boundary", [])))
+
+
+def _stress(r: Reader, value: Any, key: str) -> tuple[tuple[Any, ...], ...]:
+    """A boundary's stress tensor: d rows of d entries, each a number or an expression in x,
+    y, z (:func:`parse_expression`; e.g. a closed-form field around a crack)."""
+    ok = (
+        isinstance(value, list)
+        and len(value) in (1, 2, 3)
+        and all(
+            isinstance(row, list)
+            and len(row) == len(value)
+            and all(isinstance(v, int | float | str) and not isinstance(v, bool) for v in row)
+            for row in value
+        )
+    )
+    if not ok:
+        r.fail(
+            key,
+            "expected a square table of numbers or expressions in x, y, z (the stress "
+            f"tensor's rows), got {value!r}",
+        )
+    out = []
+    for row in value:
+        entries: list[Any] = []
+        for v in row:
+            if isinstance(v, str):
+                try:
+                    v = parse_expression(v)
+                except ValueError as err:
+                    r.fail(key, str(err))
+            elif not np.isfinite(v):
+                r.fail(key, f"must be finite, got {v}")
+            else:
+                v = float(v)
+            entries.append(v)
+        out.append(tuple(entries))
+    return tuple(out)
+
+
+def read_pins(r: Reader, data: dict) -> tuple[PinSpec, ...]:
+    pins_data = data.get("pins", [])
+    if not isinstance(pins_data, list):
+        r.fail("pins", "expected [[pins]] tables (point, fix)")
+    pins = []
+    for i, q in enumerate(pins_data):
+        key = f"pins.{i}"
+        q = r.table(q, key, KEYS["pins"])
+        point = q.get("point")
+        if not numbers(point, (1, 2, 3)):
+            r.fail(f"{key}.point", f"expected the coordinates of a mesh vertex, got {point!r}")
+        fix = r.components(q.get("fix"), f"{key}.fix", AXES)
+        pins.append(PinSpec(np.asarray(point, dtype=np.float64), fix))
+    return tuple(pins)
+
+
+def read_interface(r: Reader, data: dict) -> InterfaceSpec:
+    d = r.table(data["interface"], "interface", KEYS["interface"])
+    group = r.string(d, "interface", "group")
+    fluid = r.optional_number(d, "interface", "fluid_pressure")
+    thickness = r.optional_number(d, "interface", "proppant_thickness", positive=True)
+    zone = None
+    if "proppant_zone" in d:
+        zone = d["proppant_zone"]
+        if thickness is None:
+            r.fail(
+                "interface.proppant_zone",
+                "a zone of the proppant layer: give its proppant_thickness",
+            )
+        if not (numbers(zone, 2) and np.all(np.isfinite(zone)) and zone[0] < zone[1]):
+            r.fail(
+                "interface.proppant_zone",
+                "expected [s0, s1] with s0 < s1 (the layer's "
+                f"ends along the interface coordinate s), got {zone!r}",
+            )
+        zone = (float(zone[0]), float(zone[1]))
+    h = r.optional_number(d, "interface", "h", positive=True)
+    origin = r.vector(d["origin"], "interface.origin", 2) if "origin" in d else None
+    direction = None
+    if "direction" in d:
+        direction = r.vector(d["direction"], "interface.direction", 2)
+        norm = float(np.linalg.norm(direction))
+        if not np.isfinite(norm) or norm == 0.0:
+            r.fail("interface.direction", "expected a nonzero vector along the interface")
+        direction = direction / norm
+    joint = None
+    if "joint" in d:
+        j = r.table(d["joint"], "interface.joint", ("Kni", "Vm", "w0"))
+        values = {k: r.number(j, "interface.joint", k, positive=True) for k in ("Kni", "Vm", "w0")}
+        try:
+            joint = BartonBandis(**values)
+        except ValueError as err:
+            r.fail("interface.joint", str(err))
+    return InterfaceSpec(group, fluid, thickness, zone, joint, h, origin, direction)
+
+
+def read_obstacle(r: Reader, data: dict) -> ObstacleSpec:
+    d = r.table(data["obstacle"], "obstacle", KEYS["obstacle"])
+    shape = r.string(d, "obstacle", "shape", SHAPES)
+    contact = r.string(d, "obstacle", "contact")
+    radius = r.number(d, "obstacle", "radius", positive=True) if shape in _ROUND else None
+    edge_radius = None
+    if shape == "punch":
+        edge_radius = r.number(d, "obstacle", "edge_radius", positive=True)
+    height = wavelength = None
+    if shape == "sinusoid":
+        height = r.number(d, "obstacle", "height", positive=True)
+        wavelength = r.number(d, "obstacle", "wavelength", positive=True)
+    h = r.optional_number(d, "obstacle", "h", positive=True)
+    path = None
+    if "path" in d:
+        for k in ("motion", "amplitude"):
+            if k in d:
+                r.fail(f"obstacle.{k}", "give either path or motion (with its amplitude)")
+        path = r.offsets(d, "obstacle")
+    distance = None
+    if shape == "distance":
+        text = r.string(d, "obstacle", "distance")
+        try:
+            distance = parse_expression(text)
+        except ValueError as err:
+            r.fail("obstacle.distance", str(err))
+    return ObstacleSpec(
+        shape,
+        contact,
+        r.amplitude(d, "obstacle"),
+        radius=radius,
+        edge_radius=edge_radius,
+        height=height,
+        wavelength=wavelength,
+        distance=distance,
+        h=h,
+        position=d.get("position"),
+        motion=d.get("motion"),
+        path=path,
+    )
+
+
+def read_pair(r: Reader, data: dict, bodies: tuple[BodySpec, ...]) -> PairSpec:
+    contact_list = data["contact"]
+    if not isinstance(contact_list, list) or len(contact_list) != 1:
+        r.fail("contact", "expected one [[contact]] pair (slave, master)")
+    c = r.table(contact_list[0], "contact.0", KEYS["contact"])
+    slave, master = r.string(c, "contact.0", "slave"), r.string(c, "contact.0", "master")
+    if slave == master:
+        r.fail("contact.0", "the slave and master surfaces of a pair must differ")
+    if len(bodies) != 2:
+        r.fail("bodies", f"a contact pair needs two bodies, got {len(bodies)}")
+    h = r.optional_number(c, "contact.0", "h", positive=True)
+    force_on = None
+    if "force_on" in c:
+        force_on = r.string(c, "contact.0", "force_on", [b.group for b in bodies])
+    edge = r.string(c, "contact.0", "edge", CONTACT_EDGES) if "edge" in c else None
+    ring = None
+    if "edge_ring" in c:
+        if edge != "radial":
+            r.fail("contact.0.edge_ring", "the ring width of edge = 'radial' only")
+        ring = r.number(c, "contact.0", "edge_ring", positive=True)
+    elif edge == "radial":
+        r.fail(
+            "contact.0.edge_ring",
+            "missing (the ring width of edge = 'radial', about the slave element size)",
+        )
+    return PairSpec(slave, master, h, force_on, edge, ring)
+
+
+def read_output(r: Reader, data: dict) -> OutputSpec:
+    output = r.table(data.get("output", {}), "output", KEYS["output"])
+    reactions = output.get("reactions", [])
+    if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
+        r.fail("output.reactions", f"expected a list of group names, got {reactions!r}")
+    probes = output.get("probes", [])
+    if not isinstance(probes, list) or not all(numbers(q, (2, 3)) for q in probes):
+        r.fail("output.probes", f"expected a list of points [x, y(, z)], got {probes!r}")
+    symmetry = r.number(output, "output", "symmetry", 1.0, positive=True)
+    tsym = output.get("tangential_symmetry")
+    if tsym is not None and not numbers(tsym):
+        r.fail("output.tangential_symmetry", f"expected a list of numbers, got {tsym!r}")
+    mean = output.get("mean_displacement", {})
+    if not isinstance(mean, dict) or not all(
+        isinstance(v, list) and len(v) == 2 and isinstance(v[0], str) and v[1] in AXES
+        for v in mean.values()
+    ):
+        r.fail(
+            "output.mean_displacement",
+            "expected a table name = [group, component], e.g. "
+            f'{{ top_displacement = ["top", "y"] }}, got {mean!r}',
+        )
+    size = None
+    if "contact_size" in output:
+        size = r.string(output, "output", "contact_size", CONTACT_SIZES)
+    return OutputSpec(
+        tuple(reactions),
+        tuple(tuple(float(v) for v in q) for q in probes),
+        symmetry,
+        None if tsym is None else tuple(float(v) for v in tsym),
+        size,
+        {name: (v[0], v[1]) for name, v in mean.items()},
+    )
+
+
+def read_initial(r: Reader, data: dict) -> tuple | None:
+    initial = r.table(data.get("initial", {}), "initial", KEYS["initial"])
+    displacement = initial.get("displacement")
+    if displacement is None:
+        return None
+    if not isinstance(displacement, list) or not all(
+        isinstance(e, str | int | float) for e in displacement
+    ):
+        r.fail(
+            "initial.displacement",
+            f"expected a list of expressions in x, y, z (one per component), got {displacement!r}",
+        )
+    try:
+        return tuple(parse_expression(str(e)) for e in displacement)
+    except ValueError as err:
+        r.fail("initial.displacement", str(err))
+
+
+def read_numerics(r: Reader, data: dict) -> dict:
+    """The ``[numerics]`` overrides (checked by Numerics itself in :func:`load_problem`)."""
+    allowed = tuple(f.name for f in dataclasses.fields(Numerics))
+    return dict(r.table(data.get("numerics", {}), "numerics", allowed))
+
+
+def read_petsc(r: Reader, data: dict) -> dict:
+    petsc = data.get("petsc", {})
+    if not isinstance(petsc, dict):
+        r.fail("petsc", f"expected a table of PETSc options, got {petsc!r}")
+    return {
+        k: (None if v == "" else str(v).lower() if isinstance(v, bool) else str(v))
+        for k, v in petsc.items()
+    }
+
+
+def _contact_kind(r: Reader, data: dict) -> str:
+    """The one contact kind of the file: obstacle, contact (a pair) or interface."""
+    given = [k for k in ("obstacle", "contact", "interface") if data.get(k) is not None]
+    if not given:
+        r.fail("obstacle", "a problem needs an [obstacle], a [[contact]] pair or an [interface]")
+    if len(given) > 1:
+        r.fail(
+            given[1],
+            "give one of [obstacle], [[contact]], [interface], not "
+            f"{' and '.join(given)} (one contact kind per problem)",
+        )
+    return given[0]
+
+
+def _check_interface(
+    r: Reader, bodies: tuple[BodySpec, ...], boundary: tuple[BoundarySpec, ...]
+) -> None:
+    if len(bodies) != 1:
+        r.fail("bodies", f"an interface lies inside one body, got {len(bodies)} bodies")
+    for i, b in enumerate(boundary):
+        if b.displacement:
+            r.fail(
+                f"boundary.{i}.displacement",
+                "prescribed displacements are not offered "
+                "with an [interface] yet (fix, traction, pressure are)",
+            )
+
+
+def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
+    """(problem, numerics overrides, PETSc options) of the file, without the mesh."""
+    if not path.is_file():
+        raise FileNotFoundError(f"problem file {str(path)!r} not found")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as err:
+        raise ProblemError(f"{path}: not valid TOML: {err}") from None
+    data = apply_sets(data, sets, str(path))
+    r = Reader(path)
+    for key in data:
+        if key not in SECTIONS:
+            r.fail(key, f"unknown section (allowed: {', '.join(SECTIONS)})")
+    mesh = read_mesh(r, data)
+    bodies = read_bodies(r, data)
+    boundary = read_boundary(r, data)
+    pins = read_pins(r, data)
+    kind = _contact_kind(r, data)
+    obstacle = pair = interface = None
+    if kind == "interface":
+        interface = read_interface(r, data)
+        _check_interface(r, bodies, boundary)
+    if pins and interface is None:
+        r.fail(
+            "pins", "pinned points are offered with an [interface] (use fix on a group otherwise)"
+        )
+    if kind == "obstacle":
+        obstacle = read_obstacle(r, data)
+    if kind == "contact":
+        pair = read_pair(r, data, bodies)
+    output = read_output(r, data)
+    initial = read_initial(r, data)
+    if output.mean_displacement and interface is None:
+        r.fail("output.mean_displacement", "reported with an [interface] only")
+    title = data.get("title", path.stem)
+    if not isinstance(title, str):
+        r.fail("title", f"expected a string, got {title!r}")
+    problem = ProblemFile(
+        path=path,
+        title=title,
+        mesh=mesh,
+        bodies=bodies,
+        boundary=boundary,
+        pins=pins,
+        obstacle=obstacle,
+        pair=pair,
+        interface=interface,
+        initial=initial,
+        output=output,
+    )
+    return problem, read_numerics(r, data), read_petsc(r, data)
