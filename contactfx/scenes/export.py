@@ -20,23 +20,12 @@ from mpi4py import MPI
 from contactfx.io.toml import dumps
 from contactfx.meshes import write_msh
 from contactfx.numerics import Numerics
+from contactfx.scenes.problem_file.specs import SECTIONS
 
 __all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
 
-ORDER = (
-    "title",
-    "mesh",
-    "bodies",
-    "boundary",
-    "pins",
-    "obstacle",
-    "contact",
-    "interface",
-    "initial",
-    "numerics",
-    "petsc",
-    "output",
-)
+#: the sections in the order a problem file is read and written
+ORDER = SECTIONS
 
 
 def numerics_table(numerics: Numerics) -> dict:

@@ -20,6 +20,7 @@ from contactfx.scenes.problem_file.expressions import parse_expression
 from contactfx.scenes.problem_file.reader import ProblemError, Reader, apply_sets, numbers
 from contactfx.scenes.problem_file.specs import (
     AXES,
+    SECTIONS,
     BodySpec,
     BoundarySpec,
     InterfaceSpec,
@@ -34,20 +35,6 @@ from contactfx.scenes.two_body_base import CONTACT_EDGES
 
 __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read"]
 
-SECTIONS = (
-    "title",
-    "mesh",
-    "bodies",
-    "boundary",
-    "pins",
-    "obstacle",
-    "contact",
-    "interface",
-    "initial",
-    "numerics",
-    "petsc",
-    "output",
-)
 KEYS = {
     "mesh": ("file", "size", "builder", "parameters"),
     "bodies": ("group", "E", "nu", "body_force", "amplitude"),

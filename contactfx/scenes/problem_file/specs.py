@@ -15,6 +15,7 @@ from contactfx.mechanics.elasticity import Elastic
 
 __all__ = [
     "AXES",
+    "SECTIONS",
     "MeshSpec",
     "BodySpec",
     "BoundarySpec",
@@ -27,6 +28,21 @@ __all__ = [
 ]
 
 AXES = ("x", "y", "z")
+#: the sections of a problem file, in the order they are read and written
+SECTIONS = (
+    "title",
+    "mesh",
+    "bodies",
+    "boundary",
+    "pins",
+    "obstacle",
+    "contact",
+    "interface",
+    "initial",
+    "numerics",
+    "petsc",
+    "output",
+)
 
 #: a (load factor, multiplier) table
 Amplitude = tuple[tuple[float, float], ...]
