@@ -132,6 +132,14 @@ CASES: list[tuple[str, list[str]]] = [
         ["run", "crack-sneddon", "--crack", "unfitted", "--method", "penalty"],
     ),
     ("joint-column-unfitted", ["run", "joint-column", "--crack", "unfitted"]),
+    (
+        "crack-inclined-unfitted-al-ssn",
+        ["run", "crack-inclined", "--crack", "unfitted", "--beta", "30", "--method", "al-ssn"],
+    ),
+    (
+        "joint-column-unfitted-al-ssn",
+        ["run", "joint-column", "--crack", "unfitted", "--method", "al-ssn"],
+    ),
     ("patch-test-mortar", ["run", "patch-test", "--method", "mortar"]),
     ("patch-test-nitsche", ["run", "patch-test", "--method", "nitsche"]),
     ("hertz-cylinders-mortar", ["run", "hertz-cylinders", "--method", "mortar"]),

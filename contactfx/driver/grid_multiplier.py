@@ -157,7 +157,9 @@ class GridMultiplier:
         f = F.getArray()
         f[self.rows] += x.getArray(readonly=True)[self.rows]
 
-    def jacobian(self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat) -> None:
+    def jacobian(
+        self, x: PETSc.Vec, K: PETSc.Mat, J: PETSc.Mat, *, bulk_changed: bool = False
+    ) -> None:
         """J = K + I - R G on the multiplier rows (the contact forms' Jacobian is added by the
         solver)."""
         _compat.assemble_matrix(self.G, self.a)

@@ -320,7 +320,7 @@ def _jacobian_check(scene, num, displace):
     solver._sync(x)
     solver.coupling.update(solver.u.x.array)
     x0 = x.copy()  # x is the solver's state: every residual evaluation overwrites it
-    F0, F1, F2 = (solver.K.createVecLeft() for _ in range(3))
+    F0, F1, F2 = (solver.bulk.create_vector() for _ in range(3))
     solver._residual(None, x0, F0)
     J = solver.J
     solver._jacobian(None, x0, J, J)
@@ -558,7 +558,7 @@ def test_mortar_slip_is_objective_under_translation():
     coupling = solver.coupling
     # the search at the step's start (the converged state), then the residual at the shift
     coupling.update(pb.prev.x.array)
-    F = solver.K.createVecLeft()
+    F = solver.bulk.create_vector()
     solver._residual(None, x.copy(), F)
     rows = coupling.tangent_rows()[coupling.tmask]
     slip = coupling._g.getArray()[rows]
