@@ -95,6 +95,9 @@ class Solver(Protocol):
     def bulk_residual(self) -> PETSc.Vec:
         """R(u) = f_int(u) - f_ext without the contact terms."""
 
+    def reassemble_bulk(self) -> None:
+        """The bulk's forms changed their constants: assemble its Jacobian again."""
+
     def reuse_factorisation(self) -> None:
         """Keep an LU factorisation across Newton iterations (starts close to the solution)."""
 
@@ -127,6 +130,9 @@ class SolverWrapper:
 
     def bulk_residual(self) -> PETSc.Vec:
         return self.inner.bulk_residual()
+
+    def reassemble_bulk(self) -> None:
+        self.inner.reassemble_bulk()
 
     def reuse_factorisation(self) -> None:
         self.inner.reuse_factorisation()

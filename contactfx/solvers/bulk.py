@@ -56,6 +56,10 @@ class Bulk(Protocol):
     def create_vector(self) -> PETSc.Vec:
         """A new vector of the residual's layout (the caller destroys it)."""
 
+    def reassemble(self) -> None:
+        """Assemble K again at the next call: the constants of its forms changed (a dynamic
+        stepper's new step size in the effective stiffness K + c M)."""
+
     def destroy(self) -> None: ...
 
 
@@ -88,6 +92,11 @@ class LinearBulk(_BulkBase):
 
     def __init__(self, *, stiffness: Form, load: Form) -> None:
         super().__init__(load, _compat.assemble_matrix(_compat.create_matrix(stiffness), stiffness))
+        self.stiffness = stiffness
+
+    def reassemble(self) -> None:
+        """K assembled again, in place (same pattern)."""
+        _compat.assemble_matrix(self.K, self.stiffness)
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         self.K.mult(x, F)
@@ -114,6 +123,9 @@ class NonlinearBulk(_BulkBase):
         self.f = _compat.create_vector(internal)
         self._assembled = False
         self.jacobian(None)  # the pattern's values: the solver copies K before any iterate
+
+    def reassemble(self) -> None:
+        self._assembled = False
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         _compat.assemble_vector(self.f, self.internal)

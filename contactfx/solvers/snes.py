@@ -426,6 +426,18 @@ class ContactSNES:
         self._unconstrained_residual(x, R, search=False)
         return R
 
+    def reassemble_bulk(self) -> None:
+        """The bulk's forms changed their constants (a dynamic stepper's step size): K is
+        assembled again (the kept block of the reduced system with it) and the preconditioner
+        is set up anew at the next solve."""
+        t0 = time.perf_counter()
+        self.bulk.reassemble()
+        K = self.bulk.jacobian(_compat.petsc_vec(self.u))
+        if self.reduced is not None and self.bulk.constant_jacobian:
+            self.reduced.bulk_block(K)
+        self.snes.getKSP().getPC().reset()
+        self.timer.assembly += time.perf_counter() - t0
+
     def bulk_residual(self) -> PETSc.Vec:
         """The bulk's residual R(u) = f_int(u) - f_ext at the current u, without the contact
         terms: minus the force the contact (and the supports) exert on each dof. Collective;

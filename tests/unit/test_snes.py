@@ -39,17 +39,17 @@ H = L / N
 RTOL, ATOL = DEFAULT_OPTIONS["snes_rtol"], DEFAULT_OPTIONS["snes_atol"]
 
 
-def g(u, t):
-    return E / L * u + K * u**3 - t * F * L / 2.0
+def g(u, t, e=E):
+    return e / L * u + K * u**3 - t * F * L / 2.0
 
 
-def root(t):
+def root(t, e=E):
     """Bisection on g (increasing) over [0, t F L^2 / (2 E)] (the root lies below the
-    spring-free end displacement): 200 halvings reach the last ulp."""
-    lo, hi = 0.0, t * F * L**2 / (2.0 * E)
+    spring-free end displacement): 200 halvings reach the last ulp. ``e``: Young's modulus."""
+    lo, hi = 0.0, t * F * L**2 / (2.0 * e)
     for _ in range(200):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if g(mid, t) < 0.0 else (lo, mid)
+        lo, hi = (mid, hi) if g(mid, t, e) < 0.0 else (lo, mid)
     return 0.5 * (lo + hi)
 
 
@@ -77,10 +77,11 @@ def tolerance(f0):
     return L / E * np.sqrt(N + 1) * max(ATOL, RTOL * f0) + 1e-14
 
 
-def make_solver(prefix, bulk="linear", **kwargs):
+def make_solver(prefix, bulk="linear", modulus=None, **kwargs):
     """(ContactSNES, u, load factor Constant) of the bar; kwargs go to ContactSNES. ``bulk``:
     its linear part as a LinearBulk (``"linear"``) or as the residual form of a NonlinearBulk,
-    assembled at every iteration (``"nonlinear"``) or once (``"constant"``)."""
+    assembled at every iteration (``"nonlinear"``) or once (``"constant"``); ``modulus``: a
+    function of the mesh giving E in the forms (default the float E)."""
     mesh = _compat.create_interval(COMM, N, L)
     V = _compat.function_space(mesh, "Lagrange", 1)
     u, v, du = dolfinx.fem.Function(V), ufl.TestFunction(V), ufl.TrialFunction(V)
@@ -90,13 +91,14 @@ def make_solver(prefix, bulk="linear", **kwargs):
     left = dolfinx.mesh.locate_entities_boundary(mesh, 0, lambda x: np.isclose(x[0], 0.0))
     bc = _compat.dirichletbc(PETSc.ScalarType(0.0), _compat.locate_dofs_topological(V, 0, left), V)
     t = dolfinx.fem.Constant(mesh, PETSc.ScalarType(1.0))
+    e = E if modulus is None else modulus(mesh)
     Fc = K * u**3 * v * ds(2)
     load = dolfinx.fem.form(t * F * v * ufl.dx)
     if bulk == "linear":
-        a = E * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx
+        a = e * ufl.inner(ufl.grad(du), ufl.grad(v)) * ufl.dx
         bulk = LinearBulk(stiffness=dolfinx.fem.form(a), load=load)
     else:
-        f_int = E * ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx
+        f_int = e * ufl.inner(ufl.grad(u), ufl.grad(v)) * ufl.dx
         bulk = NonlinearBulk(
             internal=dolfinx.fem.form(f_int),
             tangent=dolfinx.fem.form(ufl.derivative(f_int, u, du)),
@@ -115,13 +117,14 @@ def make_solver(prefix, bulk="linear", **kwargs):
     return solver, u, t
 
 
-def nodal_error(u, t):
-    """max over the nodes of |u - exact discrete root at load t| (all ranks)."""
-    uL = root(t)
-    c = (uL + t * F * L**2 / (2.0 * E)) / L
+def nodal_error(u, t, e=E):
+    """max over the nodes of |u - exact discrete root at load t| (all ranks; ``e``: Young's
+    modulus)."""
+    uL = root(t, e)
+    c = (uL + t * F * L**2 / (2.0 * e)) / L
     n = u.function_space.dofmap.index_map.size_local
     x = _compat.dof_coordinates(u.function_space)[:n, 0]
-    err = np.abs(u.x.array[:n] - (-t * F * x**2 / (2.0 * E) + c * x))
+    err = np.abs(u.x.array[:n] - (-t * F * x**2 / (2.0 * e) + c * x))
     return COMM.allreduce(err.max(initial=0.0), op=MPI.MAX)
 
 
@@ -364,3 +367,30 @@ def test_linear_start_failure_names_the_reason():
     exact = -F * x**2 / (2.0 * E) + F * L * x / E  # u' (L) = 0, t = 1
     # P1 is nodally exact in 1D; the LU solve is exact to round-off
     assert COMM.allreduce(np.abs(u.x.array[:n] - exact).max(initial=0.0), op=MPI.MAX) < 1e-12
+
+
+@pytest.mark.parametrize("bulk", ["linear", "nonlinear", "constant"])
+def test_bulk_reassembled_when_its_constants_change(bulk):
+    """E a Constant of the bulk's forms, doubled after a first solve (as a dynamic stepper
+    changes its step size in K + c M): after ``reassemble_bulk`` the solver finds the root of
+    the stiffer bar, for a bulk assembled once (K again, in place) or at every iteration. The
+    first solve is the root with E; a linear bulk not reassembled would keep solving it."""
+    moduli = []
+
+    def modulus(mesh):
+        moduli.append(dolfinx.fem.Constant(mesh, PETSc.ScalarType(E)))
+        return moduli[-1]
+
+    solver, u, t = make_solver(f"cfx_unit_reassemble_{bulk}_", bulk, modulus=modulus)
+    solver.assemble_load()
+    solver.solve()
+    first = nodal_error(u, 1.0)
+    moduli[0].value = 2.0 * E
+    solver.reassemble_bulk()
+    solver.solve()
+    second = nodal_error(u, 1.0, 2.0 * E)
+    solver.destroy()
+    # tolerance(): the bound of the SNES stopping test (with E; the stiffer bar's is smaller)
+    assert first < tolerance(f0_from_zero(1.0))
+    assert second < tolerance(f0_from_zero(1.0))
+    assert root(1.0, 2.0 * E) < 0.9 * root(1.0)  # the two roots differ far beyond that
