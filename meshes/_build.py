@@ -161,12 +161,10 @@ def build(comm: MPI.Comm, builder: Builder, gdim: int, name: str) -> MeshData:
     ghost mode ``none``, dolfinx's default from 0.8 on, such a facet has one local cell: dolfinx
     0.9 refuses to create a ``dS`` form over it (RuntimeError), dolfinx 0.5 silently skips it.
 
-    Args:
-        comm: The communicator of the mesh.
-        builder: A geometry function with its parameters bound, e.g.
-            ``functools.partial(rectangle, x0=-1.0, ...)``.
-        gdim: Geometric dimension of the mesh (2 or 3).
-        name: Name of the gmsh model and of the dolfinx mesh.
+    ``comm``: the communicator of the mesh; ``builder``: a geometry function with its
+    parameters bound, e.g. ``functools.partial(rectangle, x0=-1.0, ...)``; ``gdim``: the
+    geometric dimension of the mesh (2 or 3); ``name``: the name of the gmsh model and of the
+    dolfinx mesh.
     """
     import gmsh
 

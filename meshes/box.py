@@ -67,18 +67,15 @@ def box(
 ) -> None:
     """Build and mesh the box [x0, x1] x [y0, y1] x [z0, z1] in ``model`` (a gmsh builder).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        x0, x1, y0, y1, z0, z1: Corners of the box (length).
-        refine_center: (cx, cy) of the refinement centre (cx, cy, z1) on the top face,
-            x0 <= cx <= x1, y0 <= cy <= y1 (length).
-        refine_radius: Radius of the ball around the centre meshed with h_contact (length).
-        h_contact: Element size near the refinement centre (length).
-        h_far: Element size far from it, >= h_contact (length).
-        grading: Size increase per unit distance from the refinement ball (dimensionless).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``x0``, ``x1``, ``y0``,
+    ``y1``, ``z0``, ``z1``: the corners of the box (length); ``refine_center``: (cx, cy) of the
+    refinement centre (cx, cy, z1) on the top face, x0 <= cx <= x1, y0 <= cy <= y1 (length);
+    ``refine_radius``: the radius of the ball around the centre meshed with h_contact (length);
+    ``h_contact``: the element size near the refinement centre (length); ``h_far``: the element
+    size far from it, >= h_contact (length); ``grading``: the size increase per unit distance
+    from the refinement ball (dimensionless).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     if len(refine_center) != 2:
         raise ValueError(f"refine_center must be (cx, cy), got {refine_center}")

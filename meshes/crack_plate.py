@@ -80,25 +80,23 @@ def crack_plate(
 ) -> None:
     """Build and mesh the cracked square [-half_width, half_width]^2 in ``model`` (a gmsh builder).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        half_width: Half the side of the square plate (length).
-        crack_half_length: Half-length a < half_width of the crack, centred at the origin
-            (length); the crack tips are then inside the plate at any angle.
-        angle: Angle of the crack from the x axis, counter-clockwise (degrees).
-        h_crack: Element size along and near the crack (length).
-        h_far: Element size far from the crack, >= h_crack (length).
-        grading: Size increase per unit distance from the crack (dimensionless).
-        split_at: Distinct positions -a < s < a along the crack (signed distance from the
-            centre) that must be mesh nodes, e.g. the ends of a proppant layer (length).
-        h_tip: Element size at the crack tips, <= h_crack (default h_crack): the size grows
-            from h_tip at the tips by ``grading`` per unit distance up to h_crack (length).
-        embed: Whether the crack is a chain of mesh edges; False: the plate's mesh ignores
-            the crack (a background mesh for an unfitted crack, graded towards the crack as
-            the fitted one; no ``CRACK`` group, ``split_at`` unused).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``half_width``: half the
+    side of the square plate (length); ``crack_half_length``: the half-length a < half_width of
+    the crack, centred at the origin (length), so that the crack tips are inside the plate at
+    any angle; ``angle``: the angle of the crack from the x axis, counter-clockwise (degrees);
+    ``h_crack``: the element size along and near the crack (length); ``h_far``: the element
+    size far from the crack, >= h_crack (length); ``grading``: the size increase per unit
+    distance from the crack (dimensionless).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    ``split_at``: distinct positions -a < s < a along the crack (signed distance from the
+    centre) that must be mesh nodes, e.g. the ends of a proppant layer (length). ``h_tip``: the
+    element size at the crack tips, <= h_crack (default h_crack): the size grows from h_tip at
+    the tips by ``grading`` per unit distance up to h_crack (length). ``embed``: whether the
+    crack is a chain of mesh edges; with False the plate's mesh ignores the crack (a background
+    mesh for an unfitted crack, graded towards the crack as the fitted one; no ``CRACK`` group,
+    ``split_at`` unused).
+
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(
         half_width=half_width,
@@ -217,8 +215,7 @@ def structured_plate(
     edges). Facet tags as :func:`crack_plate` (no ``CRACK`` group); the triangles are the
     grid's squares split along their (1, 1) diagonals.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(half_width=half_width, inner_half_width=inner_half_width, h=h, growth=growth)
     check_positive(half_width=half_width, inner_half_width=inner_half_width, h=h)
@@ -289,8 +286,7 @@ def crack_set_plate(
     ``grading`` per unit distance up to ``h_far`` (the smallest over the cracks holds).
     Facet tags as :func:`crack_plate` (no ``CRACK`` group).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(
         half_width=half_width,

@@ -62,15 +62,12 @@ def joint_column(
 ) -> None:
     """Build and mesh the two-block column [0, width] x [0, 2 H] in ``model`` (a gmsh builder).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        width: Width of the column and length of the joint (length).
-        block_height: Height H of each block; the joint is the line y = H (length).
-        h: Element size (length).
-        fitted: Whether the mesh follows the joint (False: one rectangle, no ``JOINT``).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``width``: the width of
+    the column and length of the joint (length); ``block_height``: the height H of each block
+    (length), the joint being the line y = H; ``h``: the element size (length); ``fitted``:
+    whether the mesh follows the joint (False: one rectangle, no ``JOINT``).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(width=width, block_height=block_height, h=h)
     check_positive(width=width, block_height=block_height, h=h)

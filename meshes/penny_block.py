@@ -78,19 +78,15 @@ def penny_block(
 ) -> None:
     """Build and mesh the quarter (or half) block with its penny crack in ``model``.
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        half_width: The block is [0, half_width]^2 x [-half_width, half_width] (length).
-        crack_radius: Radius a < half_width of the crack, centred at the origin in z = 0
-            (length).
-        h_front: Element size at the crack front r = a, <= h_crack (length).
-        h_crack: Element size on and near the crack, <= h_far (length).
-        h_far: Element size far from the crack (length).
-        grading: Size increase per unit distance (dimensionless).
-        half: The half block y >= 0 instead of the quarter x, y >= 0.
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``half_width``: the block
+    is [0, half_width]^2 x [-half_width, half_width] (length); ``crack_radius``: the radius
+    a < half_width of the crack, centred at the origin in z = 0 (length); ``h_front``: the
+    element size at the crack front r = a, <= h_crack (length); ``h_crack``: the element size on
+    and near the crack, <= h_far (length); ``h_far``: the element size far from the crack
+    (length); ``grading``: the size increase per unit distance (dimensionless); ``half``: the
+    half block y >= 0 instead of the quarter x, y >= 0.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(
         half_width=half_width,

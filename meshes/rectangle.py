@@ -68,20 +68,17 @@ def rectangle(
 ) -> None:
     """Build and mesh the rectangle [x0, x1] x [y0, y1] in ``model`` (a gmsh builder).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        x0, x1, y0, y1: Corners of the rectangle (length).
-        refine_x0, refine_x1: Ends of the contact zone on the top edge y = y1, with
-            x0 <= refine_x0 < refine_x1 <= x1 (length).
-        h_contact: Element size in and near the contact zone (length).
-        h_far: Element size far from the contact zone, >= h_contact (length).
-        grading: Size increase per unit distance from the contact zone (dimensionless).
-        interfaces: Heights y0 < y < y1 of horizontal lines across the rectangle that the mesh
-            must resolve (material interfaces of a layered block; length). The cells above the
-            highest one are the cell group ``layer``, the others ``domain``.
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``x0``, ``x1``, ``y0``,
+    ``y1``: the corners of the rectangle (length); ``refine_x0``, ``refine_x1``: the ends of the
+    contact zone on the top edge y = y1, with x0 <= refine_x0 < refine_x1 <= x1 (length);
+    ``h_contact``: the element size in and near the contact zone (length); ``h_far``: the
+    element size far from the contact zone, >= h_contact (length); ``grading``: the size
+    increase per unit distance from the contact zone (dimensionless); ``interfaces``: the
+    heights y0 < y < y1 of horizontal lines across the rectangle that the mesh must resolve
+    (material interfaces of a layered block; length). The cells above the highest one are the
+    cell group ``layer``, the others ``domain``.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(
         x0=x0,

@@ -417,18 +417,14 @@ def stacked_blocks(
     (from x = 0); uniform meshes of sizes h1 (lower) and h2 = ratio * h1 (upper). With offset > 0
     the upper block's bottom edge is split at x = l0 (:func:`offset_length`).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        width: Width of the lower block (length).
-        h_lower: Height of the lower block (length).
-        h_upper: Height of the upper block (length).
-        h1: Element size of the lower block (length).
-        ratio: Element size of the upper block / h1 (dimensionless).
-        offset: Shift of the upper block's contact nodes, fraction of its element (in [0, 1)).
-        upper_width: Width of the upper block, <= width (length); default: width.
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``width``: the width of the
+    lower block (length); ``h_lower``: the height of the lower block (length); ``h_upper``: the
+    height of the upper block (length); ``h1``: the element size of the lower block (length);
+    ``ratio``: the element size of the upper block / h1 (dimensionless); ``offset``: the shift
+    of the upper block's contact nodes, a fraction of its element (in [0, 1));
+    ``upper_width``: the width of the upper block, <= width (length), width by default.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     if upper_width is None:
         upper_width = width
@@ -505,18 +501,14 @@ def stacked_boxes(
     With offset > 0 the upper box's bottom edges along the x and y axes are split at the
     distance l0 (:func:`offset_length`) from the origin (OCC fragment of the upper box alone).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        width: Side of the lower box's square cross-section (length).
-        h_lower: Height of the lower box (length).
-        h_upper: Height of the upper box (length).
-        h1: Element size of the lower box (length).
-        ratio: Element size of the upper box / h1 (dimensionless).
-        offset: Shift of the upper box's contact nodes, fraction of its element (in [0, 1)).
-        upper_width: Side of the upper box, <= width (length); default: width.
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``width``: the side of the
+    lower box's square cross-section (length); ``h_lower``: the height of the lower box
+    (length); ``h_upper``: the height of the upper box (length); ``h1``: the element size of
+    the lower box (length); ``ratio``: the element size of the upper box / h1 (dimensionless);
+    ``offset``: the shift of the upper box's contact nodes, a fraction of its element (in
+    [0, 1)); ``upper_width``: the side of the upper box, <= width (length), width by default.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     if upper_width is None:
         upper_width = width
@@ -613,19 +605,17 @@ def cylinders(
     symmetry segment: for tangential loading); the contact arcs run from x = -R to x = R and
     the upper arc is split at -l0 and l0.
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        radius_lower, radius_upper: Radii R2 and R1 of the lower and upper cylinders (length).
-        h_contact: Element size of the lower body near the origin (length).
-        h_far: Element size far from the origin, >= h_contact and >= ratio * h_contact (length).
-        refine: Radius of the disk around the origin meshed with the contact sizes (length).
-        ratio: Element size of the upper body / that of the lower body (dimensionless).
-        offset: Shift of the upper body's contact nodes, fraction of its element (in [0, 1)).
-        grading: Size increase per unit distance from the refinement disk (dimensionless).
-        full: Half disks instead of quarter disks.
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``radius_lower``,
+    ``radius_upper``: the radii R2 and R1 of the lower and upper cylinders (length);
+    ``h_contact``: the element size of the lower body near the origin (length); ``h_far``: the
+    element size far from the origin, >= h_contact and >= ratio * h_contact (length);
+    ``refine``: the radius of the disk around the origin meshed with the contact sizes (length);
+    ``ratio``: the element size of the upper body / that of the lower body (dimensionless);
+    ``offset``: the shift of the upper body's contact nodes, a fraction of its element (in
+    [0, 1)); ``grading``: the size increase per unit distance from the refinement disk
+    (dimensionless); ``full``: half disks instead of quarter disks.
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     if full:
         _full_cylinders(
@@ -780,22 +770,18 @@ def punch_foundation(
     up to ``h_far``. With offset > 0 the punch's flat face is split at x = l0
     (:func:`offset_length`).
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        width: Half width of the block, > b (length).
-        depth: Depth of the block (length).
-        b: Half width of the punch (length).
-        rho: Edge radius of the punch, < b and < h_punch (length).
-        h_punch: Height of the punch (length).
-        h_contact: Element size of the block near the contact zone (length).
-        h_far: Element size far from it, >= h_contact and >= ratio * h_contact (length).
-        refine: Distance from the contact zone meshed with the contact sizes (length).
-        ratio: Element size of the punch / that of the block (dimensionless).
-        offset: Shift of the punch's contact nodes, fraction of its element (in [0, 1)).
-        grading: Size increase per unit distance from the refined band (dimensionless).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``width``: the half width
+    of the block, > b (length); ``depth``: the depth of the block (length); ``b``: the half width
+    of the punch (length); ``rho``: the edge radius of the punch, < b and < h_punch (length);
+    ``h_punch``: the height of the punch (length); ``h_contact``: the element size of the block
+    near the contact zone (length); ``h_far``: the element size far from it, >= h_contact and
+    >= ratio * h_contact (length); ``refine``: the distance from the contact zone meshed with
+    the contact sizes (length); ``ratio``: the element size of the punch / that of the block
+    (dimensionless); ``offset``: the shift of the punch's contact nodes, a fraction of its
+    element (in [0, 1)); ``grading``: the size increase per unit distance from the refined band
+    (dimensionless).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(width=width, depth=depth, b=b, rho=rho, h_punch=h_punch)
     check_positive(width=width, depth=depth, b=b, rho=rho, h_punch=h_punch)
@@ -899,23 +885,19 @@ def rounded_on_block(
     ``h_far``. With offset > 0 the arc is also split at the arc length l0
     (:func:`offset_length`) right of the origin.
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        radius: Radius R of the rounded body (length).
-        height: Height of the rounded body, in (0, R] (length).
-        left, right: Extent of the block left and right of the origin, right > track (length).
-        depth: Depth of the block (length).
-        track: Length of the refined track on the block, >= 0 (length).
-        h_contact: Element size of the block along the track (length).
-        h_far: Element size far from the contact zones, >= h_contact and >= ratio * h_contact
-            (length).
-        refine: Distance from the track / the origin meshed with the contact sizes (length).
-        ratio: Element size of the rounded body / that of the block (dimensionless).
-        offset: Shift of the rounded body's contact nodes, fraction of its element (in [0, 1)).
-        grading: Size increase per unit distance from the refined zones (dimensionless).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``radius``: the radius R of
+    the rounded body (length); ``height``: the height of the rounded body, in (0, R] (length);
+    ``left``, ``right``: the extent of the block left and right of the origin, right > track
+    (length); ``depth``: the depth of the block (length); ``track``: the length of the refined
+    track on the block, >= 0 (length); ``h_contact``: the element size of the block along the
+    track (length); ``h_far``: the element size far from the contact zones, >= h_contact and
+    >= ratio * h_contact (length); ``refine``: the distance from the track / the origin meshed
+    with the contact sizes (length); ``ratio``: the element size of the rounded body / that of
+    the block (dimensionless); ``offset``: the shift of the rounded body's contact nodes, a
+    fraction of its element (in [0, 1)); ``grading``: the size increase per unit distance from
+    the refined zones (dimensionless).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(radius=radius, height=height, left=left, right=right, depth=depth, track=track)
     check_positive(radius=radius, height=height, left=left, right=right, depth=depth)
@@ -1011,18 +993,17 @@ def spheres(
     :func:`cylinders`. With offset > 0 the two meridian arcs of the upper sphere (in the planes
     x = 0 and y = 0) are split at the arc length l0 (:func:`offset_length`) from the origin.
 
-    Args:
-        model: The ``gmsh.model`` namespace of an open gmsh session.
-        radius_lower, radius_upper: Radii R2 and R1 of the lower and upper spheres (length).
-        h_contact: Element size of the lower body near the origin (length).
-        h_far: Element size far from the origin, >= h_contact and >= ratio * h_contact (length).
-        refine: Radius of the ball around the origin meshed with the contact sizes (length).
-        ratio: Element size of the upper body / that of the lower body (dimensionless).
-        offset: Shift of the upper body's contact nodes, fraction of its element (in [0, 1)).
-        grading: Size increase per unit distance from the refinement ball (dimensionless).
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``radius_lower``,
+    ``radius_upper``: the radii R2 and R1 of the lower and upper spheres (length);
+    ``h_contact``: the element size of the lower body near the origin (length); ``h_far``: the
+    element size far from the origin, >= h_contact and >= ratio * h_contact (length);
+    ``refine``: the radius of the ball around the origin meshed with the contact sizes (length);
+    ``ratio``: the element size of the upper body / that of the lower body (dimensionless);
+    ``offset``: the shift of the upper body's contact nodes, a fraction of its element (in
+    [0, 1)); ``grading``: the size increase per unit distance from the refinement ball
+    (dimensionless).
 
-    Raises:
-        ValueError: Before any gmsh call, if a parameter is invalid.
+    Raises ValueError before any gmsh call if a parameter is invalid.
     """
     check_finite(radius_lower=radius_lower, radius_upper=radius_upper)
     check_positive(radius_lower=radius_lower, radius_upper=radius_upper)
