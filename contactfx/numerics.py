@@ -5,7 +5,7 @@ load steps, linear solver) followed by every registered method's parameters
 (:mod:`contactfx.contact.registry`), so that a new method's options appear here, on the
 command line and in run.json without further code. Each method's own parameter set is its
 dataclass (``method_object()``); an option several methods declare (``r0``, ``ncp``,
-``penalty``) means the same thing in each of them, checked at import (:func:`_shared`).
+``penalty``) means the same thing in each of them, checked at import (:func:`shared_option`).
 Whether a combination is supported is asked of the method
 (:class:`contactfx.contact.method.Supports`).
 """
@@ -19,7 +19,7 @@ from contactfx.contact.laws import friction_law
 from contactfx.contact.registry import METHODS, method_class, methods_supporting
 from contactfx.params import option_name, param, validate
 
-__all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS", "method_parameters"]
+__all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS", "method_parameters", "shared_option"]
 
 FRICTION_LAWS = ("none", "tresca", "coulomb")
 FORMULATIONS = ("displacement", "mixed-up")
@@ -76,7 +76,7 @@ def method_parameters() -> dict[str, list[tuple[str, dataclasses.Field]]]:
     return out
 
 
-def _shared(key: str, declared: list[tuple[str, dataclasses.Field]]) -> dataclasses.Field:
+def shared_option(key: str, declared: list[tuple[str, dataclasses.Field]]) -> dataclasses.Field:
     """The Numerics field of an option that one or more methods declare. Methods that share
     an option share its meaning: the same type, default and rule (else the option needs two
     names: a developer's error, raised at import); the help names every method that reads it,
@@ -103,9 +103,9 @@ def _shared(key: str, declared: list[tuple[str, dataclasses.Field]]) -> dataclas
 
 
 def _method_fields() -> list[tuple[str, type, dataclasses.Field]]:
-    """Every registered method's parameters under their option names (:func:`_shared`)."""
+    """Every registered method's parameters under their option names (:func:`shared_option`)."""
     return [
-        (key, declared[0][1].type, _shared(key, declared))
+        (key, declared[0][1].type, shared_option(key, declared))
         for key, declared in method_parameters().items()
     ]
 

@@ -52,8 +52,8 @@ def run(
         None if out is None else Path(out),
         dict(petsc_options or {}),
         verbose,
+        time_limit=time_limit,
     )
-    run_.time_limit = time_limit
     return run_.execute()
 
 
@@ -108,13 +108,15 @@ def prepare_output(out: Path, comm) -> None:
 
 
 class _Run:
-    def __init__(self, scene, numerics, method, comm, out, petsc_options, verbose) -> None:
+    def __init__(
+        self, scene, numerics, method, comm, out, petsc_options, verbose, time_limit=None
+    ) -> None:
         self.scene, self.num, self.method, self.comm = scene, numerics, method, comm
         self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
         self.timings: dict[str, float] = {}
         self.prefix = f"contactfx_{scene.name.replace('-', '_')}_"
         #: seconds of wall time the solves may take, or None (see run)
-        self.time_limit: float | None = None
+        self.time_limit: float | None = time_limit
         self.deadline: float | None = None
 
     @contextmanager

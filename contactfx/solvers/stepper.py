@@ -159,15 +159,11 @@ class QuasiStatic:
         is the starting iterate); the other fields at their last converged values."""
         t, t_prev = self.t, self.t_prev
         factor = (t - t_prev) / (t_prev - self.t_older) if self.step > 0 else 0.0
-        x, previous = self.x, self.previous.copies[0]
-        previous.copy(x)
+        self.previous.restore()
         if factor != 0.0:
-            x.axpy(factor, previous)
-            x.axpy(-factor, self.older)
-        _ghost_update(x)
-        for field, copy in zip(self.fields, self.previous.copies[1:], strict=True):
-            copy.copy(field)
-            _ghost_update(field)
+            self.x.axpy(factor, self.previous.copies[0])
+            self.x.axpy(-factor, self.older)
+            _ghost_update(self.x)
 
     def accept(self, stats: SolveStats) -> StepRecord:
         if self.step > 0:

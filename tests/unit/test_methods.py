@@ -274,13 +274,13 @@ def test_nitsche_coulomb_jacobian_2d(slide):
     assert worst < 1e-8 * max(1.0, scale)
 
 
-def test_shared_method_options_mean_one_thing():
+def testshared_option_method_options_mean_one_thing():
     """An option several methods declare (r0: al-uzawa, al-ssn, mortar; ncp: al-ssn, mortar;
     penalty: penalty, compliance) has one type, default and rule, and its help names every
     method that reads it; two methods declaring one option differently is refused."""
     import dataclasses
 
-    from contactfx.numerics import Numerics, _shared, method_parameters
+    from contactfx.numerics import Numerics, method_parameters, shared_option
     from contactfx.params import param
 
     shared = {k: [m for m, _ in v] for k, v in method_parameters().items() if len(v) > 1}
@@ -300,4 +300,4 @@ def test_shared_method_options_mean_one_thing():
 
     declared = [("a", dataclasses.fields(A)[0]), ("b", dataclasses.fields(B)[0])]
     with pytest.raises(TypeError, match="--r0: methods a and b"):
-        _shared("r0", declared)
+        shared_option("r0", declared)

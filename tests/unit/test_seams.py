@@ -268,12 +268,12 @@ def test_one_hookes_law_for_ufl_and_the_couplings(gdim):
     assert np.all(T[1] == 0.0)
     material = Elastic(E, nu)
     w = dolfinx.fem.Function(V)
+    expr = _compat.expression(ufl.dot(material.sigma(w), ufl.as_vector(n)), V)
     for a, node in enumerate(cell_nodes):
         for c in range(gdim):
             w.x.array[:] = 0.0
             w.x.array[node * gdim + c] = 1.0
             # sigma is constant on the cell: its traction at the cell's first point
-            expr = _compat.expression(ufl.dot(material.sigma(w), ufl.as_vector(n)), V)
             t = _compat.eval_expression(expr, mesh, np.array([0], dtype=np.int32))
             t = np.asarray(t).reshape(-1)[:gdim]
             np.testing.assert_allclose(T[0, a, c], t, rtol=1e-13, atol=1e-13)  # round-off
