@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from contactfx.contact.laws import friction_law
 from contactfx.contact.registry import METHODS, method_class, methods_supporting
+from contactfx.mechanics.hyperelastic import material_from_spec, parse_spec
 from contactfx.params import option_name, param, validate
 
 __all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS", "method_parameters", "shared_option"]
@@ -38,6 +39,13 @@ class _General:
         choices=("gauss", "nodal"),
     )
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))
+    material: str = param(
+        "linear",
+        "bulk material: linear (small strain), or finite strain neo-hookean, mooney-rivlin or "
+        "svk, with parameters as model:key=value,... (neo-hookean: E,nu or mu,kappa; "
+        "mooney-rivlin: c10,c01,kappa; svk: E,nu); omitted ones keep the scene's small-strain "
+        "E and nu",
+    )
     formulation: str = param(
         "displacement",
         "bulk unknowns: displacement, or mixed-up "
@@ -126,6 +134,7 @@ class _Checks:
 
     def __post_init__(self) -> None:
         validate(self)
+        model, _ = parse_spec(self.material)
         s = method_class(self.method).supports
         if self.friction not in s.friction:
             raise ValueError(
@@ -165,10 +174,23 @@ class _Checks:
                 )
             if self.solver != "lu":
                 raise ValueError("formulation mixed-up is a saddle-point system: use --solver lu")
+            if model == "svk":
+                raise ValueError(
+                    "formulation mixed-up needs a volumetric-isochoric split of the energy: "
+                    "use --material neo-hookean or mooney-rivlin (svk has none)"
+                )
 
     def method_object(self):
         """The configured contact method."""
         return method_class(self.method).from_options(self)
+
+    def bulk_material(self, base):
+        """The body's material: ``base`` (the scene's elastic material) under ``--material``
+        (:func:`contactfx.mechanics.hyperelastic.material_from_spec`)."""
+        model, params = parse_spec(self.material)
+        if model == "linear" and not params:
+            return base
+        return material_from_spec(model, params, base)
 
     def friction_law(self):
         return friction_law(self.friction, mu=self.mu, threshold=self.threshold)

@@ -32,12 +32,15 @@ class BoundConstraints(MethodBase):
 
     name = "vi"
     supports = Supports(
+        finite_strain=False,
         why_not={
+            "finite_strain": "its bounds are the obstacle's height above each node's reference "
+            "position (small strain)",
             "friction": "bound constraints are frictionless",
             "mixed_up": "it bounds the displacement dofs of a displacement-only space",
             "interfaces": "it bounds dofs, not displacement jumps",
             "nodal_quadrature": "it has no contact integrals",
-        }
+        },
     )
 
     def residual(self, s):

@@ -43,11 +43,13 @@ class ContactSurface(SurfaceData):
 
     def position(self, w=None):
         """Current position in the obstacle's frame, x + u - offset. For the linearised
-        (``vertical``) obstacles only the vertical displacement moves the point: their gap is
-        the small-deformation Signorini gap height(x_t) - (x_d + u_d) of Hertz and Westergaard."""
+        (``vertical``) obstacles in small strain only the vertical displacement moves the
+        point: their gap is the small-deformation Signorini gap height(x_t) - (x_d + u_d) of
+        Hertz and Westergaard; in finite strain (``reference_normal``) every point is where it
+        has moved."""
         x = ufl.SpatialCoordinate(self.mesh)
         w = self.u if w is None else w
-        if self.obstacle.vertical:
+        if self.obstacle.vertical and self.reference_normal is None:
             d = ufl.shape(x)[0]
             w = ufl.as_vector([0.0] * (d - 1) + [w[d - 1]])
         return x + w - self.offset

@@ -75,7 +75,7 @@ NODAL_MULTIPLIER = Multiplier("nodal", nodal=True)
 class Supports:
     """What a method handles. ``why_not`` maps a capability name (``friction``, ``obstacles``,
     ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``two_body_friction``,
-    ``dim1``, ``iterative``)
+    ``dim1``, ``iterative``, ``finite_strain``)
     to the reason it is not supported, quoted in the error a user sees."""
 
     friction: tuple[str, ...] = ("none",)
@@ -88,6 +88,9 @@ class Supports:
     two_body_friction: bool = True
     dim1: bool = True
     iterative: bool = True
+    #: finite-strain bodies (a hyperelastic ``--material``): the law in the deformed
+    #: configuration
+    finite_strain: bool = True
     why_not: dict[str, str] = field(default_factory=dict)
 
 

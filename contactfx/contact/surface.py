@@ -96,19 +96,26 @@ class SurfaceData:
     #: displacement cannot give, and the traction error is of the order of the relative
     #: jitter of the cell sizes at every refinement
     h_nodal: Expr | None = None
+    #: finite strain: the reference facet's unit normal N on which ``stress`` (the first Piola
+    #: stress P) gives the traction P N, whatever the normal a method projects it on (the
+    #: obstacle's, in the deformed configuration: Mlika, Renard and Chouly 2017,
+    #: doi:10.1016/j.cma.2017.01.003); None: small strain, sigma n on the plane of n
+    reference_normal: Expr | None = None
 
     # the stress tensors of the state and of the test functions (``stress`` / ``stress_test``:
     # fields or properties of each surface, from its kind's material) are the surface's own
     # business; the methods read tractions
     def traction(self, n):
-        """The traction of the state on a plane of unit normal n: S(u) n (small strain
-        sigma(u) n; finite strain the first Piola traction P(F) N, n the reference normal)."""
-        return ufl.dot(self.stress, n)
+        """The traction of the state on a plane of unit normal n: small strain sigma(u) n;
+        finite strain the first Piola traction P(F) N on the reference facet (n only the
+        direction the methods project it on)."""
+        return ufl.dot(self.stress, n if self.reference_normal is None else self.reference_normal)
 
     def traction_test(self, n):
         """The directional derivative of :meth:`traction` in the direction of the test
-        functions (small strain: sigma(v) n, linear in v)."""
-        return ufl.dot(self.stress_test, n)
+        functions (small strain: sigma(v) n, linear in v; finite strain dP[grad v] N)."""
+        N = n if self.reference_normal is None else self.reference_normal
+        return ufl.dot(self.stress_test, N)
 
     def traction_n(self, n, test: bool = False):
         """Normal traction n . t (< 0 in compression), of the state or (``test``) of the test

@@ -48,10 +48,10 @@ class ObstacleProblem(Problem):
                 f"method {method.name} is not offered against rigid obstacles ("
                 f"{method.supports.why_not.get('obstacles', '')})"
             )
-        if numerics.formulation == "mixed-up" and not scene.material().lmbda > 0.0:
+        material = numerics.bulk_material(scene.material())
+        if numerics.formulation == "mixed-up" and not (material.pressure_modulus or 0.0) > 0.0:
             raise ValueError(
-                f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = "
-                f"{scene.material().nu}"
+                f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = {material.nu}"
             )
 
     def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
@@ -99,6 +99,7 @@ class ObstacleProblem(Problem):
             ds_nodal=self.nodal_rule()[0] if self.multiplier_field else None,
             multiplier=self.lam,
             multiplier_test=self.lam_test,
+            reference_normal=ufl.FacetNormal(mesh) if mat.finite_strain else None,
         )
         return SurfaceSetup(surface, self.ds, self.v_load)
 

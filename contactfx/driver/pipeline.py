@@ -17,6 +17,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from contactfx.contact.registry import methods_supporting
 from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json
@@ -70,10 +71,18 @@ def _checked_method(scene, numerics):
     collective); the scene reads the numerics' physical choices."""
     method = numerics.method_object()
     scene.problem.check(scene, numerics, method)
-    if not scene.material().linear and not scene.problem.nonlinear_bulk:
+    material = numerics.bulk_material(scene.material())
+    if not material.linear and not scene.problem.nonlinear_bulk:
         raise ValueError(
-            f"scene '{scene.name}': its problem kind needs a linear material "
-            f"(small-strain elasticity)"
+            f"scene '{scene.name}': its problem kind needs a linear material (small-strain "
+            f"elasticity), not --material {numerics.material}; finite strain is offered "
+            "against rigid obstacles"
+        )
+    if material.finite_strain and not method.supports.finite_strain:
+        raise ValueError(
+            f"--material {numerics.material}: method {method.name} is small-strain only ("
+            f"{method.supports.why_not.get('finite_strain', '')}); use "
+            + ", ".join(methods_supporting(lambda c: c.finite_strain and c.obstacles))
         )
     if numerics.nested:
         if not scene.problem.nested:

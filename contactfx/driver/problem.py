@@ -77,7 +77,8 @@ class Problem:
         self.gdim = mesh.geometry.dim
         self.fdim = mesh.topology.dim - 1
         self.friction = numerics.friction_law()
-        self.material = self.material_of(mesh)
+        #: the bulk's material: the scene's, under ``--material`` (a finite-strain model)
+        self.material = numerics.bulk_material(self.material_of(mesh))
         self.tload = dolfinx.fem.Constant(mesh, 0.0)
         self.h = _compat.cell_diameter(mesh)
         self.mult_shape = (self.gdim,) if self.friction is not None else ()

@@ -92,6 +92,8 @@ class Elastic:
 
     #: sigma is linear in (u, p): the bulk is assembled once
     linear = True
+    #: small strain: the traction is sigma n on the current normal's plane (one configuration)
+    finite_strain = False
 
     def __post_init__(self) -> None:
         if not self.E > 0.0:
@@ -165,6 +167,11 @@ class Elastic:
         if ufl.shape(eps) == (1, 1):
             return E * eps
         return hooke(eps, lmbda, mu, ufl.tr, ufl.Identity(ufl.shape(eps)[0]))
+
+    @property
+    def pressure_modulus(self) -> float:
+        """The modulus of the mixed formulation's pressure law, lambda."""
+        return self.lmbda
 
     def pressure_law(self, u: Expr, p: Expr, q: Expr) -> Expr:
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u

@@ -13,12 +13,15 @@ A material answers in UFL, for the state u (and the pressure p of a mixed u-p fo
 * ``E`` (the reference modulus of the closed forms; the scenes' contact modulus scales the
   methods' parameters, gamma_N = gamma0 E / h) and ``density`` (None in a static run);
 * ``linear``: whether S is linear in (u, p), so that the bulk is assembled once
-  (:class:`contactfx.solvers.bulk.LinearBulk`) instead of at every Newton iteration.
+  (:class:`contactfx.solvers.bulk.LinearBulk`) instead of at every Newton iteration;
+* ``finite_strain``: whether S is the first Piola stress of F = I + grad u, so that a contact
+  surface reads its traction on the reference facet (P N) and its geometry at x + u.
 
 :class:`contactfx.mechanics.elasticity.Elastic` (small strain; plane strain, 3D, 1D, mixed u-p)
-is the first implementation. In finite strain the reference normal N (where the integral lives)
-and the current normal n (where the gap and the traction's normal part live) differ; a method
-passes the normal it means.
+is the small-strain implementation, :mod:`contactfx.mechanics.hyperelastic` the finite-strain
+ones (neo-Hookean, Mooney-Rivlin, Saint Venant-Kirchhoff). In finite strain the reference
+normal N (where the integral lives) and the current normal n (where the gap and the traction's
+normal part live) differ; a method passes the normal it means.
 """
 
 from __future__ import annotations
@@ -35,6 +38,10 @@ class Material(Protocol):
     E: float
     density: float | None
     linear: bool
+    finite_strain: bool
+
+    @property
+    def pressure_modulus(self) -> float | None: ...
 
     def weak_stress(self, u: Any, p: Any = None) -> Any: ...
 
