@@ -1,5 +1,5 @@
 """Finite-strain bodies against a rigid obstacle: a contact patch test in uniaxial stress
-(docs/verification.md section 13).
+(docs/verification.md section 15).
 
 A block [-L/2, L/2] x [-H, 0] (plane strain, unstructured triangles) is pushed by a dead
 (nominal) pressure p on its bottom face against the rigid frictionless plane y = 0; its left
