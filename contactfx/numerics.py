@@ -54,6 +54,12 @@ class _General:
         choices=FORMULATIONS,
     )
     steps: int = param(1, "load steps", positive=True)
+    max_increment: float = param(
+        0.0,
+        "adaptive load stepping: after a step that converges in at most 5 Newton iterations "
+        "the increment grows by 1.5, up to this load increment (0: at most 1 / steps)",
+        nonnegative=True,
+    )
     solver: str = param(
         "lu",
         "linear solver: MUMPS LU, or GMRES + GAMG in an inexact Newton method (large 3D meshes)",
@@ -150,6 +156,10 @@ class _Checks:
         if self.threshold > 0.0 and self.friction != "tresca":
             raise ValueError(
                 f"--threshold needs --friction tresca (got --friction {self.friction})"
+            )
+        if self.max_increment > 1.0:
+            raise ValueError(
+                f"--max-increment must lie in [0, 1] (a load increment), got {self.max_increment}"
             )
         if self.quadrature == "nodal" and (self.degree != 1 or not s.nodal_quadrature):
             raise ValueError(

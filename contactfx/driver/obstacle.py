@@ -216,6 +216,7 @@ class ObstaclePost:
             self.measure_form = dolfinx.fem.form(active(closed) * pb.dsc_fine)
         self.friction = None if pb.friction is None else _FrictionPost(pb, self, p, closed)
         self.errors = _FieldErrors(pb, p, self.pressure)
+        self.finite = None if not pb.material.finite_strain else _FiniteStrainPost(pb, self, p)
 
     def evaluate(self, solver) -> Quantities:
         on = self.nodal.on
@@ -252,6 +253,8 @@ class ObstaclePost:
         out = [self.displacement, self.vm, self.pressure, self.gap, self.status]
         if self.friction is not None:
             out += [self.friction.traction, self.friction.slip]
+        if self.finite is not None:
+            out += self.finite.fields()
         return out
 
     def finish(self, q: Quantities, out) -> dict:
@@ -274,6 +277,44 @@ class ObstaclePost:
         if self.friction is not None:
             local.update(self.friction.scores(x, p))
         return {k: self.comm.allreduce(v, op=MPI.MAX) for k, v in local.items()}
+
+
+class _FiniteStrainPost:
+    """The fields of a finite-strain body (on the reference mesh; ParaView's Warp By Vector
+    with the displacement shows the deformed body): the volume ratio J = det F and the
+    Cauchy stress sigma = P F^T / J (DG0 cell fields; the 3 x 3 tensor, out-of-plane entries
+    included in 2D), and the contact pressure as a Cauchy traction on the deformed surface,
+    p da / dA with the area ratio da / dA = J |F^-T N| (Nanson's formula), beside the
+    ``contact_pressure`` per unit reference area whose integral is the contact force."""
+
+    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p) -> None:
+        mesh, mat, u = pb.mesh, pb.material, pb.surface.u
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        T0 = _compat.function_space(mesh, "DG", 0, (9,))
+        self.J = dolfinx.fem.Function(DG0, name="volume_ratio")
+        self.sigma = dolfinx.fem.Function(T0, name="cauchy_stress")
+        F = mat.deformation_gradient(u)
+        sigma = mat.cauchy3(u, pb.p)
+        self.J_expr = _compat.expression(ufl.det(F), DG0)
+        self.sigma_expr = _compat.expression(
+            ufl.as_vector([sigma[i, j] for i in range(3) for j in range(3)]), T0
+        )
+        d = pb.gdim
+        Finv_T = ufl.inv(ufl.as_matrix([[F[i, j] for j in range(d)] for i in range(d)])).T
+        N = ufl.FacetNormal(mesh)
+        area_ratio = ufl.det(F) * ufl.sqrt(ufl.dot(ufl.dot(Finv_T, N), ufl.dot(Finv_T, N)))
+        self.post = post
+        self.current = dolfinx.fem.Function(post.Q1, name="contact_pressure_current")
+        self.current_form = None if p is None else post.nodal.form(p / area_ratio)
+
+    def fields(self) -> list:
+        self.J.interpolate(self.J_expr)
+        self.sigma.interpolate(self.sigma_expr)
+        out = [self.J, self.sigma]
+        if self.current_form is not None:
+            self.post.nodal(self.current_form, self.current)
+            out.append(self.current)
+        return out
 
 
 class _FrictionPost:

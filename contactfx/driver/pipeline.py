@@ -259,7 +259,8 @@ class _Run:
 
             t0 = time.perf_counter()
             a0 = solver.timer.assembly
-            march(QuasiStatic(self.num.steps), solver, problem.apply_load, on_step=on_step)
+            stepper = QuasiStatic(self.num.steps, max_increment=self.num.max_increment or None)
+            march(stepper, solver, problem.apply_load, on_step=on_step, diagnose=problem.diagnose)
             total = time.perf_counter() - t0
         self.timings["assembly"] = solver.timer.assembly + self.timings.pop("chain_assembly", 0.0)
         if problem.coupling() is not None:  # two bodies: the coupling's share of the assembly

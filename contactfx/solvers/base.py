@@ -45,14 +45,20 @@ class ConvergenceError(RuntimeError):
         step: int | None = None,
         load: float | None = None,
         stats: SolveStats | None = None,
+        *,
+        detail: str = "",
     ) -> None:
         self.reason = reason
         #: the iteration counts up to the failure, when known
         self.stats = stats
         self.step = step
         self.load = load
+        #: what the failed iterate shows (e.g. where an element inverted), or ""
+        self.detail = detail
         where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
-        super().__init__(f"nonlinear solve diverged{where}: {reason}")
+        super().__init__(
+            f"nonlinear solve diverged{where}: {reason}" + (f"; {detail}" if detail else "")
+        )
 
 
 class TimeLimitExceeded(ConvergenceError):

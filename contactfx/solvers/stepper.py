@@ -125,14 +125,31 @@ class QuasiStatic:
     that needed no cut-back, so without a floor steps that each fail once would shrink it
     without end). ``fields``: other (ghosted) vectors restored with the unknown on a cut-back (each
     step starts them from their last converged value).
+
+    Adaptive growth (``max_increment`` > 1 / steps, large deformation): after a step that
+    needed no cut-back and at most ``easy_newton`` Newton iterations the increment grows by
+    ``growth``, up to ``max_increment`` (the stepping of Abaqus/Standard's automatic
+    increments and of MOOSE's IterationAdaptiveDT: fewer steps where the response is mild,
+    the cut-backs where it is not). Without it the increment never exceeds 1 / steps.
     """
 
     def __init__(
-        self, steps: int, *, max_cutbacks: int = 6, fields: Sequence[PETSc.Vec] = ()
+        self,
+        steps: int,
+        *,
+        max_cutbacks: int = 6,
+        fields: Sequence[PETSc.Vec] = (),
+        max_increment: float | None = None,
+        easy_newton: int = 5,
+        growth: float = 1.5,
     ) -> None:
         if steps < 1:
             raise ValueError(f"load steps must be >= 1, got {steps}")
+        if max_increment is not None and not 0.0 < max_increment <= 1.0:
+            raise ValueError(f"the maximum increment must lie in (0, 1], got {max_increment}")
         self.steps, self.max_cutbacks, self.fields = steps, max_cutbacks, list(fields)
+        self.max_increment = max_increment
+        self.easy_newton, self.growth = easy_newton, growth
         self.step = 0
 
     def start(self, x: PETSc.Vec) -> None:
@@ -141,7 +158,7 @@ class QuasiStatic:
         self.older = x.duplicate()  # the one before, for the secant predictor: u = 0 at t = 0
         self.older.set(0.0)
         self.t_prev = self.t_older = 0.0
-        self.dt = 1.0 / self.steps
+        self.dt = self.dt_base = min(1.0 / self.steps, self.max_increment or 1.0)
         self.dt_min = self.dt / 4**self.max_cutbacks
         self.cutbacks = 0
         self.step = 0
@@ -179,7 +196,10 @@ class QuasiStatic:
             cutbacks=self.cutbacks,
         )
         if self.cutbacks == 0:
-            self.dt = min(1.0 / self.steps, 2.0 * self.dt)
+            if self.dt < self.dt_base * (1.0 - 1e-12):  # back towards the base increment
+                self.dt = min(self.dt_base, 2.0 * self.dt)
+            elif self.max_increment is not None and stats.newton <= self.easy_newton:
+                self.dt = min(self.max_increment, self.growth * self.dt)
         self.cutbacks = 0
         return record
 
@@ -207,12 +227,14 @@ def march(
     apply_load: Callable[[float], None],
     *,
     on_step: Callable[[StepRecord], None] | None = None,
+    diagnose: Callable[[], str] | None = None,
 ) -> list[StepRecord]:
     """Run ``stepper``'s program with ``solver`` (any solver of the :class:`ContactSNES`
     shape: ``u``, ``assemble_load()``, ``solve()``); ``apply_load(t)`` sets the loads'
     constants (obstacle position, tractions) for time t, ``on_step`` sees each converged
     step. When the stepper gives up, ``ConvergenceError`` names the SNES reason, the step
-    and the time, with the last converged state restored."""
+    and the time, and what ``diagnose()`` (collective) finds in the failed iterate (e.g. an
+    inverted element), with the last converged state restored."""
     records: list[StepRecord] = []
     stepper.start(_compat.petsc_vec(solver.u))
     try:
@@ -228,8 +250,9 @@ def march(
                 raise TimeLimitExceeded(f" at {stepper.describe(t)}") from None
             except ConvergenceError as err:
                 if not stepper.cut_back():
+                    detail = diagnose() if diagnose is not None else ""
                     stepper.restore()
-                    raise ConvergenceError(err.reason, stepper.step + 1, t) from None
+                    raise ConvergenceError(err.reason, stepper.step + 1, t, detail=detail) from None
                 continue
             record = stepper.accept(stats)
             records.append(record)

@@ -232,6 +232,41 @@ def test_stepper_restores_every_field_on_cutback():
     assert np.all(stub.u.x.array == 0.25) and np.all(stub.w.x.array == 2.5)
 
 
+def test_stepper_adaptive_growth():
+    # SolveStats() has newton = 0: every step is easy. Increments 0.1 (1 / steps), then x 1.5
+    # up to max_increment = 0.3: 0.1, 0.15, 0.225, 0.3, 0.225 (the rest to 1)
+    stub = _FieldStub(limit=1.0)
+    records = march(QuasiStatic(10, max_increment=0.3), stub, stub.set_load)
+    np.testing.assert_allclose(
+        [r.time for r in records], [0.1, 0.25, 0.475, 0.775, 1.0], rtol=1e-14
+    )
+    # after a cut-back the increment first returns to the base, then grows: limit 0.2 makes
+    # 0.225 fail (halved to 0.1125), then 0.1 (the base, from 2 x 0.1125 capped), 0.15 ...
+    stub = _FieldStub(limit=0.2)
+    records = march(QuasiStatic(10, max_increment=0.3), stub, stub.set_load)
+    dts = np.diff([0.0] + [r.time for r in records])
+    assert dts.max() <= 0.2 + 1e-12 and records[-1].time == 1.0
+    assert [r.cutbacks for r in records][:3] == [0, 0, 1]
+    # without max_increment the increment never exceeds 1 / steps (today's program)
+    stub = _FieldStub(limit=1.0)
+    records = march(QuasiStatic(4), stub, stub.set_load)
+    assert [r.time for r in records] == [0.25, 0.5, 0.75, 1.0]
+    with pytest.raises(ValueError, match="maximum increment"):
+        QuasiStatic(4, max_increment=1.5)
+
+
+def test_stepper_failure_carries_the_diagnosis():
+    stub = _FieldStub(limit=0.0)
+    with pytest.raises(ConvergenceError, match="at load step 1 .*; an element inverted") as err:
+        march(
+            QuasiStatic(1, max_cutbacks=1),
+            stub,
+            stub.set_load,
+            diagnose=lambda: "an element inverted",
+        )
+    assert err.value.detail == "an element inverted"
+
+
 def test_stepper_rejects_no_steps():
     with pytest.raises(ValueError, match="load steps must be >= 1"):
         QuasiStatic(0)

@@ -27,6 +27,7 @@ Measured (h = 0.1, two load steps):
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import dolfinx.fem
 import numpy as np
@@ -34,10 +35,13 @@ import pytest
 import ufl
 from mpi4py import MPI
 
+from contactfx.io.vtk import read_vtu
 from contactfx.meshes import RectangleFacets
 from contactfx.scenes import Numerics
 from contactfx.scenes._common import fix_component
+from contactfx.scenes.hertz import Hertz2D
 from contactfx.scenes.sliding_block import SlidingBlock
+from contactfx.solvers.base import ConvergenceError
 
 P = 200.0
 
@@ -92,7 +96,7 @@ class UniaxialBlock(SlidingBlock):
         return [fix_component(V, facet_tags, RectangleFacets.LEFT, 0)]
 
     def on_step(self, problem, solver, load, quantities) -> None:
-        material = problem.material
+        material = self.material_used = problem.material
         model = material.name if material.finite_strain else "linear"
         l1, l2 = uniaxial_stretches(model, material, min(2.0 * load, 1.0) * self.p.pressure)
         G = ufl.as_matrix([[l1 - 1.0, 0.0], [0.0, l2 - 1.0]])
@@ -139,6 +143,26 @@ def test_uniaxial_patch_exact(model, pressure, method, options):
     assert res.peak_pressure == pytest.approx(pressure, rel=1e-9)
 
 
+def test_finite_strain_fields(tmp_path):
+    comm = MPI.COMM_WORLD
+    out = Path(comm.bcast(str(tmp_path), root=0))
+    num = Numerics(method="nitsche", friction="none", mu=0.0, steps=2, material="neo-hookean")
+    scene = UniaxialBlock(PARAMS)
+    scene.run(num, comm=comm, out=out, verbose=False)
+    l1, l2 = uniaxial_stretches("neo-hookean", scene.material_used, P)
+    body = read_vtu(out / f"{scene.name}_0002.vtu")["cell_data"]
+    surface = read_vtu(out / f"{scene.name}_surface_0002.vtu")["point_data"]
+    # the homogeneous state, exact in P1 (to the solver's tolerance, 1e-10): J = l1 l2, the
+    # Cauchy stress sigma_yy = P22 l2 / J = -p / l1 (sigma_xx = 0), the nominal pressure p
+    # and the Cauchy pressure on the deformed face p / l1 (its length grew by l1)
+    np.testing.assert_allclose(body["volume_ratio"], l1 * l2, rtol=1e-9)
+    sigma = body["cauchy_stress"].reshape(-1, 3, 3)
+    np.testing.assert_allclose(sigma[:, 1, 1], -P / l1, rtol=1e-9)
+    np.testing.assert_allclose(sigma[:, 0, 0], 0.0, atol=1e-9 * P)
+    np.testing.assert_allclose(surface["contact_pressure"], P, rtol=1e-9)
+    np.testing.assert_allclose(surface["contact_pressure_current"], P / l1, rtol=1e-9)
+
+
 def test_uniaxial_patch_uzawa():
     scene, res = solve(method="al-uzawa", material="neo-hookean")
     # Uzawa's outer loop stops at its multiplier tolerance: measured 1.5e-11 on grad u and
@@ -176,6 +200,25 @@ def test_serial_and_parallel_agree():
     # same mesh, same discrete problem, Newton converged to 1e-10: round-off only
     for key in ("force", "contact_size", "peak_pressure"):
         assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
+
+
+def test_inverted_element_is_named():
+    # a cylinder (R = 1) pressed 0.9 deep into a unit-high neo-Hookean block: the elements at
+    # the contact edge invert near a load factor of 0.89 whatever the step (measured: the
+    # stepper cuts back to 1/64 increments, then gives up with J = -0.24 at (-0.21, -0.05))
+    params = dataclasses.replace(
+        Hertz2D.Params(),
+        E=1.0,
+        profile="circle",
+        depth=0.9,
+        h_contact=0.05,
+        h_far=0.2,
+        refine_half_width=0.5,
+    )
+    num = Numerics(material="neo-hookean", steps=1)
+    with pytest.raises(ConvergenceError, match=r"an element inverted \(J .*\) at \(") as err:
+        Hertz2D(params).run(num, verbose=False)
+    assert 0.8 < err.value.load < 0.95
 
 
 @pytest.mark.parametrize(
