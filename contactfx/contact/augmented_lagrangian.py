@@ -39,6 +39,7 @@ branch.)
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import ufl
 
@@ -51,13 +52,17 @@ from contactfx.contact.laws import (
     tangential,
 )
 from contactfx.contact.method import MULTIPLIER_FIELD, NODAL_MULTIPLIER, MethodBase, Supports
-from contactfx.contact.surface import Surface
+from contactfx.contact.surface import Expr, Form, Surface
 from contactfx.params import param, validate
+
+if TYPE_CHECKING:
+    from contactfx.solvers.snes import ContactSNES
+    from contactfx.solvers.uzawa import Uzawa
 
 __all__ = ["AugmentedLagrangianUzawa", "AugmentedLagrangianSSN", "split_multiplier"]
 
 
-def split_multiplier(lam, n):
+def split_multiplier(lam: Expr, n: Expr) -> tuple[Expr, Expr | None]:
     """(lambda_n, lambda_T) of a scalar pressure or a traction vector t = -lambda_n n + lambda_T
     (lambda_T is None for a scalar multiplier)."""
     if ufl.shape(lam) == ():
@@ -71,13 +76,18 @@ _FRICTION = ("none", "tresca", "coulomb")
 
 @dataclass(frozen=True)
 class _AugmentedBase(MethodBase):
+    if TYPE_CHECKING:
+        # the augmentation factor, a field of each subclass (r = r0 E / h); declared for the
+        # checker only (here it would be a field of this dataclass)
+        r0: float
+
     def __post_init__(self) -> None:
         validate(self)
 
-    def r(self, s: Surface):
+    def r(self, s: Surface) -> Expr:
         return self.r0 * s.E / s.h
 
-    def _augmented(self, s: Surface):
+    def _augmented(self, s: Surface) -> tuple[Expr, Expr | None, Expr | None]:
         """(p, T trial, T) from the surface's multiplier; T and its trial are None without
         friction."""
         s = self.law_surface(s)
@@ -89,13 +99,16 @@ class _AugmentedBase(MethodBase):
         trial = lam_t - self.r(s) * s.slip_increment(n)
         return p, trial, ball_projection(trial, s.friction.bound(p), s.E, stick=s.stick)
 
-    def trial_traction(self, s: Surface):
+    # the friction terms are built only with a friction law (s.friction is not None)
+    def trial_traction(self, s: Surface) -> tuple[Expr, Expr]:
         """The trial tangential traction lambda_T - r du_T and the friction bound (with
         friction)."""
+        assert s.friction is not None
         p, trial, _ = self._augmented(s)
         return trial, s.friction.bound(p)
 
-    def _slip(self, s: Surface):
+    def _slip(self, s: Surface) -> Expr:
+        assert s.friction is not None
         p, trial, _ = self._augmented(s)
         return active(p) * active(norm(trial, s.E) - s.friction.bound(p))
 
@@ -129,7 +142,7 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
         },
     )
 
-    def attach(self, solver, problem):
+    def attach(self, solver: ContactSNES, problem: Any) -> Uzawa:
         """Uzawa's outer loop around the Newton solver (the problem gives the multiplier
         Function, its nodal update and the contact nodes)."""
         from contactfx.solvers.uzawa import Uzawa
@@ -144,23 +157,23 @@ class AugmentedLagrangianUzawa(_AugmentedBase):
             max_it=self.al_max_it,
         )
 
-    def pressure(self, s: Surface):
+    def pressure(self, s: Surface) -> Expr:
         return self._augmented(s)[0]
 
-    def tangential_traction(self, s: Surface):
+    def tangential_traction(self, s: Surface) -> Expr | None:
         return self._augmented(s)[2]
 
-    def slip_indicator(self, s: Surface):
+    def slip_indicator(self, s: Surface) -> Expr:
         return self._slip(s)
 
-    def update(self, s: Surface):
+    def update(self, s: Surface) -> Expr:
         """The multiplier's next value (UFL, interpolated at the nodes by the outer loop)."""
         p, _, t_T = self._augmented(s)
         if t_T is None:
             return p
         return -p * s.normal() + t_T
 
-    def residual(self, s: Surface):
+    def residual(self, s: Surface) -> Form:
         p, _, t_T = self._augmented(s)
         form = p * ufl.dot(s.v, s.normal()) * s.ds
         if t_T is not None:
@@ -194,30 +207,30 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         },
     )
 
-    def pressure(self, s: Surface):
+    def pressure(self, s: Surface) -> Expr:
         if s.ds_nodal is None:  # a projected multiplier (projected_law)
             return self._augmented(s)[0]
         return split_multiplier(s.multiplier, s.normal())[0]
 
-    def tangential_traction(self, s: Surface):
+    def tangential_traction(self, s: Surface) -> Expr | None:
         if s.ds_nodal is None:
             return self._augmented(s)[2]
         return split_multiplier(s.multiplier, s.normal())[1]
 
-    def contact_indicator(self, s: Surface):
+    def contact_indicator(self, s: Surface) -> Expr:
         """[lambda_n - r g]_+: > 0 exactly where the surfaces are closed (between the nodes
         too; lambda_n itself only vanishes up to the solver tolerance where open)."""
         return self._augmented(s)[0]
 
-    def slip_indicator(self, s: Surface):
+    def slip_indicator(self, s: Surface) -> Expr:
         return self._slip(s)
 
-    def law_surface(self, s: Surface):
+    def law_surface(self, s: Surface) -> Surface:
         """A projected multiplier (``s.ds_nodal`` None): the law reads the surface as
         al-uzawa's does (its motion at each unfitted piece's midpoint, ``tip_extended``)."""
         return s.tip_extended() if s.ds_nodal is None else s
 
-    def projected_law(self, s: Surface):
+    def projected_law(self, s: Surface) -> Expr:
         """The augmented traction p (scalar multiplier) or -p n + T (traction).
 
         Where the multiplier has no nodal collocation (``s.ds_nodal`` None: an unfitted
@@ -231,7 +244,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         p, _, t_T = self._augmented(s)
         return p if t_T is None else -p * s.normal() + t_T
 
-    def residual(self, s: Surface):
+    def residual(self, s: Surface) -> Form:
         n = s.normal()
         lam, mu = s.multiplier, s.multiplier_test
         lam_n, lam_t = split_multiplier(lam, n)

@@ -12,6 +12,7 @@ obstacle. No contact term enters the residual; the contact pressure is the react
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import dolfinx
 import numpy as np
@@ -22,6 +23,12 @@ from contactfx import _compat
 from contactfx.contact.method import MethodBase, Supports
 from contactfx.solvers.base import SolverWrapper
 from contactfx.solvers.snes import owned_size
+
+if TYPE_CHECKING:
+    from contactfx.contact.obstacles import Obstacle
+    from contactfx.contact.surface import Surface
+    from contactfx.solvers.base import Solver
+    from contactfx.solvers.snes import ContactSNES
 
 __all__ = ["BoundConstraints"]
 
@@ -43,20 +50,22 @@ class BoundConstraints(MethodBase):
         },
     )
 
-    def residual(self, s):
+    def residual(self, s: Surface) -> None:
         return None
 
-    def pressure(self, s):
+    def pressure(self, s: Surface) -> None:
         return None
 
     def snes_options(self) -> dict[str, object]:
         return {"snes_type": "vinewtonrsls"}
 
-    def attach(self, solver, problem):
+    def attach(self, solver: ContactSNES, problem: Any) -> _Bounded:
         return _Bounded(solver, problem.V, problem.contact_facets, problem.obstacle, problem.offset)
 
     @staticmethod
-    def reaction_pressure(solver, u, mass: np.ndarray, target) -> float:
+    def reaction_pressure(
+        solver: Solver, u: dolfinx.fem.Function, mass: np.ndarray, target: dolfinx.fem.Function
+    ) -> float:
         """The nodal contact pressure from the reaction -R(u) = f_ext - f_int(u) of the bulk at
         the bounded component (lumped by the surface's nodal ``mass`` of ``target``'s space)
         into ``target``; returns the total contact force. ``u`` is the solver's state."""
@@ -79,7 +88,17 @@ class BoundConstraints(MethodBase):
 class _Bounded(SolverWrapper):
     """The solver with the bounds of the current obstacle position (updated with the load)."""
 
-    def __init__(self, solver, V, facets, obstacle, offset) -> None:
+    #: the Newton solver itself (its bounds are set here)
+    inner: ContactSNES
+
+    def __init__(
+        self,
+        solver: ContactSNES,
+        V: dolfinx.fem.FunctionSpace,
+        facets: np.ndarray,
+        obstacle: Obstacle,
+        offset: dolfinx.fem.Constant,
+    ) -> None:
         super().__init__(solver)
         mesh = V.mesh
         gdim = mesh.geometry.dim

@@ -19,7 +19,7 @@ import ufl
 
 from contactfx.contact.laws import positive_part
 from contactfx.contact.method import MethodBase, Supports
-from contactfx.contact.surface import Surface
+from contactfx.contact.surface import Expr, Form, Surface
 from contactfx.params import param, validate
 
 __all__ = ["NormalCompliance"]
@@ -49,9 +49,9 @@ class NormalCompliance(MethodBase):
     def __post_init__(self) -> None:
         validate(self)
 
-    def pressure(self, s: Surface):
+    def pressure(self, s: Surface) -> Expr:
         s = self.law_surface(s)
         return self.kappa0 * s.E * (positive_part(-s.gap()) / s.h_continuous) ** self.exponent
 
-    def residual(self, s: Surface):
+    def residual(self, s: Surface) -> Form:
         return self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

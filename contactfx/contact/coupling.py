@@ -26,13 +26,16 @@ the extended sparsity (rows of one body, columns of the other) appears as the se
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import dolfinx
 import numpy as np
 from petsc4py import PETSc
 
 from contactfx import _compat
+
+if TYPE_CHECKING:
+    from mpi4py import MPI
 
 __all__ = ["Coupling", "PairCoupling", "NodeLayout", "aij", "blocked_rows"]
 
@@ -63,11 +66,11 @@ class PairCoupling(Coupling, Protocol):
     ``search_gaps()`` (the gaps the last search measured); a coupling with nodal normals
     (mortar) has them as ``normal``."""
 
-    def nodal(self) -> tuple: ...
+    def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]: ...
 
-    def nodal_friction(self) -> tuple: ...
+    def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
 
-    def friction_state(self) -> dict: ...
+    def friction_state(self) -> dict[str, float]: ...
 
     def force(self) -> float: ...
 
@@ -76,7 +79,7 @@ class PairCoupling(Coupling, Protocol):
     def search_gaps(self) -> np.ndarray: ...
 
 
-def aij(comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:
+def aij(comm: MPI.Comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:
     """An empty square parallel AIJ matrix that accepts entries anywhere (new nonzeros are
     allocated on the fly)."""
     A = PETSc.Mat().createAIJ(
@@ -97,7 +100,7 @@ class NodeLayout:
     reference coordinates as a vector, and scalar / blocked node vectors to assemble nodal
     quantities on the owners of the nodes."""
 
-    def __init__(self, V) -> None:
+    def __init__(self, V: dolfinx.fem.FunctionSpace) -> None:
         self.V = V
         self.comm = V.mesh.comm
         self.imap = V.dofmap.index_map

@@ -45,13 +45,20 @@ interface (:class:`CutSurface`).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import ufl
 
 from contactfx.contact.interface import InterfaceSurface
-from contactfx.contact.laws import tangential
+from contactfx.contact.laws import Expr, tangential
+
+if TYPE_CHECKING:
+    from typing import Self
+
+    from contactfx.contact.surface import Form
 
 __all__ = [
     "SNAP",
@@ -283,7 +290,7 @@ class CrackQuadrature:
     weight ratios ``ratio`` (cells, nq) = Gauss weight / (cell weight |det J|); zero in the
     other cells."""
 
-    def __init__(self, X: np.ndarray, cells: CutCells, rule) -> None:
+    def __init__(self, X: np.ndarray, cells: CutCells, rule: tuple[np.ndarray, np.ndarray]) -> None:
         ref_w = np.asarray(rule[1])
         nq = len(ref_w)
         xi, w = np.polynomial.legendre.leggauss(nq)
@@ -333,7 +340,9 @@ class CoarseGrid:
         i = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, len(self.nodes) - 2)
         return i, (x - self.nodes[i]) / (self.nodes[i + 1] - self.nodes[i])
 
-    def moments(self, psi: np.ndarray, weights: np.ndarray, values: np.ndarray):
+    def moments(
+        self, psi: np.ndarray, weights: np.ndarray, values: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(int phi_j v, int phi_j) of the grid's hat functions phi_j against the values
         (points, components) at the points psi with the quadrature weights: one rank's part
         of the lumped L2 projection (sum them over the ranks, then divide)."""
@@ -355,7 +364,7 @@ class CoarseGrid:
 class WeightedMeasure(ufl.Measure):
     """A measure that multiplies every integrand by ``weight`` (``integrand * measure``)."""
 
-    def __init__(self, measure: ufl.Measure, weight) -> None:
+    def __init__(self, measure: ufl.Measure, weight: Expr) -> None:
         super().__init__(
             measure.integral_type(),
             domain=measure.ufl_domain(),
@@ -365,7 +374,7 @@ class WeightedMeasure(ufl.Measure):
         )
         self.weight = weight
 
-    def __rmul__(self, integrand):
+    def __rmul__(self, integrand: Expr | float) -> Form:
         if isinstance(integrand, (int, float)):
             integrand = ufl.as_ufl(integrand)
         return super().__rmul__(self.weight * integrand)
@@ -381,55 +390,56 @@ class CutSurface(InterfaceSurface):
     maps a P1 field to its value at the crack's Gauss points, ``at_law`` to its value at the
     midpoint of each cell's piece (:meth:`tip_extended`)."""
 
-    at_crack: object = None
-    at_law: object = None
+    at_crack: Callable[[Expr], Expr] | None = None
+    at_law: Callable[[Expr], Expr] | None = None
     #: the enrichment's half jump at the Gauss points and at the pieces' midpoints (the tip
     #: enrichment's part included: contactfx.contact.tip); None: ``at_crack`` / ``at_law``
-    at_jump: object = None
-    at_jump_law: object = None
+    at_jump: Callable[[Expr], Expr] | None = None
+    at_jump_law: Callable[[Expr], Expr] | None = None
     #: the first component of this crack's enrichment in U = (u, a_1, ..., a_K)
     first: int = 2
 
-    def jump(self, X):
+    def jump(self, X: Expr) -> Expr:
         """[[w]] = 2 a at the crack's Gauss points (2 (a_H + sqrt(r) a_T) with the tip
         enrichment), for X = (u, a_1, ...) (the unknown, its test or trial function)."""
         half = self.at_crack if self.at_jump is None else self.at_jump
+        assert half is not None  # the driver gives at_crack
         return 2.0 * half(ufl.as_vector([X[self.first + i] for i in range(2)]))
 
     @property
-    def u(self):
+    def u(self) -> Expr:
         return self.jump(self.w)
 
     @property
-    def v(self):
+    def v(self) -> Expr:
         return self.jump(self.v_total)
 
     @property
-    def h(self):
+    def h(self) -> Expr:
         return self.h_cell
 
     @property
-    def stress(self):
+    def stress(self) -> Expr:
         s = self.stress_cell
         if self.fluid is not None:
             s = s + self.fluid * self._identity()
         return s
 
     @property
-    def stress_test(self):
+    def stress_test(self) -> Expr:
         return self.stress_test_cell
 
-    def _identity(self):
+    def _identity(self) -> Expr:
         return ufl.Identity(ufl.shape(self.H)[0])
 
-    def interface_normal(self):
+    def interface_normal(self) -> Expr:
         return self.H
 
-    def opening(self, w=None):
+    def opening(self, w: Expr | None = None) -> Expr:
         jump = self.u if w is None else self.jump(w)
         return ufl.dot(jump, self.interface_normal())
 
-    def tip_extended(self):
+    def tip_extended(self) -> Self:
         """The surface that the law of a method collocated at a fitted crack's nodes (the
         penalty: ``tip_continued``) reads: its motion at the midpoint of each cut cell's
         piece, where the linear jump takes its mean, so that the law is one value per piece.
@@ -440,7 +450,7 @@ class CutSurface(InterfaceSurface):
             return self
         return dataclasses.replace(self, at_crack=self.at_law, at_jump=self.at_jump_law)
 
-    def slip_increment(self, n):
+    def slip_increment(self, n: Expr) -> Expr:
         if self.u_prev is None:
             raise ValueError("the slip increment needs the previous state (friction only)")
         return tangential(self.u - self.jump(self.u_prev), n)

@@ -41,7 +41,7 @@ class ContactSurface(SurfaceData):
     h: Expr
     offset_prev: Expr | None = None
 
-    def position(self, w=None):
+    def position(self, w: Expr | None = None) -> Expr:
         """Current position in the obstacle's frame, x + u - offset. For the linearised
         (``vertical``) obstacles in small strain only the vertical displacement moves the
         point: their gap is the small-deformation Signorini gap height(x_t) - (x_d + u_d) of
@@ -54,15 +54,15 @@ class ContactSurface(SurfaceData):
             w = ufl.as_vector([0.0] * (d - 1) + [w[d - 1]])
         return x + w - self.offset
 
-    def gap(self, w=None):
+    def gap(self, w: Expr | None = None) -> Expr:
         """g(u) = phi(x + u - offset), > 0 when apart."""
         return self.obstacle.gap(self.position(w))
 
-    def normal(self, w=None):
+    def normal(self, w: Expr | None = None) -> Expr:
         """n(u) = -grad phi at x + u - offset: outward normal of the body at contact."""
         return self.obstacle.normal(self.position(w))
 
-    def slip_increment(self, n):
+    def slip_increment(self, n: Expr) -> Expr:
         """Tangential displacement of the body relative to the obstacle since the last
         converged step: (I - n n) ((u - u_prev) - (offset - offset_prev))."""
         if self.u_prev is None:

@@ -41,7 +41,9 @@ Interface laws beyond Signorini, all through the gap (the laws module's forms ar
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import ufl
 
@@ -49,16 +51,19 @@ from contactfx.contact.laws import positive_part, tangential
 from contactfx.contact.surface import Expr, SurfaceData
 from contactfx.references import bb_closure
 
+if TYPE_CHECKING:
+    from typing import Self
+
 __all__ = ["BartonBandis", "InterfaceSurface", "oriented_jump", "interface_normal", "tangent"]
 
 
-def oriented_jump(w, H):
+def oriented_jump(w: Expr, H: Expr) -> Expr:
     """[[w]] = w(+side) - w(-side) on facets where H changes sign (whatever dolfinx's '+' / '-'
     restriction of the facet is)."""
     return 0.5 * (H("+") - H("-")) * (w("+") - w("-"))
 
 
-def tangent(n, axis=None):
+def tangent(n: Expr, axis: Iterable[float] | None = None) -> Expr:
     """The interface direction: in 2D the normal n_I rotated by -90 degrees; in 3D the unit
     projection of ``axis`` (a vector not normal to the interface) on the interface's plane."""
     if ufl.shape(n)[0] == 2:
@@ -70,7 +75,7 @@ def tangent(n, axis=None):
     return t / ufl.sqrt(ufl.dot(t, t))
 
 
-def interface_normal(H, n):
+def interface_normal(H: Expr, n: Expr) -> Expr:
     """Unit normal n_I of the interface, pointing from the H = -1 side to the H = +1 side
     (n is ufl.FacetNormal: n('+') is the outward normal of the '+' cell)."""
     return -H("+") * n("+")
@@ -91,7 +96,7 @@ class BartonBandis:
         if self.Vm > self.w0:
             raise ValueError(f"maximal closure V_m = {self.Vm} exceeds the aperture w0 = {self.w0}")
 
-    def closure(self, s):
+    def closure(self, s: Expr) -> Expr:
         """v = psi(s) for an effective normal stress s >= 0 (numbers or UFL)."""
         return bb_closure(s, self.Kni, self.Vm)
 
@@ -126,23 +131,23 @@ class InterfaceSurface(SurfaceData):
 
     # -- the ContactSurface members the methods use -----------------------------------------
     @property
-    def u(self):
+    def u(self) -> Expr:
         """The oriented displacement jump [[w]] (the +side's motion relative to the -side)."""
         return oriented_jump(self.w, self.H)
 
     @property
-    def v(self):
+    def v(self) -> Expr:
         return oriented_jump(self.v_total, self.H)
 
     @property
-    def h(self):
+    def h(self) -> Expr:
         return ufl.avg(self.h_cell)
 
-    def _identity(self):
+    def _identity(self) -> Expr:
         return ufl.Identity(ufl.shape(self.w)[0])
 
     @property
-    def stress(self):
+    def stress(self) -> Expr:
         """Averaged stress of the state, plus p_f I (the contact law acts on the effective
         stress)."""
         s = ufl.avg(self.stress_cell)
@@ -151,28 +156,28 @@ class InterfaceSurface(SurfaceData):
         return s
 
     @property
-    def stress_test(self):
+    def stress_test(self) -> Expr:
         return ufl.avg(self.stress_test_cell)
 
-    def interface_normal(self):
+    def interface_normal(self) -> Expr:
         """n_I: from the -side to the +side."""
         return interface_normal(self.H, ufl.FacetNormal(self.mesh))
 
-    def normal(self, w=None):
+    def normal(self, w: Expr | None = None) -> Expr:
         """Outward normal of the +side face: -n_I."""
         return -self.interface_normal()
 
-    def opening(self, w=None):
+    def opening(self, w: Expr | None = None) -> Expr:
         """Normal opening [[w]] . n_I (> 0 open)."""
         jump = self.u if w is None else oriented_jump(w, self.H)
         return ufl.dot(jump, self.interface_normal())
 
-    def effective_pressure(self):
+    def effective_pressure(self) -> Expr:
         """s' = -(n . sigma n + p_f): the normal stress the faces (or the joint) carry."""
         n = self.normal()
         return -self.traction_n(n)
 
-    def gap(self, w=None):
+    def gap(self, w: Expr | None = None) -> Expr:
         """opening - proppant floor (+ joint closure psi(s'))."""
         g = self.opening(w)
         if self.floor is not None:
@@ -181,7 +186,7 @@ class InterfaceSurface(SurfaceData):
             g = g + self.joint.closure(positive_part(self.effective_pressure()))
         return g
 
-    def tip_extended(self):
+    def tip_extended(self) -> Self:
         """This surface with the motion w, the previous motion, the multiplier and the nodal
         fields of a law (the traction history, the nodal mesh size) replaced, on each tip's
         element, by their values at the tip's neighbour, and unchanged elsewhere.
@@ -199,12 +204,13 @@ class InterfaceSurface(SurfaceData):
             return self
         d = self.tip_step
 
-        def extend(f):
-            if f is None:
-                return None
+        def extend(f: Expr) -> Expr:
             if isinstance(f, ufl.classes.Restricted):  # a nodal field seen from one side
                 return extend(f.ufl_operands[0])(f.side())
             return f + ufl.dot(ufl.grad(f), d) + 0.5 * ufl.dot(ufl.dot(ufl.grad(ufl.grad(f)), d), d)
+
+        def extend_optional(f: Expr | None) -> Expr | None:
+            return None if f is None else extend(f)
 
         lam = self.multiplier
         if lam is not None and self.multiplier_tie is not None:
@@ -212,14 +218,14 @@ class InterfaceSurface(SurfaceData):
         return replace(
             self,
             w=extend(self.w),
-            u_prev=extend(self.u_prev),
+            u_prev=extend_optional(self.u_prev),
             multiplier=lam,
-            traction_prev=extend(self.traction_prev),
-            h_nodal=extend(self.h_nodal),
+            traction_prev=extend_optional(self.traction_prev),
+            h_nodal=extend_optional(self.h_nodal),
             tip_step=None,
         )
 
-    def slip_increment(self, n):
+    def slip_increment(self, n: Expr) -> Expr:
         """Tangential jump increment since the last converged step."""
         if self.u_prev is None:
             raise ValueError("the slip increment needs the previous state (friction only)")

@@ -12,10 +12,12 @@ conditions to t_T = proj_{B(0, s)}(t_T - r du_T) with du_T the slip increment (A
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeAlias
 
 import ufl
 
 __all__ = [
+    "Expr",
     "tangential",
     "positive_part",
     "active",
@@ -29,28 +31,32 @@ __all__ = [
     "friction_law",
 ]
 
+#: a UFL expression (a Function, a component of a mixed one, a test function, a Constant;
+#: re-exported as :data:`contactfx.contact.surface.Expr`)
+Expr: TypeAlias = ufl.core.expr.Expr
 
-def tangential(w, n):
+
+def tangential(w: Expr, n: Expr) -> Expr:
     """Tangential part (I - n n) w of the vector w."""
     return w - ufl.dot(w, n) * n
 
 
-def positive_part(x):
+def positive_part(x: Expr) -> Expr:
     """[x]_+ = max(x, 0), with the derivative 0 at x = 0 (semi-smooth Newton)."""
     return ufl.conditional(ufl.gt(x, 0.0), x, 0.0)
 
 
-def active(x):
+def active(x: Expr) -> Expr:
     """Indicator 1 where x > 0, else 0."""
     return ufl.conditional(ufl.gt(x, 0.0), 1.0, 0.0)
 
 
-def norm(x, scale: float):
+def norm(x: Expr, scale: float) -> Expr:
     """|x|, regularised by 1e-12 ``scale`` so that it and its derivative stay finite at 0."""
     return ufl.sqrt(ufl.dot(x, x) + (1e-12 * scale) ** 2)
 
 
-def ball_projection(x, s, scale: float, stick=None):
+def ball_projection(x: Expr, s: Expr, scale: float, stick: Expr | None = None) -> Expr:
     """Projection of the vector x onto the ball of radius s >= 0: x where |x| <= s, else
     s x / |x|. ``scale`` is a typical magnitude of x (regularises |x| at 0). ``stick``
     (optional): where it is > 0 and s > 0, x itself whatever |x| (the stick branch; see
@@ -62,7 +68,7 @@ def ball_projection(x, s, scale: float, stick=None):
     return ufl.conditional(inside, x, s / nx * x)
 
 
-def reversal(x, x_last, s):
+def reversal(x: Expr, x_last: Expr, s: Expr) -> Expr:
     """1 where the point slipped at Newton's previous iterate (its trial tangential traction
     there, x_last, outside the ball of radius s) and the trial x now points against x_last,
     else 0.
@@ -78,7 +84,7 @@ def reversal(x, x_last, s):
     return ufl.conditional(ufl.And(slipped, ufl.lt(ufl.dot(x, x_last), 0.0)), 1.0, 0.0)
 
 
-def fischer_burmeister(a, b, scale: float):
+def fischer_burmeister(a: Expr, b: Expr, scale: float) -> Expr:
     """phi(a, b) = a + b - sqrt(a^2 + b^2): zero exactly when a >= 0, b >= 0 and a b = 0
     (Fischer 1992, doi:10.1080/02331939208843795). Regularised at (0, 0) by 1e-12 scale."""
     return a + b - ufl.sqrt(a**2 + b**2 + (1e-12 * scale) ** 2)
@@ -90,10 +96,10 @@ class Friction:
 
     name = "none"
 
-    def bound(self, p):
+    def bound(self, p: Expr) -> Expr:
         raise NotImplementedError
 
-    def bound_where(self, p, closed):
+    def bound_where(self, p: Expr, closed: Expr) -> Expr:
         """The bound for the pressure p where ``closed`` > 0 marks the contact set (they
         differ only for multiplier methods, whose pressure is not exactly 0 where open)."""
         return self.bound(p)
@@ -111,10 +117,10 @@ class Tresca(Friction):
         if not self.threshold >= 0.0:
             raise ValueError(f"Tresca threshold must be >= 0, got {self.threshold}")
 
-    def bound(self, p):
+    def bound(self, p: Expr) -> Expr:
         return self.threshold * active(p)
 
-    def bound_where(self, p, closed):
+    def bound_where(self, p: Expr, closed: Expr) -> Expr:
         return self.threshold * active(closed)
 
 
@@ -129,7 +135,7 @@ class Coulomb(Friction):
         if not self.mu >= 0.0:
             raise ValueError(f"friction coefficient mu must be >= 0, got {self.mu}")
 
-    def bound(self, p):
+    def bound(self, p: Expr) -> Expr:
         return self.mu * positive_part(p)
 
 

@@ -27,9 +27,18 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
 from contactfx.contact.laws import active, ball_projection, norm
+
+if TYPE_CHECKING:
+    from typing import Self
+
+    from contactfx.contact.coupling import PairCoupling
+    from contactfx.contact.pair import ContactPair
+    from contactfx.contact.surface import Expr, Form, Surface
+    from contactfx.solvers.base import Solver
+    from contactfx.solvers.snes import ContactSNES
 
 __all__ = [
     "Supports",
@@ -102,20 +111,21 @@ class ContactMethod(Protocol):
     multiplier: ClassVar[Multiplier]
     supports: ClassVar[Supports]
 
-    def residual(self, s) -> Any: ...
+    def residual(self, s: Surface) -> Form | None: ...
 
-    def pressure(self, s) -> Any: ...
+    def pressure(self, s: Surface) -> Expr | None: ...
 
-    def contact_indicator(self, s) -> Any: ...
+    def contact_indicator(self, s: Surface) -> Expr | None: ...
 
     def snes_options(self) -> dict[str, object]: ...
 
-    def attach(self, solver, problem) -> Any: ...
+    def attach(self, solver: ContactSNES, problem: Any) -> Solver: ...
 
 
 class MethodBase:
     """Defaults of the protocol for the dataclass methods."""
 
+    name: ClassVar[str]
     multiplier: ClassVar[Multiplier] = NO_MULTIPLIER
     #: with friction, whether the method's law needs the tangential traction of the last
     #: converged step (the surface's ``traction_prev``, kept by the driver)
@@ -131,19 +141,23 @@ class MethodBase:
     #: --method NAME`` runs ("": none)
     sweep: ClassVar[tuple[str, tuple]] = ("", ())
 
+    if TYPE_CHECKING:
+        # every method defines it (the ContactMethod protocol)
+        def pressure(self, s: Surface) -> Expr | None: ...
+
     @classmethod
-    def from_options(cls, options) -> MethodBase:
+    def from_options(cls, options: Any) -> Self:
         """The method with its parameters read from ``options`` (a Numerics, by option name)."""
         from contactfx.params import option_name
 
         return cls(**{f.name: getattr(options, option_name(f)) for f in dataclasses.fields(cls)})
 
-    def law_surface(self, s):
+    def law_surface(self, s: Surface) -> Surface:
         """The surface the method's law reads: with ``tip_continued``, continued over each
         crack tip's element from its neighbouring node (``s.tip_extended()``), else ``s``."""
         return s.tip_extended() if self.tip_continued else s
 
-    def contact_indicator(self, s):
+    def contact_indicator(self, s: Surface) -> Expr | None:
         """> 0 exactly where the surfaces are closed (the pressure, unless a multiplier that
         vanishes only to solver tolerance where open needs a sharper test)."""
         return self.pressure(s)
@@ -151,14 +165,16 @@ class MethodBase:
     def snes_options(self) -> dict[str, object]:
         return {}
 
-    def coupling(self, pair):
+    def coupling(self, pair: ContactPair) -> PairCoupling:
         """The terms between two separately meshed bodies
         (:class:`contactfx.contact.coupling.Coupling`) of a contact ``pair``
         (:class:`contactfx.contact.pair.ContactPair`); only methods that support two bodies."""
         raise NotImplementedError(f"method {self.name} has no two-body coupling")
 
-    def attach(self, solver, problem):
-        """The solver the load program drives (``solver`` itself unless wrapped)."""
+    def attach(self, solver: ContactSNES, problem: Any) -> Solver:
+        """The solver the load program drives (``solver`` itself unless wrapped). ``problem``
+        is the driver's problem kind (:class:`contactfx.driver.problem.Problem`; the members a
+        method reads, e.g. an obstacle's, differ from kind to kind)."""
         return solver
 
 
@@ -169,19 +185,27 @@ class TrialFriction:
     bound (Newton's reversal guard, :func:`contactfx.contact.laws.reversal`) and the slip
     indicator."""
 
-    def _trial_t(self, s):
+    if TYPE_CHECKING:
+        # the method's own (its normal law)
+        def pressure(self, s: Surface) -> Expr: ...
+
+    def _trial_t(self, s: Surface) -> Expr:
         raise NotImplementedError
 
-    def tangential_traction(self, s):
+    # the friction terms are built only with a friction law (s.friction is not None)
+    def tangential_traction(self, s: Surface) -> Expr:
+        assert s.friction is not None
         return ball_projection(
             self._trial_t(s), s.friction.bound(self.pressure(s)), s.E, stick=s.stick
         )
 
-    def trial_traction(self, s):
+    def trial_traction(self, s: Surface) -> tuple[Expr, Expr]:
         """The trial tangential traction and the friction bound."""
+        assert s.friction is not None
         return self._trial_t(s), s.friction.bound(self.pressure(s))
 
-    def slip_indicator(self, s):
+    def slip_indicator(self, s: Surface) -> Expr:
         """1 where the friction bound is reached (slip), else 0."""
+        assert s.friction is not None
         p = self.pressure(s)
         return active(p) * active(norm(self._trial_t(s), s.E) - s.friction.bound(p))

@@ -77,6 +77,7 @@ holding the gap rows and the slip rows.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
 from petsc4py import PETSc
@@ -92,7 +93,17 @@ from contactfx.contact.projection import (
 )
 from contactfx.params import param, validate
 
+if TYPE_CHECKING:
+    from mpi4py import MPI
+
+    from contactfx.contact.pair import ContactPair
+    from contactfx.contact.surface import Surface
+
 __all__ = ["Mortar", "MortarCoupling", "mortar_matrices", "dual_triangle"]
+
+#: the local mortar integrals (:func:`mortar_matrices`): D contributions, weighted normals
+#: and the triplets (slave node, master node, value) of M
+_Integrals: TypeAlias = tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 
 @dataclass(frozen=True)
@@ -125,13 +136,13 @@ class Mortar(MethodBase):
     def __post_init__(self) -> None:
         validate(self)
 
-    def residual(self, s):
+    def residual(self, s: Surface) -> None:
         return None
 
-    def pressure(self, s):
+    def pressure(self, s: Surface) -> None:
         return None
 
-    def coupling(self, pair) -> MortarCoupling:
+    def coupling(self, pair: ContactPair) -> MortarCoupling:
         return MortarCoupling(pair, self.r0, self.ncp)
 
 
@@ -159,7 +170,9 @@ def nodal_weights(x: np.ndarray) -> np.ndarray:
     return np.repeat(area[:, None] / 3.0, 3, axis=1)
 
 
-def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
+def mortar_matrices(
+    slave: Facets, master: Facets, pairs: tuple[np.ndarray, np.ndarray], order: int = 2
+) -> _Integrals:
     """The local mortar integrals of P1 facets (segments in 2D, triangles in 3D, from
     ``slave.x.shape[1]``): D contributions (m_s, d) per slave facet node (int N_j),
     measure-weighted normal contributions (m_s, d, gdim), and the triplets (slave node, master
@@ -197,7 +210,9 @@ def mortar_matrices(slave: Facets, master: Facets, pairs, order: int = 2):
     return D, normals, (flat[0].astype(np.int64), flat[1].astype(np.int64), flat[2])
 
 
-def _mortar_triangles(slave: Facets, master: Facets, pairs):
+def _mortar_triangles(
+    slave: Facets, master: Facets, pairs: tuple[np.ndarray, np.ndarray]
+) -> _Integrals:
     """:func:`mortar_matrices` of P1 triangles: each facing candidate pair's overlap, the
     master projected onto the slave plane along the slave normal
     (:func:`.projection.triangle_overlaps`), integrated over its fan triangles with the
@@ -242,7 +257,9 @@ def _mortar_triangles(slave: Facets, master: Facets, pairs):
     )
 
 
-def _to_owners(comm, ranges: np.ndarray, node: np.ndarray, payload: list[np.ndarray]):
+def _to_owners(
+    comm: MPI.Comm, ranges: np.ndarray, node: np.ndarray, payload: list[np.ndarray]
+) -> tuple[np.ndarray, list[np.ndarray]]:
     """Send rows (node, *payload) to the owners of ``node``; the received rows."""
     if comm.size == 1:
         return node, payload
@@ -259,13 +276,18 @@ def _to_owners(comm, ranges: np.ndarray, node: np.ndarray, payload: list[np.ndar
 class MortarCoupling:
     """The condensed dual-mortar contact of one pair (see the module docstring)."""
 
-    def __init__(self, pair, r0: float, ncp: str) -> None:
+    def __init__(self, pair: ContactPair, r0: float, ncp: str) -> None:
         self.pair, self.r0, self.ncp = pair, r0, ncp
         self.layout: NodeLayout = pair.layout
         self.comm = self.layout.comm
         self.search_each_newton = pair.search_each_newton
         self.ranges = owners(self.layout.imap, self.comm)
-        self.T = self.G = self.TK = self.g0 = None
+        # the row operator T, the gap (and slip) rows G, T K and the gaps at the reference
+        # configuration: made by the search (update), T K at the next Jacobian
+        self.T: PETSc.Mat | None = None
+        self.G: PETSc.Mat | None = None
+        self.TK: PETSc.Mat | None = None
+        self.g0: PETSc.Vec | None = None
         #: the reference weights D0_j (the slave surface at X) of this rank's slave nodes
         #: (sorted global nodes, weights), for the nominal pressure (:meth:`nodal`)
         self._reference: tuple[np.ndarray, np.ndarray] | None = None
@@ -283,6 +305,7 @@ class MortarCoupling:
         if self._reference is None:
             self._reference = self._node_sums(nodes, nodal_weights(pair.slave.X))
         near, pairs = pair.search(slave, master)
+        assert pairs is not None  # searched with pairs
         D, normals, (rows, cols, vals) = mortar_matrices(slave, near, pairs)
         # nodal sums on the owners: D_j and sum of weighted normals
         node_data = np.concatenate([D.reshape(-1, 1), normals.reshape(-1, gdim)], axis=1)
@@ -290,7 +313,7 @@ class MortarCoupling:
         m_rows, (m_cols, m_vals) = _to_owners(comm, self.ranges, rows, [cols, vals])
         self._assemble(j_nodes, j_data, m_rows, m_cols, m_vals)
 
-    def _node_sums(self, nodes: np.ndarray, values: np.ndarray):
+    def _node_sums(self, nodes: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(sorted owned nodes, sums): the per-facet-node ``values`` (same shape as the facets'
         nodes) summed on the nodes' owners. Collective."""
         j, (d,) = _to_owners(self.comm, self.ranges, nodes, [values.reshape(-1, 1)])
@@ -305,6 +328,7 @@ class MortarCoupling:
         ub = u.reshape(-1, lay.bs)[:, : lay.gdim]
         slave, master = pair.slave.current(ub), pair.master.current(ub)
         near, pairs = pair.search(slave, master)
+        assert pairs is not None  # searched with pairs
         D, _, (rows, _, vals) = mortar_matrices(slave, near, pairs)
         uniq, Dj = self._node_sums(slave.nodes.reshape(-1), D)
         m_rows, (m_vals,) = _to_owners(comm, self.ranges, rows, [vals])
@@ -314,7 +338,14 @@ class MortarCoupling:
 
         return comm.allreduce(len(np.setdiff1d(covered, self.covered)), op=MPI.SUM)
 
-    def _assemble(self, j_nodes, j_data, m_rows, m_cols, m_vals) -> None:
+    def _assemble(
+        self,
+        j_nodes: np.ndarray,
+        j_data: np.ndarray,
+        m_rows: np.ndarray,
+        m_cols: np.ndarray,
+        m_vals: np.ndarray,
+    ) -> None:
         lay = self.layout
         gdim, bs = lay.gdim, lay.bs
         uniq, inv = np.unique(j_nodes, return_inverse=True)
@@ -341,6 +372,7 @@ class MortarCoupling:
         contact &= np.linalg.norm(n_free, axis=1) > 0.5
         keep = contact[key]
         self.nodes, self.D = uniq[contact], Dj[contact]
+        assert self._reference is not None  # the first search's (update)
         uniq0, D0 = self._reference
         self.D0 = D0[np.searchsorted(uniq0, self.nodes)]
         self.normal, self.comp = nj[contact], comp[contact]
@@ -426,6 +458,7 @@ class MortarCoupling:
         G.mult(lay.X, self.g0)
         if self.mu is not None:  # slip rows: - G u_prev (the increment from the last step)
             n = lay.n_owned * bs
+            assert self.previous is not None  # set with mu
             prev = G.createVecRight()
             prev.getArray()[:] = self.previous.x.array[:n]
             slip0 = G.createVecLeft()
@@ -439,8 +472,11 @@ class MortarCoupling:
         self._g = G.createVecLeft()
 
     # -- nonlinear residual and Jacobian ---------------------------------------------------
-    def _state(self, x: PETSc.Vec, R: PETSc.Vec):
+    def _state(
+        self, x: PETSc.Vec, R: PETSc.Vec
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(y = T R, lambda, c g, the NCP value and its partial derivatives) at x."""
+        assert self.T is not None and self.G is not None  # made by the search
         self.T.mult(R, self._y)
         self.G.mult(x, self._g)
         self._g.axpy(1.0, self.g0)
@@ -466,11 +502,14 @@ class MortarCoupling:
             (self.nodes - self.layout.start)[:, None] * bs + np.arange(self.layout.gdim)
         ).astype(np.int64)
 
-    def _friction(self, lam, cg, y, q):
+    def _friction(
+        self, lam: np.ndarray, cg: np.ndarray, y: np.ndarray, q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Coulomb at the contact nodes: C_T = lambda_T - proj_{B(xi)}(lambda_T + c v), the
         bound xi = mu max(0, lambda - c g) (Hueeber, Stadler & Wohlmuth 2008,
         doi:10.1137/060671061), in the tangent slots (m, gdim) of ``tmask``; its derivatives
         with respect to lambda_T, v (m, gdim, gdim) and to lambda, g (m, gdim)."""
+        assert self.mu is not None
         tm = self.tmask
         lt, v = np.where(tm, y, 0.0), np.where(tm, q, 0.0)
         c = self.c[:, None]
@@ -510,6 +549,7 @@ class MortarCoupling:
     ) -> None:
         """At the x of the last residual (SNES evaluates F(x) before J(x)); T K is formed
         again after a search or when the bulk's Jacobian K changed."""
+        assert self.T is not None and self.G is not None  # made by the search
         da, db = self._da, self._db
         if bulk_changed and self.TK is not None:
             self.TK.destroy()
@@ -541,10 +581,11 @@ class MortarCoupling:
         A.destroy()
         B.destroy()
 
-    def _friction_blocks(self, da, db):
+    def _friction_blocks(self, da: np.ndarray, db: np.ndarray) -> tuple[PETSc.Mat, PETSc.Mat]:
         """(P T K, Q G): the nodal blocks P, Q (identity and zero away from the contact nodes)
         of the derivative of the rows (normal C, tangential C_T) with respect to y = T R
         (lambda, lambda_T) and q = G u (g, v)."""
+        assert self.TK is not None and self.G is not None  # formed by the Jacobian
         lay = self.layout
         gdim, bs, m = lay.gdim, lay.bs, len(self.nodes)
         _, d_lt, d_v, d_lam, d_g = self._fric
@@ -600,11 +641,12 @@ class MortarCoupling:
         local = -np.sum(self.D[:, None] * traction, axis=0)
         return self.comm.allreduce(np.asarray(local, dtype=float).reshape(-1), op=MPI.SUM)
 
-    def friction_state(self) -> dict:
+    def friction_state(self) -> dict[str, float]:
         """Sums over this rank's contact nodes: the contact measure (the nodes where the
         friction bound is positive) and the stick measure on the reference surface (weights
         D0_j, as :meth:`nodal`), the bound mu lambda, the excess of |lambda_T| over it and the
         sum of |lambda_T| as forces (weights D_j)."""
+        assert self.mu is not None  # with friction
         closed = self.xi > 0.0
         bound = self.mu * self.lam
         excess = np.maximum(np.linalg.norm(self.lam_t, axis=1) - bound, 0.0)
@@ -617,7 +659,7 @@ class MortarCoupling:
             "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1))),
         }
 
-    def nodal_friction(self):
+    def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per node of :meth:`nodal`: the nominal |lambda_T| (D_j |lambda_T| / D0_j), |weighted
         slip increment of the step| and the stick mask."""
         slip = np.where(self.tmask, self._g.getArray()[self.tangent_rows()], 0.0)
@@ -628,7 +670,7 @@ class MortarCoupling:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""
         return self.g0.getArray()[self.normal_rows] + 0.0 if self.g0 is not None else np.zeros(0)
 
-    def nodal(self):
+    def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Owned contact nodes: (global node, reference weight D0_j, nominal pressure
         D_j lambda_j / D0_j, gap g_j). The nodal force D_j lambda_j per the node's support
         measured on the reference surface (D0_j = int N_j over it): the bulk is small-strain, its
@@ -638,7 +680,9 @@ class MortarCoupling:
         return self.nodes, self.D0, self.D * self.lam / self.D0, self.gap
 
 
-def _owned_matrix(lay: NodeLayout, rows, cols, vals) -> PETSc.Mat:
+def _owned_matrix(
+    lay: NodeLayout, rows: np.ndarray, cols: np.ndarray, vals: np.ndarray
+) -> PETSc.Mat:
     """The AIJ matrix of the node layout with the entries (global row, global column, value)
     of owned rows (duplicates summed), built from local CSR arrays in one call."""
     n_local = lay.n_owned * lay.bs
@@ -658,7 +702,7 @@ def _owned_matrix(lay: NodeLayout, rows, cols, vals) -> PETSc.Mat:
     return M
 
 
-def _frames(n: np.ndarray, free: np.ndarray):
+def _frames(n: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Nodal frames restricted to the free (not Dirichlet) components.
 
     n: (m, gdim) unit normals, free: (m, gdim) bool. Returns n_F = the normals' free part,

@@ -28,13 +28,18 @@ asimov-contact gamma_a / h with gamma_a = gamma0 E.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import ufl
 
 from contactfx.contact.laws import positive_part
 from contactfx.contact.method import MethodBase, Supports, TrialFriction
-from contactfx.contact.surface import Surface
+from contactfx.contact.surface import Expr, Form, Surface
 from contactfx.params import param, validate
+
+if TYPE_CHECKING:
+    from contactfx.contact.pair import ContactPair
+    from contactfx.contact.point_coupling import PointCoupling
 
 __all__ = ["Nitsche"]
 
@@ -64,19 +69,19 @@ class Nitsche(TrialFriction, MethodBase):
     def __post_init__(self) -> None:
         validate(self)
 
-    def gamma(self, s: Surface):
+    def gamma(self, s: Surface) -> Expr:
         return self.gamma0 * s.E / s.h
 
-    def pressure(self, s: Surface):
+    def pressure(self, s: Surface) -> Expr:
         n = s.normal()
         return positive_part(-s.traction_n(n) - self.gamma(s) * s.gap())
 
-    def _trial_t(self, s: Surface):
+    def _trial_t(self, s: Surface) -> Expr:
         """The trial tangential traction sigma_T(u) - gamma_N du_T."""
         n = s.normal()
         return s.traction_t(n) - self.gamma(s) * s.slip_increment(n)
 
-    def residual(self, s: Surface):
+    def residual(self, s: Surface) -> Form:
         n = s.normal()
         gamma = self.gamma(s)
         sn_u = s.traction_n(n)
@@ -94,7 +99,7 @@ class Nitsche(TrialFriction, MethodBase):
                 form -= self.theta / gamma * ufl.dot(s.traction_t(n), st_v) * s.ds
         return form
 
-    def coupling(self, pair):
+    def coupling(self, pair: ContactPair) -> PointCoupling:
         """Between two bodies (frictionless): biased or unbiased Nitsche at Gauss points
         (:mod:`contactfx.contact.point_coupling`)."""
         from contactfx.contact.point_coupling import Law, PointCoupling

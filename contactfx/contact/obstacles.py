@@ -22,15 +22,17 @@ from dataclasses import dataclass
 import numpy as np
 import ufl
 
+from contactfx.contact.laws import Expr
+
 __all__ = ["Obstacle", "HalfSpace", "Ball", "Paraboloid", "FlatPunch", "Sinusoid"]
 
 
-def _tangential_sq(y):
+def _tangential_sq(y: Expr) -> Expr:
     d = ufl.shape(y)[0]
     return sum(y[i] ** 2 for i in range(d - 1)) if d > 1 else 0.0
 
 
-def _e_last(d: int):
+def _e_last(d: int) -> Expr:
     return ufl.as_vector([0.0] * (d - 1) + [1.0])
 
 
@@ -45,16 +47,16 @@ class Obstacle:
 
     vertical: bool = False  # gap measured along e_d, pressure along e_d
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         raise NotImplementedError
 
     def height(self, t: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
-    def gap(self, y):
+    def gap(self, y: Expr) -> Expr:
         return self.phi(y)
 
-    def normal(self, y):
+    def normal(self, y: Expr) -> Expr:
         d = ufl.shape(y)[0]
         if self.vertical:
             return _e_last(d)
@@ -70,7 +72,7 @@ class HalfSpace(Obstacle):
     level: float = 0.0
     vertical = True
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         return self.level - y[ufl.shape(y)[0] - 1]
 
     def height(self, t: np.ndarray) -> np.ndarray:
@@ -86,12 +88,12 @@ class Ball(Obstacle):
     def __post_init__(self) -> None:
         _check_positive(radius=self.radius)
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         d = ufl.shape(y)[0]
         r = y - ufl.as_vector([0.0] * (d - 1) + [self.radius])
         return ufl.sqrt(ufl.dot(r, r)) - self.radius
 
-    def normal(self, y):
+    def normal(self, y: Expr) -> Expr:
         d = ufl.shape(y)[0]
         r = y - ufl.as_vector([0.0] * (d - 1) + [self.radius])
         return -r / ufl.sqrt(ufl.dot(r, r))
@@ -114,7 +116,7 @@ class Paraboloid(Obstacle):
     def __post_init__(self) -> None:
         _check_positive(radius=self.radius)
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         return _tangential_sq(y) / (2.0 * self.radius) - y[ufl.shape(y)[0] - 1]
 
     def height(self, t: np.ndarray) -> np.ndarray:
@@ -135,7 +137,7 @@ class FlatPunch(Obstacle):
     def __post_init__(self) -> None:
         _check_positive(half_width=self.half_width, edge_radius=self.edge_radius)
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         d = ufl.shape(y)[0]
         rho = ufl.sqrt(_tangential_sq(y) + (1e-12 * self.half_width) ** 2)
         q = ufl.max_value(rho - self.half_width, 0.0)
@@ -163,7 +165,7 @@ class Sinusoid(Obstacle):
     def __post_init__(self) -> None:
         _check_positive(amplitude=self.amplitude, wavelength=self.wavelength)
 
-    def phi(self, y):
+    def phi(self, y: Expr) -> Expr:
         k = 2.0 * np.pi / self.wavelength
         return self.amplitude * (1.0 - ufl.cos(k * y[0])) - y[ufl.shape(y)[0] - 1]
 

@@ -22,11 +22,17 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from mpi4py import MPI
 
 from contactfx import _compat
+
+if TYPE_CHECKING:
+    import dolfinx
+
+    from contactfx.contact.coupling import NodeLayout
 
 __all__ = [
     "Side",
@@ -94,8 +100,9 @@ class Side:
         return len(self.local)
 
 
-def side_of(V, facet_tags, tag: int) -> Side:
-    """The owned facets tagged ``tag`` of the P1 vector space V, oriented outwards."""
+def side_of(V: dolfinx.fem.FunctionSpace, facet_tags: Any, tag: int) -> Side:
+    """The owned facets tagged ``tag`` of the P1 vector space V, oriented outwards
+    (``facet_tags``: dolfinx's mesh tags, whose class differs between its versions)."""
     mesh = V.mesh
     tdim = mesh.topology.dim
     fdim = tdim - 1
@@ -129,7 +136,7 @@ def side_of(V, facet_tags, tag: int) -> Side:
     local[flip, :2] = local[flip, 1::-1]
     imap = V.dofmap.index_map
 
-    def glob(a):
+    def glob(a: np.ndarray) -> np.ndarray:
         out = imap.local_to_global(a.ravel().astype(np.int32))
         return np.asarray(out, dtype=np.int64).reshape(a.shape)
 
@@ -153,7 +160,7 @@ def _boxes_meet(lo: np.ndarray, hi: np.ndarray, box: np.ndarray) -> np.ndarray:
     return np.all((hi >= box[0]) & (lo <= box[1]), axis=1)
 
 
-def gather_near(comm, master: Facets, region: Facets, radius: float) -> Facets:
+def gather_near(comm: MPI.Comm, master: Facets, region: Facets, radius: float) -> Facets:
     """The master facets of every rank that meet this rank's ``region`` (its bounding box
     enlarged by ``radius``), in rank order. Collective."""
     gdim = master.x.shape[2]
@@ -196,14 +203,14 @@ def facet_order(X: np.ndarray) -> np.ndarray:
     return rank
 
 
-def owners(imap, comm) -> np.ndarray:
+def owners(imap: Any, comm: MPI.Comm) -> np.ndarray:
     """The first global index of every rank's owned range (and the total), for
     ``np.searchsorted(ranges, i, side='right') - 1`` = the owner of global index i."""
     start = imap.local_range[0]
     return np.array(comm.allgather(start) + [imap.size_global], dtype=np.int64)
 
 
-def global_max(comm, value: float) -> float:
+def global_max(comm: MPI.Comm, value: float) -> float:
     return comm.allreduce(value, op=MPI.MAX)
 
 
@@ -214,7 +221,7 @@ class ContactPair:
     owned Dirichlet dofs (``fixed``: bool (n_owned * bs,), local unrolled dof indices, or
     None), and the search's counters (number of searches, wall time)."""
 
-    layout: object
+    layout: NodeLayout
     slave: Side
     master: Side
     E: float
@@ -229,9 +236,11 @@ class ContactPair:
     #: Coulomb friction coefficient (None: frictionless) and the last converged displacement
     #: (a Function: the history of the slip increments), set by the problem
     mu: float | None = None
-    previous: object = None
+    previous: dolfinx.fem.Function | None = None
 
-    def search(self, slave: Facets, master: Facets, pairs: bool = True):
+    def search(
+        self, slave: Facets, master: Facets, pairs: bool = True
+    ) -> tuple[Facets, tuple[np.ndarray, np.ndarray] | None]:
         """The master facets near this rank's slave facets (from every rank: those meeting the
         rank's slave box enlarged by the largest facet of either surface) and, with ``pairs``,
         the candidate pairs (slave facet, near master facet) whose boxes, each enlarged by its
@@ -243,8 +252,11 @@ class ContactPair:
         near = gather_near(comm, master, slave, self.radius)
         found = None
         if pairs:
-            tree = _compat.FacetTree(near.x, near.diameters())
-            found = tree.collide(_compat.FacetTree(slave.x, slave.diameters()))
+            # FacetTree takes a padding per facet too (its docstring; the annotation says float)
+            tree = _compat.FacetTree(near.x, near.diameters())  # type: ignore[arg-type]
+            found = tree.collide(
+                _compat.FacetTree(slave.x, slave.diameters())  # type: ignore[arg-type]
+            )
         self.searches += 1
         self.search_time += time.perf_counter() - t0
         return near, found

@@ -25,14 +25,18 @@ every quadrature point, with Gauss points the history between nodes is its P1 in
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import ufl
 
 from contactfx.contact.laws import positive_part, tangential
 from contactfx.contact.method import MethodBase, Supports, TrialFriction
-from contactfx.contact.surface import Surface
+from contactfx.contact.surface import Expr, Form, Surface
 from contactfx.params import param, validate
+
+if TYPE_CHECKING:
+    from contactfx.contact.pair import ContactPair
+    from contactfx.contact.point_coupling import PointCoupling
 
 __all__ = ["Penalty"]
 
@@ -65,26 +69,27 @@ class Penalty(TrialFriction, MethodBase):
     def __post_init__(self) -> None:
         validate(self)
 
-    def kappa(self, s: Surface):
+    def kappa(self, s: Surface) -> Expr:
         return self.kappa0 * s.E / s.h_continuous
 
-    def pressure(self, s: Surface):
+    def pressure(self, s: Surface) -> Expr:
         s = self.law_surface(s)
         return self.kappa(s) * positive_part(-s.gap())
 
-    def _trial_t(self, s: Surface):
+    def _trial_t(self, s: Surface) -> Expr:
         """The trial tangential traction t_prev - kappa du_T."""
         s = self.law_surface(s)
         n = s.normal()
+        assert s.traction_prev is not None  # kept by the driver (traction_history)
         return tangential(s.traction_prev, n) - self.kappa(s) * s.slip_increment(n)
 
-    def residual(self, s: Surface):
+    def residual(self, s: Surface) -> Form:
         form = self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds
         if s.friction is not None:
             form -= ufl.dot(self.tangential_traction(s), s.v) * s.ds
         return form
 
-    def coupling(self, pair):
+    def coupling(self, pair: ContactPair) -> PointCoupling:
         """Between two bodies: p = kappa [-g]_+ at the slave facets' Gauss points."""
         from contactfx.contact.point_coupling import Law, PointCoupling
 

@@ -34,6 +34,7 @@ shares) are not in contact.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, TypeAlias
 
 import numpy as np
 from petsc4py import PETSc
@@ -43,7 +44,17 @@ from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
 from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
 from contactfx.mechanics.elasticity import basis_tractions
 
+if TYPE_CHECKING:
+    from contactfx.contact.pair import ContactPair
+
 __all__ = ["PointCoupling", "Law"]
+
+#: the arrays of one direction's Gauss points (:meth:`PointCoupling._points`), by name
+_Points: TypeAlias = dict[str, np.ndarray]
+#: per direction at the last residual: P, g, and with friction t_T, the stick mask, the slip
+_State: TypeAlias = tuple[
+    np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None
+]
 
 
 @dataclass(frozen=True)
@@ -95,16 +106,24 @@ class _Directed:
 class PointCoupling:
     """Penalty / Nitsche terms of a contact pair at Gauss points (module docstring)."""
 
-    def __init__(self, pair, law: Law, unbiased: bool = False) -> None:
+    # set by the search (update) and by the residual
+    points: list[_Points]
+    state: list[_State]
+    _local: PETSc.Vec
+    _xvec: PETSc.Vec
+
+    def __init__(self, pair: ContactPair, law: Law, unbiased: bool = False) -> None:
         self.pair, self.law = pair, law
         self.layout: NodeLayout = pair.layout
         self.comm = self.layout.comm
         self.search_each_newton = pair.search_each_newton
+        assert pair.slave_lame is not None  # set by the problem, as master_lame
         dirs = [_Directed(pair.slave, pair.master, 0.5 if unbiased else 1.0, pair.slave_lame)]
         if unbiased:
+            assert pair.master_lame is not None
             dirs.append(_Directed(pair.master, pair.slave, 0.5, pair.master_lame))
         self.dirs = dirs
-        self.scatter = None
+        self.scatter: PETSc.Scatter | None = None
         #: Coulomb coefficient (None: frictionless) and the last converged state (history)
         self.mu = pair.mu
         self.previous = pair.previous
@@ -119,7 +138,10 @@ class PointCoupling:
         self._scatter_setup(needed)
         self.points = points
         u_upd = self._gather_u(u)
-        u_prev = None if self.mu is None else self._gather_u(self.previous.x.array)
+        u_prev = None
+        if self.mu is not None:
+            assert self.previous is not None  # set with mu
+            u_prev = self._gather_u(self.previous.x.array)
         for p in points:
             p["idx"] = np.searchsorted(needed, p["rows"])
             # reference positions of the involved dofs: current at the search minus u then
@@ -140,7 +162,7 @@ class PointCoupling:
             new += int(np.sum(now & ~old["paired"]))
         return self.comm.allreduce(new, op=MPI.SUM)
 
-    def _points(self, dr: _Directed, ub: np.ndarray) -> dict:
+    def _points(self, dr: _Directed, ub: np.ndarray) -> _Points:
         lay, pair = self.layout, self.pair
         gdim, bs = lay.gdim, lay.bs
         slave, master = dr.slave.current(ub), dr.master.current(ub)
@@ -197,7 +219,7 @@ class PointCoupling:
         x_master = near.x[k] if len(near) else np.zeros((len(xq), d, gdim))
         x_search = np.concatenate([x_cell, x_master], axis=1).reshape(len(xq), (d + 1 + d) * gdim)
         scale = self.law.stiffness * E / dr.h[facet]
-        extra = {}
+        extra: _Points = {}
         if self.mu is not None:
             P_T = np.eye(gdim)[None] - n[:, :, None] * n[:, None, :]
             Nfull = np.concatenate([N, -Nm], axis=1)  # (P, nodes)
@@ -227,7 +249,7 @@ class PointCoupling:
             slave_nodes=dr.slave.nodes[facet],
         )
 
-    def _project(self, xq: np.ndarray, near: Facets):
+    def _project(self, xq: np.ndarray, near: Facets) -> Pick:
         """The master facet of each point (index -1: not in contact)."""
         from contactfx import _compat
 
@@ -242,7 +264,8 @@ class PointCoupling:
                 np.full(n, np.nan),
                 np.full(n, np.nan),
             )
-        tree = _compat.FacetTree(near.x, near.diameters())
+        # FacetTree takes a padding per facet too (its docstring; the annotation says float)
+        tree = _compat.FacetTree(near.x, near.diameters())  # type: ignore[arg-type]
         rows, facets = tree.collide_points(xq)
         counts = np.bincount(rows, minlength=len(xq))
         width = max(int(counts.max(initial=0)), 1)
@@ -281,6 +304,7 @@ class PointCoupling:
         idx.destroy()
 
     def _gather(self, x: PETSc.Vec) -> np.ndarray:
+        assert self.scatter is not None  # made by the search (update)
         self.scatter.scatter(
             x, self._local, addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD
         )
@@ -292,7 +316,9 @@ class PointCoupling:
         return self._gather(self._xvec)
 
     # -- residual and Jacobian ------------------------------------------------------------
-    def _law(self, p: dict, vals: np.ndarray):
+    def _law(
+        self, p: _Points, vals: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
         """(P, dP/du coefficient vector, the stress term's value) at the points of p."""
         u = vals[p["idx"]]
         x = p["X"] + u
@@ -309,9 +335,12 @@ class PointCoupling:
         dP = (arg > -p["tie"])[:, None] * (p["scale"][:, None] * p["Jn"] - p["S"])
         return P, dP, g, sn
 
-    def _friction(self, p: dict, vals: np.ndarray, P: np.ndarray, dP: np.ndarray):
+    def _friction(
+        self, p: _Points, vals: np.ndarray, P: np.ndarray, dP: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Coulomb (Nitsche): t = proj_{B(0, mu P)}(sigma_T(u) - gamma P_T [u - u_prev]) and
         its derivative (P, gdim, ndofs); the stick mask."""
+        assert self.mu is not None
         u = vals[p["idx"]]
         gamma = p["scale"]
         Z = p["ST"] - gamma[:, None, None] * np.einsum("pig,pgh->pih", p["Jvec"], p["P_T"])
@@ -391,7 +420,7 @@ class PointCoupling:
         return np.concatenate(out) if out else np.zeros(0)
 
     # -- what the post-processing reads ----------------------------------------------------
-    def _lumped(self, columns: list[np.ndarray]):
+    def _lumped(self, columns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Owned contact nodes (those whose support has a master on more than half of it) and
         the N-weighted nodal means of the first direction's point values ``columns``."""
         p = self.points[0]
@@ -411,7 +440,7 @@ class PointCoupling:
         on = (sums[:, 0] > 0.0) & (sums[:, 1] > 0.5 * sums[:, 0])
         return on, sums[on]
 
-    def nodal(self):
+    def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
         quadrature values lumped to the nodes of the first direction's slave surface."""
         P, g = self.state[0][:2]
@@ -419,10 +448,11 @@ class PointCoupling:
         D = sums[:, 0]
         return np.flatnonzero(on) + self.layout.start, D, sums[:, 2] / D, sums[:, 3] / sums[:, 1]
 
-    def nodal_friction(self):
+    def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per node of :meth:`nodal`: |t_T|, |slip increment of the step| and the stick
         indicator (the fraction of the node's support in stick), lumped like the pressure."""
         P, _, t, stick, slip = self.state[0]
+        assert t is not None and stick is not None and slip is not None  # with friction
         closed_stick = (stick & (P > 0.0)).astype(float)
         _, sums = self._lumped(
             [np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1), closed_stick]
@@ -444,12 +474,13 @@ class PointCoupling:
             total += (1.0 if k == 0 else -1.0) * np.sum(p["w"][:, None] * traction, axis=0)
         return self.comm.allreduce(total, op=MPI.SUM)
 
-    def friction_state(self) -> dict:
+    def friction_state(self) -> dict[str, float]:
         """Sums over this rank's points of the first direction (weights without the unbiased
         halving): the contact measure (P > 0), the stick measure, the friction bound mu P and
         the excess of |t_T| over it, and the sum of |t_T|."""
         p, s = self.points[0], self.state[0]
         P, t, stick = s[0], s[2], s[3]
+        assert self.mu is not None and t is not None and stick is not None  # with friction
         w = p["w"] / self.dirs[0].weight
         closed = P > 0.0
         bound = self.mu * P

@@ -128,7 +128,9 @@ class Pick(NamedTuple):
     chosen facet; closest: (n, d) closest point of it; gap: (n,) signed distance (p - x) . n
     along its unit normal; distance: (n,) |p - closest|. Rows with index -1 hold NaN."""
 
-    index: np.ndarray
+    # the field shadows tuple.index, which typeshed's tuple declares as a method (a field
+    # name the checker rejects for a NamedTuple; renaming it would change the public API)
+    index: np.ndarray  # type: ignore[assignment]
     inside: np.ndarray
     bary: np.ndarray
     closest: np.ndarray
@@ -392,12 +394,12 @@ def pick_closest(
     corner of the master surface, equally far from the facets that share the corner). Rows
     without any candidate are always -1. gap is signed along :func:`facet_normal` of the chosen
     facet."""
-    p, facets = np.asarray(points, float), np.asarray(facets, float)
-    cand = _candidates(candidates, p.shape[0], facets.shape[0])
+    p, f = np.asarray(points, float), np.asarray(facets, float)
+    cand = _candidates(candidates, p.shape[0], f.shape[0])
     key = None if key is None else np.asarray(key, dtype=np.int64)
-    pick = _pick(p, cand, lambda q, j: closest_point_facets(q, facets[j], tol), fallback, key)
+    pick = _pick(p, cand, lambda q, j: closest_point_facets(q, f[j], tol), fallback, key)
     r = np.nonzero(pick.index >= 0)[0]
-    pick.gap[r] = _dot(p[r] - pick.closest[r], facet_normal(facets[pick.index[r]]))
+    pick.gap[r] = _dot(p[r] - pick.closest[r], facet_normal(f[pick.index[r]]))
     return pick
 
 
@@ -413,17 +415,17 @@ def closest_point_segments_many(
     ((n, d)), among ``candidates`` ((n, k) int, -1 padded) or all of them: the choice of
     :func:`pick_closest`. xi of the chosen segment is ``bary[:, 1]``; gap is signed along
     :func:`segment_normal` in 2D and NaN in 3D (a segment in space has no normal)."""
-    p, a, b = (np.asarray(x, float) for x in (points, a, b))
-    cand = _candidates(candidates, p.shape[0], a.shape[0])
+    p, a0, b0 = (np.asarray(x, float) for x in (points, a, b))
+    cand = _candidates(candidates, p.shape[0], a0.shape[0])
 
     def project(q: np.ndarray, j: np.ndarray) -> FacetProjection:
-        r = closest_point_segments(q, a[j], b[j], tol)
+        r = closest_point_segments(q, a0[j], b0[j], tol)
         return FacetProjection(np.stack([1 - r.xi, r.xi], axis=-1), r.inside, r.closest, r.distance)
 
     pick = _pick(p, cand, project, fallback)
     if p.shape[-1] == 2:
         r = np.nonzero(pick.index >= 0)[0]
-        normal = segment_normal(a[pick.index[r]], b[pick.index[r]])
+        normal = segment_normal(a0[pick.index[r]], b0[pick.index[r]])
         pick.gap[r] = _dot(p[r] - pick.closest[r], normal)
     return pick
 
@@ -622,7 +624,9 @@ def _bary2(p: np.ndarray, tri: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - s - t, s, t], axis=-1)
 
 
-def _clip_halfplanes(poly: np.ndarray, count: np.ndarray, clip: np.ndarray):
+def _clip_halfplanes(
+    poly: np.ndarray, count: np.ndarray, clip: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Sutherland-Hodgman on n convex polygons at once: poly (n, k, 2) padded, count (n,) the
     vertex numbers, clipped by the n counter-clockwise triangles clip (n, 3, 2). Returns the
     clipped (n, k', 2) and the counts (0 for an empty result). A vertex is kept by the exact

@@ -5,6 +5,11 @@ here."""
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from contactfx.contact.method import MethodBase, Supports
 
 __all__ = ["METHODS", "method_class", "methods_supporting"]
 
@@ -20,7 +25,7 @@ METHODS: dict[str, str] = {
 }
 
 
-def method_class(name: str) -> type:
+def method_class(name: str) -> type[MethodBase]:
     """The class registered as ``name``."""
     try:
         module, cls = METHODS[name].split(":")
@@ -29,6 +34,6 @@ def method_class(name: str) -> type:
     return getattr(importlib.import_module(module), cls)
 
 
-def methods_supporting(predicate) -> list[str]:
+def methods_supporting(predicate: Callable[[Supports], bool]) -> list[str]:
     """Names of the methods whose ``supports`` satisfies ``predicate``."""
     return [name for name in METHODS if predicate(method_class(name).supports)]

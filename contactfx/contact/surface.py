@@ -12,16 +12,21 @@ against an obstacle, the oriented jump across an interface).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, TypeAlias, runtime_checkable
 
 import ufl
 
-from contactfx.contact.laws import Friction, tangential
+from contactfx.contact.laws import Expr, Friction, tangential
 
-__all__ = ["Expr", "Surface", "SurfaceData"]
+if TYPE_CHECKING:
+    from typing import Self
 
-#: a UFL expression (a Function, a component of a mixed one, a test function, a Constant)
-Expr = ufl.core.expr.Expr
+__all__ = ["Expr", "Form", "Surface", "SurfaceData"]
+
+# Expr (from laws, re-exported here): a UFL expression (a Function, a component of a mixed
+# one, a test function, a Constant)
+#: a UFL form (an integrand times a measure): what a method's residual is
+Form: TypeAlias = ufl.Form
 
 
 @runtime_checkable
@@ -35,29 +40,61 @@ class Surface(Protocol):
     friction: the friction law or None; multiplier / multiplier_test: a method's multiplier
     (None without one)."""
 
-    u: Any
-    v: Any
-    ds: ufl.Measure
-    ds_nodal: ufl.Measure | None
-    E: float
-    h: Any
-    friction: Friction | None
-    multiplier: Any
-    multiplier_test: Any
+    # read-only members: a surface has them as (frozen) dataclass fields or as properties
+    @property
+    def u(self) -> Expr: ...
 
-    def gap(self, w=None) -> Any: ...
+    @property
+    def v(self) -> Expr: ...
 
-    def normal(self, w=None) -> Any: ...
+    @property
+    def ds(self) -> ufl.Measure: ...
 
-    def traction(self, n) -> Any: ...
+    @property
+    def ds_nodal(self) -> ufl.Measure | None: ...
 
-    def traction_test(self, n) -> Any: ...
+    @property
+    def E(self) -> float: ...
 
-    def traction_n(self, n, test: bool = False) -> Any: ...
+    @property
+    def h(self) -> Expr: ...
 
-    def traction_t(self, n, test: bool = False) -> Any: ...
+    @property
+    def friction(self) -> Friction | None: ...
 
-    def slip_increment(self, n) -> Any: ...
+    @property
+    def multiplier(self) -> Expr | None: ...
+
+    @property
+    def multiplier_test(self) -> Expr | None: ...
+
+    # the members of SurfaceData some methods read (see there)
+    @property
+    def traction_prev(self) -> Expr | None: ...
+
+    @property
+    def stick(self) -> Expr | None: ...
+
+    @property
+    def h_continuous(self) -> Expr: ...
+
+    def gap(self, w: Expr | None = None) -> Expr: ...
+
+    def normal(self, w: Expr | None = None) -> Expr: ...
+
+    def traction(self, n: Expr) -> Expr: ...
+
+    def traction_test(self, n: Expr) -> Expr: ...
+
+    def traction_n(self, n: Expr, test: bool = False) -> Expr: ...
+
+    def traction_t(self, n: Expr, test: bool = False) -> Expr: ...
+
+    def slip_increment(self, n: Expr) -> Expr: ...
+
+    def collocated(self, law: Expr) -> Expr: ...
+
+    def tip_extended(self) -> Surface: ...
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -102,36 +139,51 @@ class SurfaceData:
     #: doi:10.1016/j.cma.2017.01.003); None: small strain, sigma n on the plane of n
     reference_normal: Expr | None = None
 
+    if TYPE_CHECKING:
+        # what every surface provides as a field or a property (declared for the checker
+        # only: a property here would shadow the subclasses' dataclass fields)
+        @property
+        def ds(self) -> ufl.Measure: ...
+
+        @property
+        def h(self) -> Expr: ...
+
+        @property
+        def stress(self) -> Expr: ...
+
+        @property
+        def stress_test(self) -> Expr: ...
+
     # the stress tensors of the state and of the test functions (``stress`` / ``stress_test``:
     # fields or properties of each surface, from its kind's material) are the surface's own
     # business; the methods read tractions
-    def traction(self, n):
+    def traction(self, n: Expr) -> Expr:
         """The traction of the state on a plane of unit normal n: small strain sigma(u) n;
         finite strain the first Piola traction P(F) N on the reference facet (n only the
         direction the methods project it on)."""
         return ufl.dot(self.stress, n if self.reference_normal is None else self.reference_normal)
 
-    def traction_test(self, n):
+    def traction_test(self, n: Expr) -> Expr:
         """The directional derivative of :meth:`traction` in the direction of the test
         functions (small strain: sigma(v) n, linear in v; finite strain dP[grad v] N)."""
         N = n if self.reference_normal is None else self.reference_normal
         return ufl.dot(self.stress_test, N)
 
-    def traction_n(self, n, test: bool = False):
+    def traction_n(self, n: Expr, test: bool = False) -> Expr:
         """Normal traction n . t (< 0 in compression), of the state or (``test``) of the test
         functions."""
         return ufl.dot(n, self.traction_test(n) if test else self.traction(n))
 
-    def traction_t(self, n, test: bool = False):
+    def traction_t(self, n: Expr, test: bool = False) -> Expr:
         """Tangential traction (I - n n) t, of the state or (``test``) of the test
         functions."""
         return tangential(self.traction_test(n) if test else self.traction(n), n)
 
     @property
-    def mesh(self):
+    def mesh(self) -> ufl.Mesh:
         return self.ds.ufl_domain()
 
-    def collocated(self, law):
+    def collocated(self, law: Expr) -> Expr:
         """A multiplier's equation at the nodes (vertex rule): ``law``, the multiplier minus
         its law's value, and at a crack tip the tie lambda(tip) = lambda(neighbour) instead.
         This merges the tip node's multiplier basis function into its neighbour's, so that
@@ -140,14 +192,15 @@ class SurfaceData:
         zero there instead, the traction would fall to zero across the tip element."""
         if self.multiplier_tie is None:
             return law
+        assert self.at_tips is not None  # set with multiplier_tie
         return (1.0 - self.at_tips) * law - self.multiplier_tie
 
     @property
-    def h_continuous(self):
+    def h_continuous(self) -> Expr:
         """``h_nodal`` where the driver built it, else the facet-wise h."""
         return self.h if self.h_nodal is None else self.h_nodal
 
-    def tip_extended(self):
+    def tip_extended(self) -> Self:
         """The surface whose motion and multiplier are continued over each crack tip's
         element from its other node (see :meth:`contactfx.contact.interface.InterfaceSurface.
         tip_extended`); without crack tips the surface itself."""

@@ -58,7 +58,9 @@ def branch(
     return F, grad
 
 
-def tip_split(X: np.ndarray, flags: np.ndarray, points: np.ndarray):
+def tip_split(
+    X: np.ndarray, flags: np.ndarray, points: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The tip nodes' share of a P1 field in the triangles X (cells, 3, 2) with tip-node flags
     (cells, 3), at ``points`` (cells, q, 2): with lambda_i the barycentric coordinates,
     L = sum_i flag_i lambda_i and P = sum_i flag_i lambda_i X_i at the points, and the cells'
@@ -106,17 +108,17 @@ def _collapsed(n: int) -> tuple[np.ndarray, np.ndarray]:
 def _side_polygons(tri: np.ndarray, phi: np.ndarray) -> list[tuple[float, np.ndarray]]:
     """The two sides (+1, -1) of a triangle cut by the zero line of the linear phi, as
     polygons (k, 2) of positive area."""
-    out = []
+    out: list[tuple[float, np.ndarray]] = []
     for s in (1.0, -1.0):
-        poly = []
+        vertices: list[np.ndarray] = []
         for i in range(3):
             j = (i + 1) % 3
             if s * phi[i] >= 0.0:
-                poly.append(tri[i])
+                vertices.append(tri[i])
             if phi[i] * phi[j] < 0.0:
                 t = phi[i] / (phi[i] - phi[j])
-                poly.append(tri[i] + t * (tri[j] - tri[i]))
-        poly = np.asarray(poly)
+                vertices.append(tri[i] + t * (tri[j] - tri[i]))
+        poly = np.asarray(vertices)
         if len(poly) >= 3:
             e = poly[1:] - poly[0]
             area = 0.5 * abs(np.sum(e[:-1, 0] * e[1:, 1] - e[:-1, 1] * e[1:, 0]))
@@ -152,7 +154,7 @@ def star_rule(
     tips: np.ndarray,
     slots: int,
     snap: float = 0.0,
-):
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A rule for the star cells X (cells, 3, 2) (module docstring): points (cells, slots, 2),
     weights (cells, slots) (zero in the unused slots), and each point's side: the side of the
     cell's zero line of phi (cells, 3) in a cut cell, ``cell_side`` (cells,) elsewhere; and
