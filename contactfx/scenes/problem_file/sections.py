@@ -14,6 +14,13 @@ import numpy as np
 
 from contactfx.contact.interface import BartonBandis
 from contactfx.mechanics.elasticity import Elastic
+from contactfx.mechanics.hyperelastic import (
+    MODELS,
+    Hyperelastic,
+    MooneyRivlin,
+    NeoHookean,
+    SaintVenantKirchhoff,
+)
 from contactfx.meshes import BUILDERS
 from contactfx.numerics import Numerics
 from contactfx.scenes.problem_file.expressions import parse_expression
@@ -37,7 +44,18 @@ __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read"]
 
 KEYS = {
     "mesh": ("file", "size", "builder", "parameters"),
-    "bodies": ("group", "E", "nu", "body_force", "amplitude"),
+    "bodies": (
+        "group",
+        "material",
+        "E",
+        "nu",
+        "mu",
+        "kappa",
+        "c10",
+        "c01",
+        "body_force",
+        "amplitude",
+    ),
     "boundary": (
         "group",
         "fix",
@@ -130,10 +148,7 @@ def read_bodies(r: Reader, data: dict) -> tuple[BodySpec, ...]:
         key = f"bodies.{i}"
         b = r.table(b, key, KEYS["bodies"])
         group = r.string(b, key, "group")
-        E = r.number(b, key, "E", positive=True)
-        nu = r.number(b, key, "nu")
-        if not -1.0 < nu < 0.5:
-            r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
+        material = _material(r, b, key)
         force, amplitude = None, ()
         if "body_force" in b:
             if not numbers(b["body_force"], minimum=1):
@@ -141,8 +156,52 @@ def read_bodies(r: Reader, data: dict) -> tuple[BodySpec, ...]:
             force, amplitude = np.asarray(b["body_force"], dtype=np.float64), r.amplitude(b, key)
         elif "amplitude" in b:
             r.fail(f"{key}.amplitude", "an amplitude scales a body_force: give one")
-        bodies.append(BodySpec(group, Elastic(E, nu), force, amplitude))
+        bodies.append(BodySpec(group, material, force, amplitude))
+    if len(bodies) > 1 and any(b.material.finite_strain for b in bodies):
+        r.fail(
+            "bodies",
+            "a finite-strain material is offered for one body against a rigid obstacle (give "
+            "the other bodies' groups to the same [[bodies]] table, or use linear materials)",
+        )
     return tuple(bodies)
+
+
+def _material(r: Reader, b: dict, key: str) -> Elastic | Hyperelastic:
+    """A body's material: ``material`` (linear, the default; neo-hookean, mooney-rivlin,
+    svk) with its parameters (linear and svk: E, nu; neo-hookean: E, nu or mu, kappa;
+    mooney-rivlin: c10, c01 (default 0), kappa)."""
+    model = r.string(b, key, "material", tuple(MODELS), default="linear")
+    allowed = MODELS[model]
+    for k in ("E", "nu", "mu", "kappa", "c10", "c01"):
+        if k in b and k not in allowed:
+            r.fail(
+                f"{key}.{k}",
+                f"not a parameter of material {model} (its parameters: {', '.join(allowed)})",
+            )
+    if model == "mooney-rivlin":
+        c10 = r.number(b, key, "c10")
+        c01 = r.number(b, key, "c01", 0.0)
+        for name, value in (("c10", c10), ("c01", c01)):
+            if value < 0.0:
+                r.fail(f"{key}.{name}", f"must be >= 0, got {value}")
+        if not c10 + c01 > 0.0:
+            r.fail(f"{key}.c10", "c10 + c01 (half the shear modulus) must be > 0")
+        return MooneyRivlin(c10, c01, r.number(b, key, "kappa", positive=True))
+    if model == "neo-hookean" and ("mu" in b or "kappa" in b):
+        for k in ("E", "nu"):
+            if k in b:
+                r.fail(f"{key}.{k}", "give E and nu, or mu and kappa, not both")
+        mu = r.number(b, key, "mu", positive=True)
+        return NeoHookean.from_mu_kappa(mu, r.number(b, key, "kappa", positive=True))
+    E = r.number(b, key, "E", positive=True)
+    nu = r.number(b, key, "nu")
+    if not -1.0 < nu < 0.5:
+        r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
+    if model == "neo-hookean":
+        return NeoHookean.from_E_nu(E, nu)
+    if model == "svk":
+        return SaintVenantKirchhoff.from_E_nu(E, nu)
+    return Elastic(E, nu)
 
 
 def _boundary(r: Reader, b: Any, key: str) -> BoundarySpec:

@@ -73,7 +73,8 @@ class BodySpec:
     amplitude."""
 
     group: str
-    material: Elastic
+    #: :class:`contactfx.mechanics.elasticity.Elastic` or a hyperelastic material
+    material: Any
     force: np.ndarray | None = None
     amplitude: Amplitude = ()
 
