@@ -3,13 +3,18 @@ conditions that confine a field to a surface, lumped nodal projections and globa
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import Any
+
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.contact.surface import Expr
 
 __all__ = [
     "vertex_rule",
@@ -26,9 +31,17 @@ __all__ = [
 ]
 
 
-def vertex_rule(fdim: int) -> dict:
+#: a predicate of points x (3, n): bool per point
+PointPredicate = Callable[[NDArray[np.float64]], NDArray[np.bool_]]
+#: (point, tolerance) pairs
+TolerancePoints = Sequence[tuple[NDArray[np.float64], float]]
+
+
+def vertex_rule(fdim: int) -> dict[str, Any]:
     """Quadrature at the facet's vertices (trapezoidal rule): nodal collocation of the
     multiplier equations, exact nodal complementarity."""
+    points: tuple[tuple[float, ...], ...]
+    weights: tuple[float, ...]
     if fdim == 0:
         points, weights = ((),), (1.0,)
     elif fdim == 1:
@@ -43,7 +56,9 @@ def vertex_rule(fdim: int) -> dict:
     }
 
 
-def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=None) -> np.ndarray:
+def surface_mask(
+    Q: Any, fdim: int, facets: NDArray[np.int32], excluded: PointPredicate | None = None
+) -> NDArray[np.bool_]:
     """Bool per local (owned + ghost) dof block of the collapsed space Q: on one of the facets
     on any rank, and not where ``excluded`` (a predicate of the points (3, n), e.g. on a crack
     tip or front) holds."""
@@ -60,11 +75,11 @@ def surface_mask(Q, fdim: int, facets: np.ndarray, excluded=None) -> np.ndarray:
     return on
 
 
-def near_points(points):
+def near_points(points: TolerancePoints) -> PointPredicate:
     """The predicate of points x (3, n): within the tolerance of one of the (point, tolerance)
     pairs."""
 
-    def at(x):
+    def at(x: NDArray[np.float64]) -> NDArray[np.bool_]:
         hit = np.zeros(x.shape[1], dtype=bool)
         for point, tol in points:
             hit |= np.linalg.norm(x[: len(point)].T - point, axis=1) < tol
@@ -73,13 +88,13 @@ def near_points(points):
     return at
 
 
-def at_points(Q, points) -> np.ndarray:
+def at_points(Q: Any, points: TolerancePoints) -> NDArray[np.int32]:
     """Local dof blocks of the collapsed space Q within the tolerance of one of the
     (point, tolerance) pairs."""
     return dolfinx.fem.locate_dofs_geometrical(Q, near_points(points))
 
 
-def at_nodes(Q, points: np.ndarray) -> np.ndarray:
+def at_nodes(Q: Any, points: NDArray[np.float64]) -> NDArray[np.bool_]:
     """Bool per local dof (block) of the collapsed space Q: at one of ``points`` (dof
     coordinates of another space on the same mesh; the same vertex gives the same coordinates
     to round-off)."""
@@ -91,7 +106,7 @@ def at_nodes(Q, points: np.ndarray) -> np.ndarray:
     return np.array([tuple(k) in keys for k in np.round(x / scale).astype(np.int64)], dtype=bool)
 
 
-def confine(Wsub, mask_of) -> list:
+def confine(Wsub: Any, mask_of: Callable[[Any], NDArray[np.bool_]]) -> list[Any]:
     """Dirichlet conditions that fix the sub-space ``Wsub`` to zero outside the dofs that
     ``mask_of(Q)`` marks (Q the collapsed sub-space): a field that lives on a surface only
     (a contact multiplier, an interface enrichment)."""
@@ -107,7 +122,7 @@ def confine(Wsub, mask_of) -> list:
     ]
 
 
-def assemble_array(form) -> np.ndarray:
+def assemble_array(form: Any) -> NDArray[np.float64]:
     """The assembled linear form's owned entries (ghost contributions accumulated)."""
     b = _compat.assemble_vector(_compat.create_vector(form), form)
     arr = b.getArray().copy()
@@ -120,7 +135,7 @@ class NodalProjection:
     where the mass is > 0, 0 elsewhere. With the vertex rule it gives f's exact nodal values;
     it serves interior-facet quantities, which cannot be interpolated cellwise."""
 
-    def __init__(self, measure, space, restrict=None) -> None:
+    def __init__(self, measure: ufl.Measure, space: Any, restrict: str | None = None) -> None:
         q = ufl.TestFunction(space)
         self.q = q if restrict is None else q(restrict)
         self.measure = measure
@@ -129,11 +144,11 @@ class NodalProjection:
         self.mass = assemble_array(dolfinx.fem.form(ufl.inner(ones, self.q) * measure))
         self.on = self.mass > 0.0
 
-    def form(self, expr):
+    def form(self, expr: Expr) -> Any:
         """The compiled right-hand side of ``expr`` (compile once, project every step)."""
         return dolfinx.fem.form(ufl.inner(expr, self.q) * self.measure)
 
-    def __call__(self, form, target) -> None:
+    def __call__(self, form: Any, target: dolfinx.fem.Function) -> None:
         b = assemble_array(form)
         vec = _compat.petsc_vec(target)
         arr = vec.getArray()
@@ -142,7 +157,9 @@ class NodalProjection:
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
 
-def nodal_contact(p: np.ndarray, gap: np.ndarray, on: np.ndarray, comm):
+def nodal_contact(
+    p: NDArray[np.float64], gap: NDArray[np.float64], on: NDArray[np.bool_], comm: MPI.Comm
+) -> tuple[float, NDArray[np.bool_], float, float]:
     """(peak pressure, closed, max penetration, max |g p|) from the nodal pressure and gap
     (local arrays of a P1 field) at the surface nodes ``on``; closed marks the local nodes
     where p > 1e-10 of the peak."""
@@ -154,12 +171,17 @@ def nodal_contact(p: np.ndarray, gap: np.ndarray, on: np.ndarray, comm):
     return peak, p > 1e-10 * max(peak, 1e-300), penetration, complementarity
 
 
-def global_sum(form, comm) -> float:
+def global_sum(form: Any, comm: MPI.Comm) -> float:
     """A compiled functional summed over the ranks."""
     return comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
 
 
-def zero_pattern(mesh, trial, test, measures) -> ufl.Form:
+def zero_pattern(
+    mesh: dolfinx.mesh.Mesh,
+    trial: Expr,
+    test: Expr,
+    measures: Sequence[tuple[ufl.Measure, Callable[[Expr], Expr]]],
+) -> ufl.Form:
     """A zero coupling of every component of ``trial`` with every component of ``test`` on
     each (measure, restriction) pair: gives the bulk matrix the sparsity of the contact terms,
     so that the contact Jacobian can be added to it."""

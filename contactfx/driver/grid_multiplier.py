@@ -28,14 +28,76 @@ beyond its own cells, which the forms' cell-local assembly cannot express.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
+
 import dolfinx
 import numpy as np
 import ufl
+from numpy.typing import NDArray
 from petsc4py import PETSc
 
 from contactfx import _compat
 
+if TYPE_CHECKING:
+    from contactfx.contact.cut import CoarseGrid, CutSurface
+    from contactfx.contact.surface import Expr
+
+    #: a law on a crack's surface (a UFL expression of the surface)
+    Law = Callable[[CutSurface], Expr]
+
 __all__ = ["GridMultiplier"]
+
+
+class _CrackView(Protocol):
+    """What the multiplier reads of an unfitted crack (``contactfx.driver.unfitted._Crack``)."""
+
+    @property
+    def ds(self) -> ufl.Measure: ...
+
+    @property
+    def cut_owned(self) -> NDArray[np.int32]: ...
+
+    @property
+    def psi_q(self) -> NDArray[np.float64]: ...
+
+    @property
+    def weight_q(self) -> NDArray[np.float64]: ...
+
+    @property
+    def grid(self) -> CoarseGrid: ...
+
+    def nodes(self, Q: Any) -> NDArray[np.bool_]: ...
+
+    def coordinate(self, x: Any) -> Any: ...
+
+
+class CrackedKind(Protocol):
+    """What the multiplier reads of its problem kind, a
+    :class:`contactfx.driver.unfitted.UnfittedProblem` (a protocol: that module imports this
+    one)."""
+
+    @property
+    def mesh(self) -> dolfinx.mesh.Mesh: ...
+
+    @property
+    def state(self) -> dolfinx.fem.Function: ...
+
+    @property
+    def trial(self) -> Expr: ...
+
+    @property
+    def mult_shape(self) -> tuple[int, ...]: ...
+
+    @property
+    def cracks(self) -> Sequence[_CrackView]: ...
+
+    @property
+    def surfaces(self) -> Sequence[CutSurface]: ...
+
+    def surface_space(self, shape: tuple[int, ...]) -> Any: ...
+
+    def newton_surface(self, s: CutSurface) -> CutSurface: ...
 
 
 class GridMultiplier:
@@ -44,7 +106,7 @@ class GridMultiplier:
 
     search_each_newton = False
 
-    def __init__(self, pb, law) -> None:
+    def __init__(self, pb: CrackedKind, law: Law) -> None:
         self.comm = pb.mesh.comm
         self.W = W = pb.state.function_space
         self.bs = pb.mult_shape[0] if pb.mult_shape else 1
@@ -62,7 +124,7 @@ class GridMultiplier:
         self.y = self.R.createVecLeft()
         self._grown = False
 
-    def weighted(self, law):
+    def weighted(self, law: Law) -> ufl.Form:
         """sum over the cracks of int q . law(s) ds, q the quadrature space's test function:
         the vector omega_q law_q at the Gauss points."""
         pb = self.pb
@@ -71,20 +133,21 @@ class GridMultiplier:
         ]
         return sum(terms[1:], terms[0])
 
-    def _global(self, local: np.ndarray) -> np.ndarray:
+    def _global(self, local: NDArray[np.int64]) -> NDArray[np.int64]:
         """Global indices of local (owned or ghost) dofs of the mixed space."""
         bs = self.W.dofmap.index_map_bs
         blocks = self.W.dofmap.index_map.local_to_global(np.asarray(local // bs, np.int32))
         return np.asarray(blocks, dtype=np.int64) * bs + local % bs
 
-    def _projection(self):
+    def _projection(self) -> tuple[PETSc.Mat, NDArray[np.int32]]:
         """(R, the owned local rows of the multiplier's dofs on the cracks)."""
         comm, W, bs, Qq = self.comm, self.W, self.bs, self.Qq
         q_map = Qq.dofmap.index_map
         q_cells = _compat.cell_dofs(Qq)
         W1 = W.sub(1)
         subs = [W1.sub(c) for c in range(bs)] if self.pb.mult_shape else [W1]
-        entries: dict[int, list] = {}  # owned local row: [(columns, values), ...]
+        # owned local row: [(columns, values), ...]
+        entries: dict[int, list[tuple[NDArray[np.int64], NDArray[np.float64]]]] = {}
         for crack in self.pb.cracks:
             cells = crack.cut_owned
             parts = comm.allgather(
@@ -118,7 +181,9 @@ class GridMultiplier:
                                 (q_of[k] * bs + c, a / den[j] * n_q[k])
                             )
         rows = np.array(sorted(entries), dtype=np.int32)
-        indptr, indices, values = [0], [], []
+        indptr = [0]
+        indices: list[np.ndarray] = []
+        values: list[np.ndarray] = []
         for row in range(self.n_owned):
             if row in entries:
                 cols = np.concatenate([e[0] for e in entries[row]])
@@ -143,10 +208,10 @@ class GridMultiplier:
         return R, rows
 
     # -- the Coupling protocol ---------------------------------------------------------------
-    def update(self, u) -> None:
+    def update(self, u: NDArray[np.float64]) -> None:
         """No search: the cracks' points are fixed."""
 
-    def missed(self, u) -> int:
+    def missed(self, u: NDArray[np.float64]) -> int:
         return 0
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
@@ -180,7 +245,7 @@ class GridMultiplier:
         diagonal.destroy()
         RG.destroy()
 
-    def project(self, law) -> np.ndarray:
+    def project(self, law: Law) -> NDArray[np.float64]:
         """The nodal values R b(law) on the owned multiplier rows (a start: ``law`` evaluated
         at the current state)."""
         L = dolfinx.fem.form(self.weighted(law))

@@ -18,14 +18,18 @@ u - a on the -side's (each face's displacement) and the enrichment a (``enrichme
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
+from typing import Any
 
 import dolfinx
 import numpy as np
 import ufl
+from numpy.typing import NDArray
 
 from contactfx import _compat
-from contactfx.contact.interface import InterfaceSurface, oriented_jump
+from contactfx.contact.interface import BartonBandis, InterfaceSurface, oriented_jump
 from contactfx.contact.laws import positive_part, tangential
+from contactfx.contact.surface import Expr
 from contactfx.driver.fields import (
     NodalProjection,
     at_points,
@@ -34,7 +38,15 @@ from contactfx.driver.fields import (
     zero_pattern,
 )
 from contactfx.driver.interface_post import InterfacePost
-from contactfx.driver.problem import Problem, SurfaceSetup
+from contactfx.driver.problem import (
+    Filler,
+    Method,
+    Numerics,
+    Problem,
+    Scene,
+    Solver,
+    SurfaceSetup,
+)
 from contactfx.io.vtk import Split
 from contactfx.solvers.snes import owned_size
 
@@ -46,8 +58,23 @@ class InterfaceProblem(Problem):
 
     components_per_dim = 2
 
+    surface: InterfaceSurface
+    tol: float
+    tips: list[tuple[NDArray[np.float64], float]]
+    on_front: Callable[[NDArray[np.float64]], NDArray[np.bool_]]
+    H: dolfinx.fem.Function
+    w: Expr
+    dw: Expr
+    dS: ufl.Measure
+    dSc: ufl.Measure
+    dS_fine: ufl.Measure
+    dS_nodal: ufl.Measure
+    s_coord: Expr
+    fluid_value: float | None
+    fluid: dolfinx.fem.Constant | None
+
     @classmethod
-    def check(cls, scene, numerics, method) -> None:
+    def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
         if not method.supports.interfaces:
             from contactfx.contact.registry import methods_supporting
 
@@ -59,7 +86,14 @@ class InterfaceProblem(Problem):
         if numerics.formulation != "displacement":
             raise ValueError("fitted interfaces use --formulation displacement")
 
-    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        mesh: dolfinx.mesh.Mesh,
+        facet_tags: Any,
+    ) -> None:
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.interface_tag]
         self.tol = 1e-9 * scene.length_scale()  # of point location
         self.tips = [(np.asarray(t, dtype=float), self.tol) for t in scene.tips()]
@@ -76,19 +110,19 @@ class InterfaceProblem(Problem):
         self.H.interpolate(lambda x: np.where(scene.side(x) >= 0.0, 1.0, -1.0))
         super().__init__(scene, numerics, method, mesh, facet_tags)
 
-    def output_split(self):
+    def output_split(self) -> Split | None:
         """The ParaView body with the crack faces as separate nodes: ``displacement`` written
         as u + H a, each face's own displacement (Warp By Vector opens the crack)."""
         return Split(self.H, self.contact_facets)
 
-    def total(self, X):
+    def total(self, X: Expr) -> Expr:
         """w = u + H a from X = (u, a)."""
         d = self.gdim
         return ufl.as_vector([X[i] + self.H * X[d + i] for i in range(d)])
 
-    def boundary_conditions(self) -> list:
+    def boundary_conditions(self) -> list[Any]:
         V, d, fdim, tags = self.V, self.gdim, self.fdim, self.facet_tags
-        bcs = []
+        bcs: list[Any] = []
         enrichments = self.enrichments()
         for tag, comp in self.scene.supports():  # they hold for the total displacement
             facets = tags.indices[tags.values == tag]
@@ -105,12 +139,12 @@ class InterfaceProblem(Problem):
                 bcs += self.confine(V.sub(first + i), mask)
         return bcs + self.confine_multiplier()  # al-ssn: tied at the tips (_tip_terms)
 
-    def enrichments(self) -> list:
+    def enrichments(self) -> list[tuple[int, Callable[[Any], NDArray[np.bool_]]]]:
         """(first component, mask of the free dofs) of each enrichment field of the unknown:
         the one a, free on the interface."""
         return [(self.gdim, self.free_mask)]
 
-    def free_mask(self, Q) -> np.ndarray:
+    def free_mask(self, Q: Any) -> NDArray[np.bool_]:
         """On the interface and not on a tip or front."""
         return surface_mask(Q, self.fdim, self.contact_facets, self.on_front)
 
@@ -148,7 +182,7 @@ class InterfaceProblem(Problem):
         )
         return SurfaceSetup(surface, self.ds, self.v_load)
 
-    def _tip_terms(self) -> dict:
+    def _tip_terms(self) -> dict[str, Expr]:
         """What the methods need at the crack tips: ``tip_step``, the vector from each tip's
         node to its neighbour's (``InterfaceSurface.tip_extended``), for the methods continued
         over the tips' elements (``tip_continued``) and the multiplier methods; for the latter
@@ -185,10 +219,10 @@ class InterfaceProblem(Problem):
             values[at_points(V1, [(point, tol)])] = neighbour - point[: self.gdim]
         return step
 
-    def nodal_rule(self):
+    def nodal_rule(self) -> tuple[ufl.Measure, str | None]:
         return self.dS_nodal, "+"
 
-    def bulk_form(self):
+    def bulk_form(self) -> ufl.Form:
         a = ufl.inner(self.material.sigma(self.dw), ufl.sym(ufl.grad(self.v_load))) * ufl.dx
         # zero couplings that give the matrix the pattern of the interface terms (dofs of the
         # two cells of an interface facet; every component of a mixed unknown)
@@ -198,7 +232,7 @@ class InterfaceProblem(Problem):
             pattern.append((ufl.dx, lambda f: f))
         return a + zero_pattern(self.mesh, self.trial, self.test, pattern)
 
-    def extra_load(self, L):
+    def extra_load(self, L: ufl.Form) -> ufl.Form:
         if self.fluid is None:
             return L
         # the fluid pushes both faces apart
@@ -207,18 +241,20 @@ class InterfaceProblem(Problem):
 
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
-    def multiplier_mask(self) -> np.ndarray:
+    def multiplier_mask(self) -> NDArray[np.bool_]:
         """On the interface, the 2D tips included (al-uzawa's update gives a tip its
         neighbour's value: ``InterfaceSurface.tip_extended``), a 3D front not."""
+        assert self.multiplier is not None  # a method with a nodal multiplier
         return surface_mask(
             self.multiplier.function_space, self.fdim, self.contact_facets, self.multiplier_excluded
         )
 
     @functools.cached_property
     def _multiplier_projection(self) -> NodalProjection:
+        assert self.multiplier is not None
         return NodalProjection(self.dS_nodal, self.multiplier.function_space, "+")
 
-    def nodal_update(self, expr):
+    def nodal_update(self, expr: Expr) -> Filler:
         """The nodal values of an interior-facet quantity: a vertex-rule lumped projection."""
         proj = self._multiplier_projection
         form = proj.form(expr)
@@ -229,9 +265,10 @@ class InterfaceProblem(Problem):
         self.tload.value = t
         self.scene.set_load(t)
         if self.fluid is not None:
+            assert self.fluid_value is not None  # (fluid is made with it)
             self.fluid.value = t * self.fluid_value
 
-    def start(self, solver) -> None:
+    def start(self, solver: Solver) -> None:
         """Start from the interface held together under the first load step's loads: a linear
         solve with the jump fixed to zero (the bonded body) or, for a joint, held by its initial
         normal stiffness (tangentially bonded). Where the interface is then in compression the
@@ -256,7 +293,9 @@ class InterfaceProblem(Problem):
             self._start_multiplier()
         self._tolerances(solver)
 
-    def _spring(self, joint, s, jump, ds):
+    def _spring(
+        self, joint: BartonBandis, s: InterfaceSurface, jump: Expr, ds: ufl.Measure
+    ) -> ufl.Form:
         """The joint held by its initial normal stiffness K_ni and tangentially by E / h:
         the start's bilinear form on the surface s, for the trial function's jump."""
         n_I = s.interface_normal()
@@ -266,11 +305,11 @@ class InterfaceProblem(Problem):
             + k_t * ufl.dot(tangential(jump, n_I), s.v)
         ) * ds
 
-    def _trial_jumps(self) -> list:
+    def _trial_jumps(self) -> list[tuple[InterfaceSurface, Expr, ufl.Measure]]:
         """(surface, the trial function's jump on it, its measure) of every interface."""
         return [(self.surface, oriented_jump(self.dw, self.H), self.dSc)]
 
-    def _start_traction(self, s):
+    def _start_traction(self, s: InterfaceSurface) -> Expr:
         """The multipliers' start on the surface s: the traction (with friction) or the
         compressive normal stress of the start's state."""
         if self.mult_shape:
@@ -292,7 +331,7 @@ class InterfaceProblem(Problem):
         self.state.x.array[np.asarray(q_to_w)] = lam0.x.array
         self.state.x.scatter_forward()
 
-    def _tolerances(self, solver) -> None:
+    def _tolerances(self, solver: Solver) -> None:
         if not solver.user_sets("snes_atol"):
             # absolute tolerance a little above the round-off of the loads: the start (bonded,
             # or the load-step predictor) can already be the solution, e.g. of a uniformly

@@ -5,11 +5,13 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
 
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 
 from contactfx import _compat
 from contactfx.contact.interface import tangent
@@ -17,10 +19,66 @@ from contactfx.contact.laws import active
 from contactfx.driver.fields import NodalProjection, global_sum, nodal_contact
 from contactfx.results import InterfaceQuantities, Quantities
 
-__all__ = ["InterfacePost", "Profile", "STATUS", "plot_front", "plot_profile", "pyplot"]
+if TYPE_CHECKING:
+    from contactfx.contact.interface import InterfaceSurface
+    from contactfx.contact.laws import Friction
+    from contactfx.contact.surface import Expr
+    from contactfx.driver.problem import Method, Scene, Solver
+
+__all__ = [
+    "InterfaceKind",
+    "InterfacePost",
+    "Profile",
+    "STATUS",
+    "plot_front",
+    "plot_profile",
+    "pyplot",
+]
 
 #: interface status codes of the ``interface_status`` field
 STATUS = {"open": 0, "stick": 1, "slip": 2, "propped": 3}
+
+
+class InterfaceKind(Protocol):
+    """What the post-processing reads of its problem kind, a
+    :class:`contactfx.driver.interface.InterfaceProblem` (a protocol: that module imports
+    this one)."""
+
+    @property
+    def scene(self) -> Scene: ...
+
+    @property
+    def method(self) -> Method: ...
+
+    @property
+    def mesh(self) -> dolfinx.mesh.Mesh: ...
+
+    @property
+    def surface(self) -> InterfaceSurface: ...
+
+    @property
+    def material(self) -> Any: ...
+
+    @property
+    def friction(self) -> Friction | None: ...
+
+    @property
+    def gdim(self) -> int: ...
+
+    @property
+    def U(self) -> Expr: ...
+
+    @property
+    def ds(self) -> ufl.Measure: ...
+
+    @property
+    def dS_nodal(self) -> ufl.Measure: ...
+
+    @property
+    def dS_fine(self) -> ufl.Measure: ...
+
+    @property
+    def s_coord(self) -> Expr: ...
 
 
 @dataclasses.dataclass
@@ -55,7 +113,7 @@ class Profile:
 class InterfacePost:
     """Nodal interface fields, forces, errors against the closed forms, the profile."""
 
-    def __init__(self, pb) -> None:
+    def __init__(self, pb: InterfaceKind) -> None:
         self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
         mesh, s, method = pb.mesh, pb.surface, pb.method
         self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
@@ -87,13 +145,13 @@ class InterfacePost:
         dSf = pb.dS_fine
         self.force_form = dolfinx.fem.form(p * dSf)
         self.closed_form = dolfinx.fem.form(active(closed) * dSf)
-        self.tforce_form = None
+        self.tforce_form: Any = None
         extra = {}
         if s.friction is not None:
             self.tforce_form = dolfinx.fem.form(quantities["tangential_traction"] * dSf)
             # the slipping part of the interface (its length in 2D, area in 3D)
             extra["slipping_size"] = quantities["slipping"] * dSf
-        self.propped_form = None
+        self.propped_form: Any = None
         if s.floor is not None:
             self.propped_form = dolfinx.fem.form(p * active(s.floor) * dSf)
         self.err_forms = self._error_forms(s, p, t_I)
@@ -109,10 +167,10 @@ class InterfacePost:
         self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(d)]), V1)
         self.a_expr = _compat.expression(ufl.as_vector([U[d + i] for i in range(d)]), V1)
 
-    def _error_forms(self, s, p, t_I) -> dict[str, tuple]:
+    def _error_forms(self, s: InterfaceSurface, p: Expr, t_I: Expr) -> dict[str, tuple[Any, Any]]:
         """Errors against the closed forms (the pressure also away from the tips), integrated
         with a degree-12 rule."""
-        out = {}
+        out: dict[str, tuple[Any, Any]] = {}
         sc, dSf = self.pb.s_coord, self.pb.dS_fine
         exact_p, interior = self.scene.exact_pressure_interface(sc), self.scene.away_from_tips(sc)
         for name, computed, exact, weight in (
@@ -128,7 +186,7 @@ class InterfacePost:
                 )
         return out
 
-    def evaluate(self, solver) -> Quantities:
+    def evaluate(self, solver: Solver) -> Quantities:
         for name, f in self.fields_nodal.items():
             self.nodal(self.forms[name], f)
         on, n = self.nodal.on, len(self.nodal.on)
@@ -171,7 +229,7 @@ class InterfacePost:
             interface=interface,
         )
 
-    def fields(self) -> list:
+    def fields(self) -> list[dolfinx.fem.Function]:
         self.u_out.interpolate(self.u_expr)
         self.a_out.interpolate(self.a_expr)
         self.vm.interpolate(self.vm_expr)
@@ -188,7 +246,7 @@ class InterfacePost:
         xs = _compat.dof_coordinates(self.Q1)[:n][sel][:, :d]
         s = self.scene.coordinate(xs.T)
 
-        def col(name):
+        def col(name: str) -> NDArray[np.float64]:
             f = self.fields_nodal.get(name)
             return np.zeros(len(s)) if f is None else f.x.array[:n][sel]
 
@@ -214,7 +272,7 @@ class InterfacePost:
             a[:, 0], a[:, 1 : d + 1], f[:, 0] - self.w0, f[:, 1], f[:, 2], f[:, 3], f[:, 4], f[:, 5]
         )
 
-    def finish(self, q: Quantities, out: Path | None) -> dict:
+    def finish(self, q: Quantities, out: Path | None) -> dict[str, Any]:
         """Closed-form comparisons from the gathered profile, field errors, the CSV and the
         line plot."""
         prof = self.profile()
@@ -250,7 +308,7 @@ class InterfacePost:
         }
 
 
-def pyplot():
+def pyplot() -> Any:
     """matplotlib.pyplot on the Agg backend (files only, no display)."""
     import matplotlib
 
@@ -260,7 +318,7 @@ def pyplot():
     return plt
 
 
-def plot_profile(prof: Profile, scene, path: Path) -> None:
+def plot_profile(prof: Profile, scene: Scene, path: Path) -> None:
     """Line plots along the interface: aperture and slip (with the closed forms where the
     scene has them), normal and tangential traction, status."""
     plt = pyplot()
@@ -294,7 +352,7 @@ def plot_profile(prof: Profile, scene, path: Path) -> None:
     plt.close(fig)
 
 
-def plot_front(front: dict[str, np.ndarray], scene, path: Path) -> None:
+def plot_front(front: dict[str, np.ndarray], scene: Scene, path: Path) -> None:
     """The stress intensities along a 3D crack front (every key K... of ``front`` with its
     K..._exact) against the front angle."""
     plt = pyplot()

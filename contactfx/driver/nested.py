@@ -18,7 +18,7 @@ coarse chain keeps its own friction history, advanced with the fine steps.
 from __future__ import annotations
 
 import time
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import dolfinx
 import numpy as np
@@ -27,6 +27,9 @@ from mpi4py import MPI
 from contactfx import _compat
 from contactfx.solvers.base import ConvergenceError, SolverWrapper, SolveStats, TimeLimitExceeded
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
+
+if TYPE_CHECKING:
+    from contactfx.driver.problem import Problem, Solver
 
 __all__ = ["NestedSolver", "Transfer", "transfer", "nested_levels", "MIN_DOFS"]
 
@@ -44,7 +47,9 @@ def nested_levels(requested: int, dofs: int, tdim: int) -> int:
     return levels
 
 
-def _leaves(f: dolfinx.fem.Function, split: bool) -> list[tuple[object, np.ndarray]]:
+def _leaves(
+    f: dolfinx.fem.Function, split: bool
+) -> list[tuple[dolfinx.fem.FunctionSpace, np.ndarray]]:
     """(collapsed space, indices into ``f.x.array``) per field of ``f`` (one for a plain
     space, one per sub-space of a mixed one)."""
     W = f.function_space
@@ -141,7 +146,9 @@ class NestedSolver(SolverWrapper):
     Functions carried from coarse to fine. The other members of the solver protocol are the
     fine solver's."""
 
-    def __init__(self, fine, problem, coarse, coarse_problem) -> None:
+    def __init__(
+        self, fine: Solver, problem: Problem, coarse: Solver, coarse_problem: Problem
+    ) -> None:
         super().__init__(fine)
         self.fine, self.problem = fine, problem
         self.coarse, self.coarse_problem = coarse, coarse_problem

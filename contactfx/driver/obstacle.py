@@ -11,16 +11,20 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from pathlib import Path
+from typing import Any
 
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 from petsc4py import PETSc
 
 from contactfx import _compat
 from contactfx.contact.gap import ContactSurface
 from contactfx.contact.laws import active, positive_part
+from contactfx.contact.surface import Expr
 from contactfx.driver.fields import (
     NodalProjection,
     global_sum,
@@ -29,7 +33,15 @@ from contactfx.driver.fields import (
     vertex_rule,
     zero_pattern,
 )
-from contactfx.driver.problem import Problem, SurfaceSetup
+from contactfx.driver.problem import (
+    Filler,
+    Method,
+    Numerics,
+    Problem,
+    Scene,
+    Solver,
+    SurfaceSetup,
+)
 from contactfx.results import Friction, Quantities
 
 __all__ = ["ObstacleProblem", "closed_form_errors"]
@@ -41,8 +53,15 @@ class ObstacleProblem(Problem):
     nested = True
     nonlinear_bulk = True
 
+    surface: ContactSurface
+    obstacle: Any
+    dsc: ufl.Measure
+    dsc_fine: ufl.Measure
+    offset: dolfinx.fem.Constant
+    offset_prev: dolfinx.fem.Constant | None
+
     @classmethod
-    def check(cls, scene, numerics, method) -> None:
+    def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
         if not method.supports.obstacles:
             raise ValueError(
                 f"method {method.name} is not offered against rigid obstacles ("
@@ -54,7 +73,14 @@ class ObstacleProblem(Problem):
                 f"formulation mixed-up needs lambda > 0 (0 < nu < 0.5), got nu = {material.nu}"
             )
 
-    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        mesh: dolfinx.mesh.Mesh,
+        facet_tags: Any,
+    ) -> None:
         if mesh.topology.dim == 1 and not method.supports.dim1:
             raise ValueError(
                 f"method {method.name} needs a 2D or 3D mesh ({method.supports.why_not['dim1']})"
@@ -63,12 +89,12 @@ class ObstacleProblem(Problem):
         self.obstacle = scene.obstacle()
         super().__init__(scene, numerics, method, mesh, facet_tags)
 
-    def material_of(self, mesh):
+    def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
         """The scene's material, with its modulus field for a heterogeneous body."""
         material, modulus = self.scene.material(), self.scene.modulus(mesh)
         return material if modulus is None else dataclasses.replace(material, modulus=modulus)
 
-    def boundary_conditions(self) -> list:
+    def boundary_conditions(self) -> list[Any]:
         supports = self.scene.dirichlet(self.V, self.facet_tags)
         return supports + self.confine_multiplier(supports=supports)
 
@@ -103,10 +129,10 @@ class ObstacleProblem(Problem):
         )
         return SurfaceSetup(surface, self.ds, self.v_load)
 
-    def nodal_rule(self):
+    def nodal_rule(self) -> tuple[ufl.Measure, str | None]:
         return self.ds(self.scene.contact_tag, metadata=vertex_rule(self.fdim)), None
 
-    def bulk_form(self):
+    def bulk_form(self) -> ufl.Form:
         eps_v = ufl.sym(ufl.grad(self.V_test))
         a = ufl.inner(self.material.sigma(self.dU, self.dp), eps_v) * ufl.dx
         if self.up:
@@ -114,7 +140,7 @@ class ObstacleProblem(Problem):
         pattern = self.tangent_pattern()
         return a if pattern is None else a + pattern
 
-    def internal_form(self):
+    def internal_form(self) -> ufl.Form:
         """int S(u, p) : grad v dx (+ the pressure's law, mixed u-p): the material's weak
         stress."""
         f = ufl.inner(self.material.weak_stress(self.U, self.p), ufl.grad(self.V_test)) * ufl.dx
@@ -122,7 +148,7 @@ class ObstacleProblem(Problem):
             f += self.material.pressure_law(self.U, self.p, self.q) * ufl.dx
         return f
 
-    def tangent_pattern(self):
+    def tangent_pattern(self) -> ufl.Form | None:
         """A multiplier field's couplings with every cell's dofs (zero)."""
         if not self.multiplier_field:
             return None
@@ -130,12 +156,14 @@ class ObstacleProblem(Problem):
 
     # -- what the methods use ----------------------------------------------------------------
     @functools.cached_property
-    def multiplier_mask(self) -> np.ndarray:
+    def multiplier_mask(self) -> NDArray[np.bool_]:
+        assert self.multiplier is not None  # a method with a nodal multiplier
         Q = self.multiplier.function_space
         return surface_mask(Q, self.fdim, self.contact_facets)
 
-    def nodal_update(self, expr):
+    def nodal_update(self, expr: Expr) -> Filler:
         """Interpolation of ``expr`` at the multiplier's nodes."""
+        assert self.multiplier is not None
         compiled = _compat.expression(expr, self.multiplier.function_space)
         return lambda target: target.interpolate(compiled)
 
@@ -145,7 +173,7 @@ class ObstacleProblem(Problem):
         self.scene.set_load(t)
         self.offset.value[:] = self.scene.obstacle_offset(t, self.gdim)
 
-    def start(self, solver) -> None:
+    def start(self, solver: Solver) -> None:
         u = self.state.sub(0) if self.split else self.state
         self.scene.initial_guess(u, 1.0 / self.num.steps)
 
@@ -158,7 +186,7 @@ class ObstacleProblem(Problem):
         return ObstaclePost(self)
 
 
-def closed_form_errors(scene, q: Quantities) -> dict[str, float]:
+def closed_form_errors(scene: Scene, q: Quantities) -> dict[str, float]:
     """The scene's closed forms at the computed force (``scene.reference``) with the relative
     errors of the computed force, contact size ``a`` and peak pressure ``p0``."""
     ref = scene.reference(q.force)
@@ -206,7 +234,10 @@ class ObstaclePost:
         p = method.pressure(s)
         if p is None:  # bound constraints: the pressure is the reaction
             Qk = _compat.function_space(mesh, "Lagrange", pb.num.degree)
-            self.reaction = (NodalProjection(pb.dsc, Qk), dolfinx.fem.Function(Qk))
+            self.reaction: tuple[NodalProjection, dolfinx.fem.Function] | None = (
+                NodalProjection(pb.dsc, Qk),
+                dolfinx.fem.Function(Qk),
+            )
             self.measure_form = dolfinx.fem.form(self.status * pb.dsc)
         else:
             self.reaction = None
@@ -218,7 +249,7 @@ class ObstaclePost:
         self.errors = _FieldErrors(pb, p, self.pressure)
         self.finite = None if not pb.material.finite_strain else _FiniteStrainPost(pb, self, p)
 
-    def evaluate(self, solver) -> Quantities:
+    def evaluate(self, solver: Solver) -> Quantities:
         on = self.nodal.on
         if self.reaction is None:
             force = global_sum(self.force_form, self.comm)
@@ -245,7 +276,7 @@ class ObstaclePost:
             friction=friction,
         )
 
-    def fields(self) -> list:
+    def fields(self) -> list[dolfinx.fem.Function]:
         pb = self.pb
         if pb.split:
             self.displacement.x.array[:] = pb.state.x.array[self.out_map]
@@ -257,7 +288,7 @@ class ObstaclePost:
             out += self.finite.fields()
         return out
 
-    def finish(self, q: Quantities, out) -> dict:
+    def finish(self, q: Quantities, out: Path | None) -> dict[str, Any]:
         """Closed-form comparisons, pointwise scores and field errors of the final state."""
         reference = closed_form_errors(self.scene, q)
         if q.friction is not None:
@@ -287,7 +318,7 @@ class _FiniteStrainPost:
     p da / dA with the area ratio da / dA = J |F^-T N| (Nanson's formula), beside the
     ``contact_pressure`` per unit reference area whose integral is the contact force."""
 
-    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p) -> None:
+    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p: Expr | None) -> None:
         mesh, mat, u = pb.mesh, pb.material, pb.surface.u
         DG0 = _compat.function_space(mesh, "DG", 0)
         T0 = _compat.function_space(mesh, "DG", 0, (9,))
@@ -320,9 +351,10 @@ class _FiniteStrainPost:
 class _FrictionPost:
     """Tangential traction and slip at the nodes, stick zone, forces, the friction excess."""
 
-    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p, closed) -> None:
+    def __init__(self, pb: ObstacleProblem, post: ObstaclePost, p: Expr, closed: Expr) -> None:
         self.pb, self.post, self.comm = pb, post, pb.mesh.comm
         s, method, mesh, gdim = pb.surface, pb.method, pb.mesh, pb.gdim
+        assert pb.friction is not None  # (only with friction)
         V1 = _compat.function_space(mesh, "Lagrange", 1, (gdim,))
         self.vector = NodalProjection(pb.dsc, V1)
         t_T = method.tangential_traction(s)
@@ -377,7 +409,7 @@ class _FrictionPost:
         arr[on] += inc[on]
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
-    def scores(self, x, p) -> dict[str, float]:
+    def scores(self, x: NDArray[np.float64], p: NDArray[np.float64]) -> dict[str, float]:
         on = self.post.nodal.on
         n, gdim = len(on), self.pb.gdim
         t = self.traction.x.array[: n * gdim].reshape(-1, gdim)[on]
@@ -393,13 +425,15 @@ class _FieldErrors:
     bound constraints and nodal quadrature), integrated with a degree-12 rule; L2 and H1
     errors of the displacement where the scene has an exact field."""
 
-    def __init__(self, pb: ObstacleProblem, p, nodal_pressure) -> None:
+    def __init__(
+        self, pb: ObstacleProblem, p: Expr | None, nodal_pressure: dolfinx.fem.Function
+    ) -> None:
         self.pb, self.comm = pb, pb.mesh.comm
         # the nodal pressure (bound constraints, nodal quadrature): piecewise linear
         self.p_h = p if p is not None and pb.num.quadrature == "gauss" else nodal_pressure
         x = ufl.SpatialCoordinate(pb.mesh)
         exact = pb.scene.exact_displacement(x)
-        self.forms = {}
+        self.forms: dict[str, tuple[Any, ...]] = {}
         if exact is not None:
             e = pb.surface.u - exact
             dxq = ufl.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
@@ -408,7 +442,7 @@ class _FieldErrors:
                     dolfinx.fem.form(ufl.inner(op(f), op(f)) * dxq) for f in (e, exact)
                 )
 
-    def evaluate(self, ref: dict) -> dict[str, float]:
+    def evaluate(self, ref: dict[str, float]) -> dict[str, float]:
         out: dict[str, float] = {}
         pb = self.pb
         consts = {k: dolfinx.fem.Constant(pb.mesh, float(v)) for k, v in ref.items()}

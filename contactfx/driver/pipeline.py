@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Iterator
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from mpi4py import MPI
 
@@ -26,16 +28,19 @@ from contactfx.results import RunSummary, StepLog
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
 from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 
+if TYPE_CHECKING:
+    from contactfx.driver.problem import Forms, Method, Numerics, Problem, Scene, Solver
+
 __all__ = ["run", "setup", "prepare_output"]
 
 
 def run(
-    scene,
-    numerics,
+    scene: Scene,
+    numerics: Numerics,
     *,
-    comm=MPI.COMM_WORLD,
-    out=None,
-    petsc_options=None,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    out: str | Path | None = None,
+    petsc_options: dict[str, Any] | None = None,
     verbose: bool = True,
     time_limit: float | None = None,
 ) -> RunSummary:
@@ -58,7 +63,7 @@ def run(
     return run_.execute()
 
 
-def setup(scene, numerics, comm=MPI.COMM_WORLD):
+def setup(scene: Scene, numerics: Numerics, comm: MPI.Comm = MPI.COMM_WORLD) -> Problem:
     """The problem that :func:`run` solves, built (mesh, unknowns, surface) and not solved:
     to look at its forms (e.g. the contact residual ``method.residual(problem.surface)``)."""
     method = _checked_method(scene, numerics)
@@ -66,7 +71,7 @@ def setup(scene, numerics, comm=MPI.COMM_WORLD):
     return scene.problem(scene, numerics, method, mesh, facet_tags)
 
 
-def _checked_method(scene, numerics):
+def _checked_method(scene: Scene, numerics: Numerics) -> Method:
     """The method of ``numerics``, checked against the scene's problem kind (before any
     collective); the scene reads the numerics' physical choices."""
     method = numerics.method_object()
@@ -99,7 +104,7 @@ def _checked_method(scene, numerics):
     return method
 
 
-def prepare_output(out: Path, comm) -> None:
+def prepare_output(out: Path, comm: MPI.Comm) -> None:
     """Create the output folder and remove a previous run.json; fail on every rank alike."""
     error = None
     if comm.rank == 0:
@@ -118,7 +123,15 @@ def prepare_output(out: Path, comm) -> None:
 
 class _Run:
     def __init__(
-        self, scene, numerics, method, comm, out, petsc_options, verbose, time_limit=None
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        comm: MPI.Comm,
+        out: Path | None,
+        petsc_options: dict[str, Any],
+        verbose: bool,
+        time_limit: float | None = None,
     ) -> None:
         self.scene, self.num, self.method, self.comm = scene, numerics, method, comm
         self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
@@ -129,7 +142,7 @@ class _Run:
         self.deadline: float | None = None
 
     @contextmanager
-    def timed(self, phase: str):
+    def timed(self, phase: str) -> Iterator[None]:
         t0 = time.perf_counter()
         yield
         self.timings[phase] = self.timings.get(phase, 0.0) + time.perf_counter() - t0
@@ -152,7 +165,7 @@ class _Run:
             solver.destroy()
         return self.record(problem, problem.mesh, steps, extra)
 
-    def build(self):
+    def build(self) -> tuple[Problem, Any, Solver]:
         """(problem, post-processor, solver): the stages up to the load program. With
         ``--nested N``, the solver is started at every step by the chain of N coarser meshes
         (built here; their mesh and compile times count in this run's)."""
@@ -162,7 +175,7 @@ class _Run:
         with self.timed("compile"):
             forms = problem.forms()
             post = problem.post_processor()
-        solver = self.build_solver(problem, forms)
+        solver: Solver = self.build_solver(problem, forms)
         try:
             with self.timed("initial_guess"):
                 problem.start(solver)
@@ -175,7 +188,7 @@ class _Run:
             raise
         return problem, post, solver
 
-    def nested(self, problem, solver, levels: int) -> NestedSolver:
+    def nested(self, problem: Problem, solver: Solver, levels: int) -> NestedSolver:
         """The fine solver wrapped by the coarse chain: the scene meshed twice as coarse,
         with one level of nesting less."""
         scene = self.scene.coarsened(2.0)
@@ -193,7 +206,7 @@ class _Run:
         return NestedSolver(solver, problem, c_solver, c_problem)
 
     # -- solver --------------------------------------------------------------------------
-    def build_solver(self, problem, forms) -> ContactSNES:
+    def build_solver(self, problem: Problem, forms: Forms) -> ContactSNES:
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
         options.update(self.method.snes_options())
         t0 = time.perf_counter()
@@ -218,7 +231,7 @@ class _Run:
         return solver
 
     # -- load program ----------------------------------------------------------------------
-    def load_program(self, problem, solver, post) -> list[StepLog]:
+    def load_program(self, problem: Problem, solver: Solver, post: Any) -> list[StepLog]:
         """Solve at the load factors of the program; at each converged step evaluate the
         contact quantities, write the fields and keep the step as the history of the next."""
         steps: list[StepLog] = []
@@ -274,7 +287,9 @@ class _Run:
         return None if self.out is None else str(self.out / f"{self.scene.name}{suffix}")
 
     # -- record --------------------------------------------------------------------------
-    def record(self, problem, mesh, steps: list[StepLog], extra: dict) -> RunSummary:
+    def record(
+        self, problem: Problem, mesh: Any, steps: list[StepLog], extra: dict[str, Any]
+    ) -> RunSummary:
         summary = RunSummary(
             scene=self.scene.name,
             parameters=dataclasses.asdict(self.scene.p),

@@ -16,22 +16,58 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from collections.abc import Callable
-from typing import Any, NamedTuple
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, NamedTuple, overload
 
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 
 from contactfx import _compat
-from contactfx.contact.laws import reversal
-from contactfx.contact.surface import Surface
-from contactfx.driver.fields import NodalProjection, at_nodes, confine, surface_mask, vertex_rule
+from contactfx.contact.laws import Friction, reversal
+from contactfx.contact.surface import Expr
+from contactfx.driver.fields import (
+    NodalProjection,
+    PointPredicate,
+    at_nodes,
+    confine,
+    surface_mask,
+    vertex_rule,
+)
 from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
+if TYPE_CHECKING:
+    from typing import TypeAlias, TypeVar
+
+    from contactfx.contact.gap import ContactSurface
+    from contactfx.contact.interface import InterfaceSurface
+    from contactfx.io.vtk import Split
+
+    #: the surface a kind's ``make_surface`` builds: a frozen dataclass that presents the
+    #: members of :class:`contactfx.contact.surface.Surface` (an unfitted crack's
+    #: :class:`contactfx.contact.cut.CutSurface` is an InterfaceSurface)
+    KindSurface: TypeAlias = ContactSurface | InterfaceSurface
+    _S = TypeVar("_S", bound=KindSurface)
+
 __all__ = ["Forms", "Problem", "SurfaceSetup"]
+
+#: what the driver knows of the objects it is handed (typed as Any): a scene
+#: (:class:`contactfx.scenes.base.Scene` and the kind's own scene base, whose hooks differ by
+#: kind), the numerics (:class:`contactfx.numerics.Numerics`, a dataclass made at import), a
+#: method (:class:`contactfx.contact.method.ContactMethod` with its optional members:
+#: ``traction_history``, ``tangential_traction``, ...), a solver (the
+#: :class:`contactfx.solvers.snes.ContactSNES` or the wrapper a method attached) and the
+#: dolfinx objects whose classes differ between dolfinx versions (compiled forms, meshtags,
+#: DirichletBCs)
+Scene = Any
+Numerics = Any
+Method = Any
+Solver = Any
+#: a filler: writes a law's values into its target Function (``nodal_update`` and friends)
+Filler = Callable[[dolfinx.fem.Function], None]
 
 
 class SurfaceSetup(NamedTuple):
@@ -40,9 +76,9 @@ class SurfaceSetup(NamedTuple):
     ``ds`` the boundary measure the scene's loads integrate over, ``v_load`` the test function
     they act on (the total displacement's on an interface)."""
 
-    surface: Surface | None
+    surface: KindSurface | None
     ds: ufl.Measure
-    v_load: Any
+    v_load: Expr
 
 
 class Forms(NamedTuple):
@@ -50,8 +86,8 @@ class Forms(NamedTuple):
     compiled contact residual and its Jacobian (None without contact terms in UFL)."""
 
     bulk: Callable[[], Bulk]
-    contact_residual: object = None
-    contact_jacobian: object = None
+    contact_residual: Any = None
+    contact_jacobian: Any = None
 
 
 class Problem:
@@ -67,11 +103,61 @@ class Problem:
     #: whether the kind writes its bulk for a material that is not linear (``internal_form``)
     nonlinear_bulk = False
 
+    scene: Scene
+    num: Numerics
+    method: Method
+    mesh: dolfinx.mesh.Mesh
+    facet_tags: Any
+    gdim: int
+    fdim: int
+    friction: Friction | None
+    #: a :class:`contactfx.mechanics.material.Material` (the kinds use the small-strain
+    #: material's ``sigma`` too)
+    material: Any
+    tload: dolfinx.fem.Constant
+    h: Expr
+    mult_shape: tuple[int, ...]
+    #: the facets of the contact surface (set by the kind before ``Problem.__init__``)
+    contact_facets: NDArray[np.int32]
+    confined: list[Any]
+    bcs: list[Any]
+    prev: dolfinx.fem.Function | None
+    t_prev: dolfinx.fem.Function | None
+    _history: Filler | None
+    multiplier: dolfinx.fem.Function | None
+    surface: KindSurface | None
+    ds: ufl.Measure
+    v_load: Expr
+    iterate: dolfinx.fem.Function | None
+    # the unknowns (``_spaces``)
+    multiplier_field: bool
+    up: bool
+    split: bool
+    V: Any
+    state: dolfinx.fem.Function
+    trial: Expr
+    test: Expr
+    U: Expr
+    dU: Expr
+    V_test: Expr
+    lam: Expr | None
+    lam_test: Expr | None
+    p: Expr | None
+    dp: Expr | None
+    q: Expr | None
+
     @classmethod
-    def check(cls, scene, numerics, method) -> None:
+    def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
         """Raise ValueError for a request this kind cannot solve (before any collective)."""
 
-    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        mesh: dolfinx.mesh.Mesh,
+        facet_tags: Any,
+    ) -> None:
         self.scene, self.num, self.method = scene, numerics, method
         self.mesh, self.facet_tags = mesh, facet_tags
         self.gdim = mesh.geometry.dim
@@ -111,17 +197,17 @@ class Problem:
         #: Newton's previous iterate (the friction law's reversal guard), or None
         self.iterate = None
 
-    def surface_space(self, shape: tuple[int, ...]):
+    def surface_space(self, shape: tuple[int, ...]) -> Any:
         """The space of a method's values on the contact surface (a nodal multiplier, a
         traction history): P1, the law collocated at the surface's nodes."""
         return _compat.function_space(self.mesh, "Lagrange", 1, shape or None)
 
-    def material_of(self, mesh):
+    def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
         """The material of the body (or bodies) on ``mesh``: the scene's."""
         return self.scene.material()
 
     # -- the hooks every kind provides (docs/architecture.md, "Adding a problem kind") -----
-    def boundary_conditions(self) -> list:
+    def boundary_conditions(self) -> list[Any]:
         """The DirichletBCs: the scene's supports, and ``confine_multiplier`` for a
         multiplier field (called before ``make_surface``; ``contact_facets`` is set)."""
         raise NotImplementedError(f"{type(self).__name__} has no boundary conditions")
@@ -134,12 +220,12 @@ class Problem:
         """Set the load program's constants for time (load factor) t."""
         raise NotImplementedError(f"{type(self).__name__} has no load program")
 
-    def start(self, solver) -> None:
+    def start(self, solver: Solver) -> None:
         """Set the state the first Newton solve starts from (``solver``: the kind's
         ContactSNES, for a linear start)."""
         raise NotImplementedError(f"{type(self).__name__} has no start")
 
-    def post_processor(self):
+    def post_processor(self) -> Any:
         """An object with ``evaluate(solver) -> Quantities``, ``fields()`` and
         ``finish(quantities, out) -> dict``."""
         raise NotImplementedError(f"{type(self).__name__} has no post-processing")
@@ -168,11 +254,11 @@ class Problem:
         return f"an element inverted (J {value}) at ({at}) in the reference mesh"
 
     @property
-    def multiplier_mask(self) -> np.ndarray:
+    def multiplier_mask(self) -> NDArray[np.bool_]:
         """A nodal multiplier's dofs on the contact surface (bool per local dof)."""
         raise NotImplementedError(f"{type(self).__name__} has no nodal multiplier")
 
-    def nodal_update(self, expr):
+    def nodal_update(self, expr: Expr) -> Filler:
         """The filler of a nodal multiplier with the values of ``expr`` at its nodes."""
         raise NotImplementedError(f"{type(self).__name__} has no nodal multiplier")
 
@@ -206,9 +292,9 @@ class Problem:
         self.p, self.dp, self.q = (extra, d_extra, extra_test) if self.up else (None,) * 3
 
     #: where a multiplier stays zero on the contact surface (a predicate of points, or None)
-    multiplier_excluded = None
+    multiplier_excluded: PointPredicate | None = None
 
-    def confine_multiplier(self, supports=()) -> list:
+    def confine_multiplier(self, supports: Sequence[Any] = ()) -> list[Any]:
         """A multiplier field is zero away from the contact surface, and a traction
         multiplier's component i is zero where the displacement's component i is held by one
         of the ``supports`` (a symmetry plane through the contact zone): there that component
@@ -219,33 +305,37 @@ class Problem:
             return []
         W1 = self.state.function_space.sub(1)
 
-        def on_surface(Q):
+        def on_surface(Q: Any) -> NDArray[np.bool_]:
             return surface_mask(Q, self.fdim, self.contact_facets, self.multiplier_excluded)
 
-        held = [np.asarray(_compat.bc_dofs(bc)) for bc in supports]
-        if not self.mult_shape or not held:
+        held_dofs = [np.asarray(_compat.bc_dofs(bc)) for bc in supports]
+        if not self.mult_shape or not held_dofs:
             return self.confine(W1, on_surface)
-        held = np.concatenate(held)
-        bcs = []
+        held = np.concatenate(held_dofs)
+        bcs: list[Any] = []
         for i in range(self.gdim):
             Vi, to_w = self.V.sub(i).collapse()
             points = _compat.dof_coordinates(Vi)[np.isin(np.asarray(to_w), held)]
-            bcs += self.confine(W1.sub(i), lambda Q, p=points: on_surface(Q) & ~at_nodes(Q, p))
+
+            def mask(Q: Any, p: NDArray[np.float64] = points) -> NDArray[np.bool_]:
+                return on_surface(Q) & ~at_nodes(Q, p)
+
+            bcs += self.confine(W1.sub(i), mask)
         return bcs
 
-    def confine(self, Wsub, mask_of) -> list:
+    def confine(self, Wsub: Any, mask_of: Callable[[Any], NDArray[np.bool_]]) -> list[Any]:
         """:func:`contactfx.driver.fields.confine`, the conditions recorded in ``confined``:
         the solver leaves their dofs out of its linear systems."""
         bcs = confine(Wsub, mask_of)
         self.confined += bcs
         return bcs
 
-    def previous(self):
+    def previous(self) -> Expr:
         """The displacement part of the last converged state (friction history)."""
         return ufl.split(self.prev)[0] if self.split else self.prev
 
     # -- measures --------------------------------------------------------------------------
-    def contact_rule(self) -> dict:
+    def contact_rule(self) -> dict[str, Any]:
         """Gauss (degree 2k + 2) or the vertex rule (``--quadrature nodal``: the contact law at
         the P1 nodes only, so that a curved obstacle does not over-constrain the piecewise
         linear surface when gamma0 / the penalty is large)."""
@@ -272,7 +362,7 @@ class Problem:
         J = ufl.derivative(F, self.state, self.trial)
         return Forms(bulk, dolfinx.fem.form(F), dolfinx.fem.form(J))
 
-    def bulk(self, load) -> Callable[[], Bulk]:
+    def bulk(self, load: Any) -> Callable[[], Bulk]:
         """The kind's bulk for the compiled load form ``load``, built (and assembled) when
         called: for a linear material a :class:`contactfx.solvers.bulk.LinearBulk` of
         :meth:`bulk_form` (bilinear, assembled once), else a
@@ -293,31 +383,38 @@ class Problem:
             load=load,
         )
 
-    def bulk_form(self):
+    def bulk_form(self) -> ufl.Form:
         """The bulk's bilinear form a(du, v) of a linear material (trial ``trial``)."""
         raise NotImplementedError(f"{type(self).__name__} has no bulk form")
 
-    def internal_form(self):
+    def internal_form(self) -> ufl.Form:
         """The bulk's internal virtual work f_int(u; v), linear in ``test``, of the state (a
         kind with ``nonlinear_bulk``)."""
         raise NotImplementedError(f"{type(self).__name__} has no nonlinear bulk")
 
-    def tangent_pattern(self):
+    def tangent_pattern(self) -> ufl.Form | None:
         """Zero terms (bilinear in ``trial``, ``test``) that give the bulk's tangent the
         sparsity of the contact terms, or None."""
         return None
 
-    def contact_residual(self):
+    def contact_residual(self) -> ufl.Form:
         """The method's contact residual on the kind's surface (Newton's: ``newton_surface``)."""
         return self.method.residual(self.newton_surface())
 
-    def newton_surface(self, s=None):
+    @overload
+    def newton_surface(self) -> KindSurface: ...
+
+    @overload
+    def newton_surface(self, s: _S) -> _S: ...
+
+    def newton_surface(self, s: KindSurface | None = None) -> KindSurface:
         """The surface of Newton's residual (``s``, by default the kind's): with friction, a
         point whose trial tangential traction reversed since Newton's previous iterate
         (``iterate``, kept by the solver) takes the stick branch
         (:func:`contactfx.contact.laws.reversal`); at a converged iterate this is the surface
         itself."""
         s = self.surface if s is None else s
+        assert s is not None  # a kind with a UFL surface
         trial = getattr(self.method, "trial_traction", None)
         if s.friction is None or trial is None:
             return s
@@ -327,27 +424,28 @@ class Problem:
         x_last = ufl.replace(x, {self.state: self.iterate})
         return dataclasses.replace(s, stick=reversal(x, x_last, bound))
 
-    def extra_load(self, L):
+    def extra_load(self, L: ufl.Form) -> ufl.Form:
         return L
 
-    def output_split(self):
+    def output_split(self) -> Split | None:
         """How the ParaView output splits the body's nodes (:class:`contactfx.io.vtk.Split`):
         None, one body with continuous fields."""
         return None
 
-    def coupling(self):
+    def coupling(self) -> Any:
         """The solver's two-body coupling (:mod:`contactfx.contact.coupling`), or None."""
         return None
 
-    def nodal_rule(self):
+    def nodal_rule(self) -> tuple[ufl.Measure, str | None]:
         """(the contact measure with the vertex rule, the restriction of its integrands or
         None): where the traction history and the nodal mesh size are evaluated."""
         raise NotImplementedError(f"{type(self).__name__} has no vertex rule on its surface")
 
-    def _nodal_size(self):
+    def _nodal_size(self) -> Expr:
         """The surface's mesh size at its P1 nodes (``SurfaceData.h_nodal``): the lumped
         projection of the facet-wise h with the vertex rule, the length-weighted mean of the
         sizes of a node's facets."""
+        assert self.surface is not None
         measure, restrict = self.nodal_rule()
         h = dolfinx.fem.Function(_compat.function_space(self.mesh, "Lagrange", 1), name="h")
         proj = NodalProjection(measure, h.function_space, restrict)
@@ -365,20 +463,21 @@ class Problem:
         if self.prev is not None:
             self.prev.x.array[:] = self.state.x.array
 
-    def surface_update(self, law):
+    def surface_update(self, law: Callable[[Any], Expr]) -> Filler:
         """The filler of a nodal multiplier with ``law(surface)`` (a UFL expression on the
         contact surface): its values at the surface's nodes."""
         return self.nodal_update(law(self.surface))
 
-    def history_update(self, law):
+    def history_update(self, law: Callable[[Any], Expr]) -> Filler:
         """The filler of the traction history with ``law(surface)`` at the surface's nodes:
         the vertex rule's lumped projection."""
+        assert self.t_prev is not None
         measure, restrict = self.nodal_rule()
         proj = NodalProjection(measure, self.t_prev.function_space, restrict)
         form = proj.form(law(self.surface))
         return lambda target: proj(form, target)
 
-    def nested_fields(self) -> list:
+    def nested_fields(self) -> list[dolfinx.fem.Function]:
         """The Functions nested iteration carries from a coarser mesh: the state and the
         nodal multiplier."""
         return [self.state] + ([self.multiplier] if self.multiplier is not None else [])
@@ -387,7 +486,7 @@ class Problem:
         """The unknowns the solver solves for: the state's dofs but the confined ones."""
         return self.dofs_less(self.confined)
 
-    def dofs_less(self, bcs) -> int:
+    def dofs_less(self, bcs: Sequence[Any]) -> int:
         """The state's dofs less those the DirichletBCs ``bcs`` fix (each once)."""
         W = self.state.function_space
         fixed = len(owned_bc_dofs(bcs, owned_size(W)))

@@ -13,27 +13,33 @@ against the scene's closed form, ``pressure.png``, when an output folder is give
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 
 from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
-from contactfx.contact.pair import ContactPair, side_of
+from contactfx.contact.laws import Coulomb
+from contactfx.contact.pair import ContactPair, Side, side_of
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
-from contactfx.driver.problem import Problem, SurfaceSetup
+from contactfx.driver.problem import Method, Numerics, Problem, Scene, Solver, SurfaceSetup
 from contactfx.mechanics.elasticity import lame
 from contactfx.results import Friction, Quantities
 
 __all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
 
 
-def _not_offered(method, capability: str, what: str, test) -> ValueError:
+def _not_offered(
+    method: Method, capability: str, what: str, test: Callable[[Any], bool]
+) -> ValueError:
     """The one-line refusal: the method, what it lacks, its reason (``why_not``) and the
     methods whose ``supports`` pass ``test``."""
     from contactfx.contact.registry import methods_supporting
@@ -47,8 +53,14 @@ def _not_offered(method, capability: str, what: str, test) -> ValueError:
 class TwoBodyProblem(Problem):
     """Bodies in contact through a pair of non-matching surfaces (see the module docstring)."""
 
+    #: no UFL surface: the contact is the solver's coupling of the pair
+    surface: None
+    layout: NodeLayout
+    pair: ContactPair
+    _coupling: Any
+
     @classmethod
-    def check(cls, scene, numerics, method) -> None:
+    def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
         if not method.supports.two_body:
             raise _not_offered(
                 method, "two_body", "is not offered between two meshed bodies", lambda c: c.two_body
@@ -72,14 +84,21 @@ class TwoBodyProblem(Problem):
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
 
-    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        mesh: dolfinx.mesh.Mesh,
+        facet_tags: Any,
+    ) -> None:
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.slave_tag]
         super().__init__(scene, numerics, method, mesh, facet_tags)
 
-    def material_of(self, mesh):
+    def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
         return self.scene.body_material(mesh)
 
-    def boundary_conditions(self) -> list:
+    def boundary_conditions(self) -> list[Any]:
         return self.scene.dirichlet(self.V, self.facet_tags)
 
     def make_surface(self) -> SurfaceSetup:
@@ -107,12 +126,13 @@ class TwoBodyProblem(Problem):
             fixed=fixed,
         )
         if self.friction is not None:
+            assert isinstance(self.friction, Coulomb)  # (check: no Tresca between two bodies)
             self.pair.mu, self.pair.previous = self.friction.mu, self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)
         return SurfaceSetup(None, self.ds, self.v_load)
 
-    def _lame(self, side) -> np.ndarray:
+    def _lame(self, side: Side) -> NDArray[np.float64]:
         """(m, 3): E, lambda, mu of the cell of each facet of ``side``."""
         mat = self.material
         fields = [mat.modulus, mat.poisson]
@@ -122,12 +142,12 @@ class TwoBodyProblem(Problem):
         E, nu = (f.x.array[dofs] for f in fields)
         return np.stack([E, *lame(E, nu)], axis=1)
 
-    def coupling(self):
+    def coupling(self) -> Any:
         if not hasattr(self, "_coupling"):
             self._coupling = self.method.coupling(self.pair)
         return self._coupling
 
-    def bulk_form(self):
+    def bulk_form(self) -> ufl.Form:
         eps = ufl.sym(ufl.grad(self.V_test))
         return ufl.inner(self.material.sigma(self.dU), eps) * ufl.dx
 
@@ -136,7 +156,7 @@ class TwoBodyProblem(Problem):
         self.tload.value = t
         self.scene.set_load(t)
 
-    def start(self, solver) -> None:
+    def start(self, solver: Solver) -> None:
         """From the undeformed state (the Dirichlet values are set by the solve), after two
         checks of the geometry at the start (collective, so that every rank raises alike):
         the bodies must not overlap by more than 1 % of the contact element size (two
@@ -186,7 +206,7 @@ class TwoBodyPost:
         self.status = dolfinx.fem.Function(self.Q1, name="contact_status")
         #: with friction: |tangential traction| and |slip increment of the step| on the slave
         #: nodes; the status is then 0 open, 1 stick, 2 slip
-        self.friction_fields = []
+        self.friction_fields: list[dolfinx.fem.Function] = []
         if pb.friction is not None:
             self.friction_fields = [
                 dolfinx.fem.Function(self.Q1, name=name) for name in ("tangential_traction", "slip")
@@ -203,11 +223,11 @@ class TwoBodyPost:
         #: / sum of |normal part| (0 up to the solver tolerance for frictionless contact)
         self.tangential: list[float] = []
         n = pb.layout.n_owned * pb.layout.bs
-        rows = [_compat.bc_dofs(bc) for bc in pb.bcs]
-        rows = np.unique(np.concatenate(rows)) if rows else np.zeros(0, dtype=np.int64)
+        bc_rows = [_compat.bc_dofs(bc) for bc in pb.bcs]
+        rows = np.unique(np.concatenate(bc_rows)) if bc_rows else np.zeros(0, dtype=np.int64)
         self.bc_rows = rows[rows < n]
 
-    def evaluate(self, solver) -> Quantities:
+    def evaluate(self, solver: Solver) -> Quantities:
         nodes, D, lam, gap = self.pb.coupling().nodal()
         local = (nodes - self.start).astype(np.int64)
         on = np.zeros(self.pb.layout.n_owned, dtype=bool)
@@ -275,7 +295,7 @@ class TwoBodyPost:
         sign = 1.0 if self.scene.slave_is_upper else -1.0
         return sign * self.scene.symmetry * self.pb.coupling().slave_force()
 
-    def tangential_nodal_force(self, solver, local: np.ndarray) -> float:
+    def tangential_nodal_force(self, solver: Solver, local: np.ndarray) -> float:
         """sum_j |f_j - (n_j . f_j) n_j| / sum_j |n_j . f_j| over the slave contact nodes j
         (nodes with a support left out: they carry its reaction too), with f_j = -R(u)_j the
         force the contact exerts on node j, from the bulk residual R(u) = f_int(u) - f_ext,
@@ -297,11 +317,11 @@ class TwoBodyPost:
         normal = self.comm.allreduce(float(np.sum(np.abs(fn))), op=MPI.SUM)
         return tangential / normal if normal > 0.0 else 0.0
 
-    def fields(self) -> list:
+    def fields(self) -> list[dolfinx.fem.Function]:
         self.vm.interpolate(self.vm_expr)
         return [self.pb.state, self.vm, self.pressure, self.gap, self.status, *self.friction_fields]
 
-    def finish(self, q: Quantities, out) -> dict:
+    def finish(self, q: Quantities, out: Path | None) -> dict[str, Any]:
         reference = closed_form_errors(self.scene, q)
         if q.friction is not None:
             reference.update(self.scene.friction_reference(q, self.pb.friction))
@@ -343,7 +363,9 @@ class TwoBodyPost:
         }
 
 
-def plot_pressure(x: np.ndarray, p: np.ndarray, scene, force: float, path: Path) -> None:
+def plot_pressure(
+    x: NDArray[np.float64], p: NDArray[np.float64], scene: Scene, force: float, path: Path
+) -> None:
     """The nodal contact pressure p at the slave nodes x (n, gdim) against s = x (2D) or the
     distance s from the axis x = y = 0 (3D), with the scene's closed form
     (``pressure_profile``) at the computed force on a fine grid of s where it has one."""

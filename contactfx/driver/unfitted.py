@@ -38,11 +38,14 @@ Heaviside part: the picture's few cells around each tip).
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import dolfinx
 import numpy as np
 import ufl
 from mpi4py import MPI
+from numpy.typing import NDArray
 from petsc4py import PETSc
 
 from contactfx import _compat
@@ -58,14 +61,23 @@ from contactfx.contact.cut import (
     near_cells,
     snapped_tips,
 )
-from contactfx.contact.interface import tangent
+from contactfx.contact.interface import InterfaceSurface, tangent
 from contactfx.contact.laws import active
+from contactfx.contact.surface import Expr
 from contactfx.contact.tip import STAR_POINTS, branch, snapped_point, star_rule, tip_split
 from contactfx.driver.fields import global_sum, nodal_contact, zero_pattern
 from contactfx.driver.grid_multiplier import GridMultiplier
 from contactfx.driver.interface import InterfaceProblem
 from contactfx.driver.interface_post import STATUS, InterfacePost, Profile
-from contactfx.driver.problem import Problem, SurfaceSetup
+from contactfx.driver.problem import (
+    Filler,
+    Method,
+    Numerics,
+    Problem,
+    Scene,
+    Solver,
+    SurfaceSetup,
+)
 from contactfx.io.vtk import Split
 from contactfx.results import InterfaceQuantities, Quantities
 
@@ -84,6 +96,8 @@ TIP_NITSCHE = 10.0
 STAR_DEGREE = 11
 assert 3 * STAR_POINTS**2 <= 28
 _CUT = 1  # the cut cells' tag
+#: a crack's frame: its two tips (2, 2), the directions ahead of them (2, 2), its normal
+Frame = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
 #: Nitsche's length h_K = 5 |K| / |Gamma_K| on a cut cell K (area |K|, crack piece |Gamma_K|):
 #: gamma = gamma0 E / h_K is then, at the default gamma0 = 10, the stabilisation
 #: 2 E |Gamma_K| / |K| of Annavarapu, Hautefeuille & Dolbow 2012 (doi:10.1002/nme.4343) for the
@@ -95,7 +109,9 @@ NITSCHE_LENGTH = 5.0
 GRID_FACTOR = 2.0
 
 
-def _accumulate(Q, values: np.ndarray, dofs: np.ndarray, n_owned: int) -> np.ndarray:
+def _accumulate(
+    Q: Any, values: NDArray[Any], dofs: NDArray[np.int32], n_owned: int
+) -> NDArray[np.float64]:
     """Sum over every rank's owned cells of ``values`` (per cell, or per cell and vertex) at
     each cell's (block) dofs ``dofs`` of the space Q, on the local dofs (owned and ghosts;
     one value per block)."""
@@ -114,7 +130,20 @@ class _Crack:
     cut cells, the side fractions and signs (DG0), its Gauss points and weights (quadrature
     functions), Nitsche's length, and the first component of its enrichment in U."""
 
-    def __init__(self, mesh, X, crack: CrackSegment, first: int, rule, n_owned: int) -> None:
+    #: the crack's measure and its coordinate at the Gauss points (set by the problem's
+    #: ``make_surface``)
+    ds: WeightedMeasure
+    s_coord: Expr
+
+    def __init__(
+        self,
+        mesh: dolfinx.mesh.Mesh,
+        X: NDArray[np.float64],
+        crack: CrackSegment,
+        first: int,
+        rule: tuple[NDArray[np.float64], NDArray[np.float64]],
+        n_owned: int,
+    ) -> None:
         comm = mesh.comm
         self.true, self.first, self.n_owned = crack, first, n_owned
         near = near_cells(X, crack)
@@ -172,34 +201,34 @@ class _Crack:
         # same on every rank: from every rank's crossings of its owned cells' edges)
         self.psi_q = self.coordinate(quad.points.reshape(-1, 2).T).reshape(quad.ratio.shape)
         self.weight_q = quad.ratio * rule[1][None, :] * 2.0 * self.area[:, None]
-        ends = cells.pieces[self.cut_owned].reshape(-1, 2)
+        piece_ends = cells.pieces[self.cut_owned].reshape(-1, 2)
         sizes = np.repeat(cell_sizes(X[self.cut_owned]), 2)
-        gathered = comm.allgather((self.coordinate(ends.T), sizes))
+        gathered = comm.allgather((self.coordinate(piece_ends.T), sizes))
         self.grid = CoarseGrid(
             np.concatenate([g[0] for g in gathered]),
             np.concatenate([g[1] for g in gathered]),
             GRID_FACTOR,
         )
 
-    def nodes(self, Q) -> np.ndarray:
+    def nodes(self, Q: Any) -> NDArray[np.bool_]:
         """Bool per local (block) dof of the space Q: on one of this crack's cut cells, on any
         rank (a node's cut cell may be neither owned nor a ghost where the node is)."""
         return (
             _accumulate(Q, self.cells.cut.astype(float), _compat.cell_dofs(Q), self.n_owned) > 0.0
         )
 
-    def side(self, x):
+    def side(self, x: Expr) -> Expr:
         """The side (+1 / -1) of the points x (UFL): the crack's level set's sign in its cut
         cells, elsewhere the cell's side."""
         c, n = self.true.centre, self.true.normal
         phi = (x[0] - c[0]) * n[0] + (x[1] - c[1]) * n[1]
         return ufl.conditional(ufl.gt(self.is_cut, 0.5), ufl.sign(phi), self.H)
 
-    def enrichment(self, X):
+    def enrichment(self, X: Expr) -> Expr:
         """Its enrichment field in the unknown (or test function) X."""
         return ufl.as_vector([X[self.first + i] for i in range(2)])
 
-    def coordinate(self, x):
+    def coordinate(self, x: Any) -> Any:
         """psi: the true crack's coordinate of the points x (UFL or numpy (2, n))."""
         c, d = self.true.centre, self.true.direction
         return (x[0] - c[0]) * d[0] + (x[1] - c[1]) * d[1]
@@ -213,7 +242,14 @@ class _TipFields:
     cell gL and gP (:func:`contactfx.contact.tip.tip_split`). Zero off the stars: there the
     enrichment is Heaviside only. ``tags`` (cells,): crack k's star cells get k."""
 
-    def __init__(self, mesh, X, area, cracks, n_owned: int) -> None:
+    def __init__(
+        self,
+        mesh: dolfinx.mesh.Mesh,
+        X: NDArray[np.float64],
+        area: NDArray[np.float64],
+        cracks: Sequence[_Crack],
+        n_owned: int,
+    ) -> None:
         ref_w = _compat.quadrature_rule(mesh, STAR_DEGREE)[1]
         self.slots = len(ref_w)
         Qb = _compat.quadrature_space(mesh, STAR_DEGREE)
@@ -222,7 +258,7 @@ class _TipFields:
         qb, qs, c0 = (_compat.cell_dofs(S) for S in (Qb, Qs, DG0))
         c0 = c0[:, 0]
 
-        def functions(space, n):
+        def functions(space: Any, n: int) -> list[dolfinx.fem.Function]:
             return [dolfinx.fem.Function(space) for _ in range(n)]
 
         # the star rule: weight ratio, side, F, grad F (2), L, P (2)
@@ -246,7 +282,7 @@ class _TipFields:
         dofs = _compat.cell_dofs(Q1)
         self.tags = np.full(len(X), -1, dtype=np.int32)
         #: per crack: its tips (on their edges or nodes), the directions ahead, its normal
-        self.frames = []
+        self.frames: list[Frame] = []
         for k, crack in enumerate(cracks):
             cells = crack.cells
             node = _accumulate(Q1, cells.tip_nodes, dofs, n_owned) > 0.0
@@ -326,22 +362,26 @@ class _TipFields:
 
         self.x = ufl.SpatialCoordinate(mesh)
 
-    def part(self, f, L, P):
+    def part(self, f: Expr, L: Expr, P: Sequence[Expr]) -> Expr:
         """The tip nodes' share of the P1 field f at the points of L and P (lists)."""
         return L * f + ufl.dot(ufl.grad(f), ufl.as_vector(P) - L * self.x)
 
-    def part_grad(self, f):
+    def part_grad(self, f: Expr) -> Expr:
         """The gradient of the tip nodes' share of the P1 field f."""
         gL = ufl.as_vector(self.gL)
         gP = ufl.as_matrix([self.gP[:2], self.gP[2:]])
         return ufl.outer(f, gL) + ufl.dot(ufl.grad(f), gP - ufl.outer(self.x, gL))
 
-    def half_jump(self, at, f, R, L, P):
+    def half_jump(
+        self, at: Callable[[Expr], Expr], f: Expr, R: Expr, L: Expr, P: Sequence[Expr]
+    ) -> Expr:
         """The half jump of the enrichment f at the points: f's value there (``at``) with its
         tip nodes' share weighted by sqrt(r) (F = H sqrt(r) on the crack)."""
         return at(f) + (R - 1.0) * self.part(f, L, P)
 
-    def strain(self, X, crack, others, side):
+    def strain(
+        self, X: Expr, crack: _Crack, others: Sequence[tuple[Expr, Expr]], side: Expr
+    ) -> Expr:
         """The strain of w at the star rule's points, crack's enrichment split into its
         Heaviside part (with ``side``) and its tip part (with F); ``others``: the other
         cracks' (sign, enrichment) (constant sides here)."""
@@ -359,8 +399,17 @@ class _TipFields:
 class UnfittedProblem(InterfaceProblem):
     """A body with unfitted cracks (see the module docstring)."""
 
+    surface: CutSurface
+    surfaces: list[CutSurface]
+    cracks: list[_Crack]
+    tip: _TipFields
+    n_owned_cells: int
+    rule: tuple[NDArray[np.float64], NDArray[np.float64]]
+    area: NDArray[np.float64]
+    cut_tags: Any
+
     @classmethod
-    def check(cls, scene, numerics, method) -> None:
+    def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
         super().check(scene, numerics, method)
         if numerics.degree != 1:
             raise ValueError(
@@ -375,7 +424,14 @@ class UnfittedProblem(InterfaceProblem):
         if numerics.quadrature == "nodal":
             raise ValueError("unfitted cracks use Gauss points (--quadrature gauss)")
 
-    def __init__(self, scene, numerics, method, mesh, facet_tags) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        numerics: Numerics,
+        method: Method,
+        mesh: dolfinx.mesh.Mesh,
+        facet_tags: Any,
+    ) -> None:
         tdim = mesh.topology.dim
         if mesh.geometry.dim != 2 or mesh.topology.cell_name() != "triangle":
             raise ValueError("unfitted cracks are implemented on triangle meshes (2D)")
@@ -418,27 +474,28 @@ class UnfittedProblem(InterfaceProblem):
         Problem.__init__(self, scene, numerics, method, mesh, facet_tags)
 
     # -- a method's values at the cracks' pieces ----------------------------------------------
-    def surface_space(self, shape: tuple[int, ...]):
+    def surface_space(self, shape: tuple[int, ...]) -> Any:
         """Values at the points of the cell rule, which carry the cracks' Gauss points."""
         return _compat.quadrature_space(self.mesh, QUADRATURE_DEGREE, shape)
 
     @functools.cached_property
-    def multiplier_mask(self) -> np.ndarray:
+    def multiplier_mask(self) -> NDArray[np.bool_]:
         """The points of the cut cells (every crack's)."""
+        assert self.multiplier is not None  # a method with a nodal multiplier
         return self._on_cracks(self.multiplier.function_space)
 
-    def _on_cracks(self, Q) -> np.ndarray:
+    def _on_cracks(self, Q: Any) -> NDArray[np.bool_]:
         """The dofs of the space Q on the cut cells of every crack."""
         return np.any([c.nodes(Q) for c in self.cracks], axis=0)
 
-    def confine_multiplier(self, supports=()) -> list:
+    def confine_multiplier(self, supports: Sequence[Any] = ()) -> list[Any]:
         """al-ssn's multiplier lives on the nodes of the cracks' cut cells."""
         if not self.multiplier_field:
             return []
         return self.confine(self.state.function_space.sub(1), self._on_cracks)
 
     @functools.cache  # noqa: B019 (one problem, one coupling)
-    def coupling(self):
+    def coupling(self) -> GridMultiplier | None:
         """al-ssn: its multiplier's equations (:class:`contactfx.driver.grid_multiplier.
         GridMultiplier`); no coupling for the other methods."""
         if not self.multiplier_field:
@@ -450,20 +507,21 @@ class UnfittedProblem(InterfaceProblem):
         if not self.multiplier_field:
             return super()._start_multiplier()
         coupling = self.coupling()
+        assert coupling is not None  # (a multiplier field)
         vec = _compat.petsc_vec(self.state)
         vec.getArray()[coupling.rows] = coupling.project(self._start_traction)
         vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
-    def surface_update(self, law):
+    def surface_update(self, law: Callable[[Any], Expr]) -> Filler:
         """The filler of al-uzawa's multiplier: ``law(s)`` on each crack's surface s projected
         onto the crack's grid (:meth:`_filler`)."""
         return self._filler(law, on_grid=True)
 
-    def history_update(self, law):
+    def history_update(self, law: Callable[[Any], Expr]) -> Filler:
         """The filler of the traction history: ``law(s)`` at each crack's points."""
         return self._filler(law, on_grid=False)
 
-    def _filler(self, law, *, on_grid: bool):
+    def _filler(self, law: Callable[[Any], Expr], *, on_grid: bool) -> Filler:
         """The filler of a :meth:`surface_space` Function with ``law(s)`` at the Gauss points
         of each crack's surface s (its owned cut cells; the ghosts by a scatter); ``on_grid``:
         those values projected onto the crack's grid (lumped L2, summed over the ranks) and
@@ -471,7 +529,7 @@ class UnfittedProblem(InterfaceProblem):
         exprs = [dolfinx.fem.Expression(law(s), self.rule[0]) for s in self.surfaces]
         comm = self.mesh.comm
 
-        def fill(target) -> None:
+        def fill(target: dolfinx.fem.Function) -> None:
             bs = target.function_space.dofmap.index_map_bs
             dofs = _compat.cell_dofs(target.function_space)
             values = target.x.array.reshape(-1, bs)
@@ -488,13 +546,13 @@ class UnfittedProblem(InterfaceProblem):
 
         return fill
 
-    def _nodal_size(self):
+    def _nodal_size(self) -> Expr:
         """The penalty's h (``nodal_size``): the cell diameter, which varies smoothly along the
         crack. With Nitsche's h_K, large where a piece is short, the stiffness jumped from
         cut cell to cut cell and so did the pressure (docs/verification.md section 14)."""
         return self.h
 
-    def output_split(self):
+    def output_split(self) -> Split | None:
         """One crack: the ParaView body split along the edges between the cut cells' larger
         sides (u + H a on each cell, H its larger part's side: Warp By Vector opens the crack
         along a zigzag of cell edges); several cracks: not split."""
@@ -520,13 +578,13 @@ class UnfittedProblem(InterfaceProblem):
                 facets.append(f)
         return Split(crack.H, np.asarray(facets, dtype=np.int32), jump="enrichment_1")
 
-    def total(self, X):
+    def total(self, X: Expr) -> Expr:
         """w = u + sum_k H_k a_k from X = (u, a_1, ..., a_K)."""
         d = self.gdim
         u = ufl.as_vector([X[i] for i in range(d)])
         return u + sum((c.H * c.enrichment(X) for c in self.cracks), ufl.zero(d))
 
-    def boundary_total(self, X):
+    def boundary_total(self, X: Expr) -> Expr:
         """w = u + sum_k H_k a_k with each H_k the side of the point (:meth:`_Crack.side`):
         the boundary's test function and quantities, which on a facet of a cut cell see the
         facet's own side (the cell's larger side may be the other one); a loaded facet that a
@@ -535,10 +593,10 @@ class UnfittedProblem(InterfaceProblem):
         u = ufl.as_vector([X[i] for i in range(d)])
         return u + sum((c.side(x) * c.enrichment(X) for c in self.cracks), ufl.zero(d))
 
-    def enrichments(self) -> list:
+    def enrichments(self) -> list[tuple[int, Callable[[Any], NDArray[np.bool_]]]]:
         return [(c.first, functools.partial(self._enriched, c)) for c in self.cracks]
 
-    def _enriched(self, crack: _Crack, Q) -> np.ndarray:
+    def _enriched(self, crack: _Crack, Q: Any) -> NDArray[np.bool_]:
         """The enriched nodes of a crack: of a cut cell, with area on both sides of the crack
         in their support and no tip inside it (summed over every rank's cells)."""
         dofs = _compat.cell_dofs(Q)
@@ -566,7 +624,7 @@ class UnfittedProblem(InterfaceProblem):
             )
         return enriched
 
-    def _mean_stress(self, X, crack):
+    def _mean_stress(self, X: Expr, crack: _Crack) -> Expr:
         """The stress at crack's Gauss points of the cells' sides weighted by their area
         fractions (Hansbo & Hansbo 2002, doi:10.1016/S0045-7825(02)00524-8):
         sigma(u + sum_k (2 f_k - 1) a_k), and the tip part's (F = H sqrt(r) on the crack)."""
@@ -597,10 +655,10 @@ class UnfittedProblem(InterfaceProblem):
         for k, crack in enumerate(self.cracks):
             Y, M = ufl.as_vector(crack.Y), ufl.as_vector(crack.mid)
 
-            def at_crack(f, Y=Y):
+            def at_crack(f: Expr, Y: Expr = Y) -> Expr:
                 return f + ufl.dot(ufl.grad(f), Y - x)
 
-            def at_midpoint(f, M=M):
+            def at_midpoint(f: Expr, M: Expr = M) -> Expr:
                 return f + ufl.dot(ufl.grad(f), M - x)
 
             t, K = self.tip, len(self.cracks)
@@ -670,20 +728,20 @@ class UnfittedProblem(InterfaceProblem):
                 "crossing); move the crack or hold that boundary"
             )
 
-    def _trial_jumps(self) -> list:
+    def _trial_jumps(self) -> list[tuple[InterfaceSurface, Expr, ufl.Measure]]:
         return [(s, s.jump(self.dU), s.ds) for s in self.surfaces]
 
-    def _multiplier_at(self, at_crack):
+    def _multiplier_at(self, at_crack: Callable[[Expr], Expr]) -> Expr | None:
         """al-uzawa's multiplier (values at the points), al-ssn's P1 field at the crack's
         points, or None."""
         if self.multiplier is not None or self.lam is None:
             return self.multiplier
         return at_crack(self.lam)
 
-    def contact_residual(self):
+    def contact_residual(self) -> ufl.Form:
         return sum(self.method.residual(self.newton_surface(s)) for s in self.surfaces)
 
-    def extra_load(self, L):
+    def extra_load(self, L: ufl.Form) -> ufl.Form:
         if self.fluid is None:
             return L
         # the fluid pushes the faces of every crack apart
@@ -691,7 +749,7 @@ class UnfittedProblem(InterfaceProblem):
             L = L + self.fluid * ufl.dot(s.v, s.interface_normal()) * s.ds
         return L
 
-    def bulk_form(self):
+    def bulk_form(self) -> ufl.Form:
         """Each side of a cut cell with its area fraction (exact for P1): with m_k = 2 f_k - 1
         the sides' mean of the sign of crack k's enrichment and 1 - m_k^2 its variance (no
         cell is cut by two cracks),
@@ -699,10 +757,10 @@ class UnfittedProblem(InterfaceProblem):
         d = self.gdim
         sigma = self.material.sigma
 
-        def eps(z):
+        def eps(z: Expr) -> Expr:
             return ufl.sym(ufl.grad(z))
 
-        def mean(X):
+        def mean(X: Expr) -> Expr:
             u = ufl.as_vector([X[i] for i in range(d)])
             return u + sum(
                 ((2.0 * c.fraction - 1.0) * c.enrichment(X) for c in self.cracks), ufl.zero(d)
@@ -732,7 +790,7 @@ class UnfittedProblem(InterfaceProblem):
             + zero * ufl.inner(lam, mu) * dx
         )
 
-    def _star_form(self, dx):
+    def _star_form(self, dx: ufl.Measure) -> ufl.Form:
         """The bulk energy on the cells around the tips' nodes, by the star rule
         (:mod:`contactfx.contact.tip`): the tip enrichment is not P1."""
         t, K = self.tip, len(self.cracks)
@@ -759,13 +817,15 @@ class CutPost(InterfacePost):
     """The cracks' quantities at their Gauss points, forces, errors against the closed forms
     (of the first crack: the scenes with closed forms have one)."""
 
-    def __init__(self, pb) -> None:
+    pb: UnfittedProblem
+
+    def __init__(self, pb: UnfittedProblem) -> None:
         self.pb, self.scene, self.comm = pb, pb.scene, pb.mesh.comm
         mesh, method = pb.mesh, pb.method
         joint = pb.surface.joint
         self.w0 = 0.0 if joint is None else joint.w0  # the aperture's opening at zero jump
         points = pb.rule[0]
-        self.exprs = []
+        self.exprs: list[dict[str, dolfinx.fem.Expression]] = []
         forms = {"force": 0, "closed": 0, "tangential": 0, "propped": 0, "slipping": 0}
         for crack, s in zip(pb.cracks, pb.surfaces, strict=True):
             t_I = tangent(s.interface_normal())
@@ -812,16 +872,21 @@ class CutPost(InterfacePost):
         self.u_out = dolfinx.fem.Function(V1, name="displacement")
         U, d = pb.U, pb.gdim
         self.u_expr = _compat.expression(ufl.as_vector([U[i] for i in range(d)]), V1)
-        self.a_out = [
+        self.a_outs = [
             dolfinx.fem.Function(V1, name=f"enrichment_{k + 1}") for k in range(len(pb.cracks))
         ]
-        self.a_expr = [_compat.expression(c.enrichment(U), V1) for c in pb.cracks]
+        self.a_exprs = [_compat.expression(c.enrichment(U), V1) for c in pb.cracks]
         self._tip_scales = [
             self._tip_scale(V1, c, frame) for c, frame in zip(pb.cracks, pb.tip.frames, strict=True)
         ]
         self.values: dict[str, np.ndarray] = {}
 
-    def _tip_scale(self, V1, crack, frame) -> np.ndarray:
+    def _tip_scale(
+        self,
+        V1: Any,
+        crack: _Crack,
+        frame: Frame,
+    ) -> NDArray[np.float64]:
         """Per node of V1: abs(F) at a tip's node (the branch function there, F a_T its
         enriched displacement), 1 elsewhere: the enrichment written for ParaView is then the
         displacement's part at every node."""
@@ -851,7 +916,7 @@ class CutPost(InterfacePost):
         names = set().union(*parts)
         return {n: np.concatenate([p.get(n, np.zeros(len(p["s"]))) for p in parts]) for n in names}
 
-    def evaluate(self, solver) -> Quantities:
+    def evaluate(self, solver: Solver) -> Quantities:
         v = self.values = self._evaluate_points()
         on = np.ones(len(v["normal_traction"]), dtype=bool)
         peak, closed, penetration, complementarity = nodal_contact(
@@ -888,20 +953,20 @@ class CutPost(InterfacePost):
             interface=interface,
         )
 
-    def fields(self) -> list:
+    def fields(self) -> list[dolfinx.fem.Function]:
         self.u_out.interpolate(self.u_expr)
-        for f, e, scale in zip(self.a_out, self.a_expr, self._tip_scales, strict=True):
+        for f, e, scale in zip(self.a_outs, self.a_exprs, self._tip_scales, strict=True):
             f.interpolate(e)
             f.x.array.reshape(-1, self.pb.gdim)[:] *= scale[:, None]
         self.vm.interpolate(self.vm_expr)
-        return [self.u_out, *self.a_out, self.vm, *(c.fraction for c in self.pb.cracks)]
+        return [self.u_out, *self.a_outs, self.vm, *(c.fraction for c in self.pb.cracks)]
 
     def profile(self) -> Profile:
         """The Gauss points' values gathered on rank 0, sorted by crack and s."""
         v = self.values or self._evaluate_points()
         x = np.column_stack([v["x"], v["y"]])
 
-        def col(name):
+        def col(name: str) -> NDArray[np.float64]:
             return v[name] if name in v else np.zeros(len(v["s"]))
 
         opening = col("aperture") - self.w0
@@ -924,4 +989,5 @@ class CutPost(InterfacePost):
         a = np.vstack(parts)
         a = a[np.lexsort((a[:, 0], a[:, -1]))]
         crack = a[:, -1] if len(self.pb.cracks) > 1 else None
-        return Profile(a[:, 0], a[:, 1:3], *(a[:, 3 + i] for i in range(6)), crack=crack)
+        opening, slip, p, t, status, floor = (a[:, 3 + i] for i in range(6))
+        return Profile(a[:, 0], a[:, 1:3], opening, slip, p, t, status, floor, crack=crack)
