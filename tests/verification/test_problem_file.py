@@ -23,7 +23,10 @@ def _solve(name: str, comm=MPI.COMM_WORLD, sets=()):
     return scene, res
 
 
-@pytest.mark.parametrize("name, radius", [("holed-pad.toml", 2.0), ("bored-block.toml", 1.0)])
+@pytest.mark.parametrize(
+    "name, radius",
+    [("holed-pad.toml", 2.0), ("bored-block.toml", 1.0), ("rubber-pad.toml", 2.0)],
+)
 def test_obstacle_problem_reaction_balances_contact_force(name, radius):
     scene, res = _solve(name)
     d = "xyz"[scene.gdim - 1]
@@ -54,7 +57,14 @@ def test_contact_pair_problem_reactions_balance():
 
 @pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
 @pytest.mark.parametrize(
-    "name", ["holed-pad.toml", "block-on-plinth.toml", "pressurised-crack.toml", "bored-block.toml"]
+    "name",
+    [
+        "holed-pad.toml",
+        "block-on-plinth.toml",
+        "pressurised-crack.toml",
+        "bored-block.toml",
+        "rubber-pad.toml",
+    ],
 )
 def test_problem_file_ranks_agree(name):
     _, parallel = _solve(name)
@@ -75,6 +85,59 @@ def test_set_overrides_a_key():
     assert len(res.steps) == 1
     # half the indentation: a smaller force (Hertz-like growth, faster than linear)
     assert 0.2 * full.force < res.force < 0.5 * full.force
+
+
+def test_hyperelastic_body():
+    scene, numerics, _ = load_problem(DEMOS / "rubber-pad.toml")
+    material = scene.material()
+    # the file's mu = 1, kappa = 50: the neo-Hookean body with those small-strain moduli
+    assert material.finite_strain and material.name == "neo-hookean"
+    assert (material.mu, material.kappa) == pytest.approx((1.0, 50.0), rel=1e-14)
+    assert numerics.formulation == "mixed-up"
+
+
+RUBBER = (DEMOS / "rubber-pad.toml").read_text()
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (
+            lambda t: t.replace('"neo-hookean"', '"rubber"'),
+            "bodies.0.material: must be one of",
+        ),
+        (lambda t: t.replace("mu = 1.0", "mu = -1.0"), "bodies.0.mu: must be > 0"),
+        (lambda t: t.replace("kappa = 50.0", "kappa = 0.0"), "bodies.0.kappa: must be > 0"),
+        (lambda t: t.replace("mu = 1.0", "mu = 1.0\nE = 3.0"), "bodies.0.E: give E and nu"),
+        (
+            lambda t: t.replace("mu = 1.0", "mu = 1.0\nc10 = 3.0"),
+            "bodies.0.c10: not a parameter of material neo-hookean",
+        ),
+        (
+            lambda t: t.replace("mu = 1.0", "c10 = -1.0"),
+            "bodies.0.c10: not a parameter of material neo-hookean",
+        ),
+        (
+            lambda t: t.replace('"neo-hookean"', '"mooney-rivlin"').replace(
+                "mu = 1.0", "c10 = -1.0"
+            ),
+            "bodies.0.c10: must be >= 0",
+        ),
+        (
+            lambda t: t.replace('"neo-hookean"', '"svk"').replace(
+                "mu = 1.0\nkappa = 50.0", "E = 1.0\nnu = 0.5"
+            ),
+            "bodies.0.nu: Poisson's ratio must be in (-1, 0.5)",
+        ),
+    ],
+)
+def test_bad_materials(tmp_path, edit, message):
+    path = _write(tmp_path, edit(RUBBER))
+    with pytest.raises((ValueError, OSError)) as err:
+        load_problem(path)
+    assert message in str(err.value)
+    assert "\n" not in str(err.value)
 
 
 def _write(tmp_path: Path, text: str) -> Path:
