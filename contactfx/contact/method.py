@@ -165,6 +165,12 @@ class MethodBase:
     def snes_options(self) -> dict[str, object]:
         return {}
 
+    def trial_traction(self, s: Surface) -> tuple[Expr, Expr] | None:
+        """With friction, the trial tangential traction and the friction bound that Newton's
+        reversal guard compares between iterates (:func:`contactfx.contact.laws.reversal`);
+        None: a method without the guard."""
+        return None
+
     def coupling(self, pair: ContactPair) -> PairCoupling:
         """The terms between two separately meshed bodies
         (:class:`contactfx.contact.coupling.Coupling`) of a contact ``pair``

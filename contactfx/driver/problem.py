@@ -415,12 +415,12 @@ class Problem:
         itself."""
         s = self.surface if s is None else s
         assert s is not None  # a kind with a UFL surface
-        trial = getattr(self.method, "trial_traction", None)
-        if s.friction is None or trial is None:
+        trial = None if s.friction is None else self.method.trial_traction(s)
+        if trial is None:
             return s
         if self.iterate is None:
             self.iterate = dolfinx.fem.Function(self.state.function_space, name="iterate")
-        x, bound = trial(s)
+        x, bound = trial
         x_last = ufl.replace(x, {self.state: self.iterate})
         return dataclasses.replace(s, stick=reversal(x, x_last, bound))
 
