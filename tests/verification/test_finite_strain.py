@@ -193,6 +193,48 @@ def test_uniaxial_patch_mixed_near_incompressible():
     assert res.peak_pressure == pytest.approx(P, rel=1e-9)
 
 
+@pytest.mark.parametrize("method", ["nitsche", "al-ssn"])
+def test_coulomb_gross_slip(method):
+    # the sliding block pressed by p = 100 (10 % shortening, neo-Hookean) and dragged 0.3 by
+    # the plane: the whole face slides, and Coulomb's law bounds every point's traction by
+    # mu p, so Q = mu P (equilibrium, exact on any mesh; measured 30 / 30 to 1e-15)
+    params = dataclasses.replace(SlidingBlock.Params(), pressure=100.0, shift=0.3)
+    num = Numerics(method=method, friction="coulomb", mu=0.3, steps=10, material="neo-hookean")
+    res = SlidingBlock(params).run(num, verbose=False)
+    q = res.quantities.friction
+    assert res.force == pytest.approx(100.0, rel=1e-9)
+    assert abs(q.tangential_force[0]) == pytest.approx(0.3 * res.force, rel=1e-8)
+    assert q.slip_fraction == pytest.approx(1.0)
+
+
+def test_small_load_limit_hertz2d():
+    # a rigid cylinder (circle, R = 1) on a neo-Hookean and on a linear block, same mesh, at
+    # three depths. The linear run's distance to Hertz is the discretisation (and finite
+    # block) error; the neo-Hookean run's distance to the linear one is the geometric and
+    # material nonlinearity, which vanishes with the load like a / R (docs/verification.md
+    # section 15; measured peak pressure -0.24 %, -0.51 %, -0.87 % at a / R = 0.026, 0.059,
+    # 0.133, i.e. 0.07-0.09 a / R)
+    base = dataclasses.replace(
+        Hertz2D.Params(), profile="circle", refine_half_width=0.15, h_contact=0.003
+    )
+    deviations = []
+    for depth in (0.0015, 0.006, 0.024):
+        runs = [
+            Hertz2D(dataclasses.replace(base, depth=depth)).run(
+                Numerics(material=m, steps=2), verbose=False
+            )
+            for m in ("linear", "neo-hookean")
+        ]
+        a_over_r = runs[1].contact_size / base.radius
+        dp = runs[1].peak_pressure / runs[0].peak_pressure - 1.0
+        deviations.append((a_over_r, dp))
+    # the nonlinearity softens the peak, by at most 0.1 a / R, and more at larger loads
+    assert all(-0.1 * a <= dp < 0.0 for a, dp in deviations)
+    assert abs(deviations[0][1]) < abs(deviations[1][1]) < abs(deviations[2][1])
+    # as the load goes to zero the two agree (0.24 % at a / R = 0.026)
+    assert abs(deviations[0][1]) < 5e-3
+
+
 def test_serial_and_parallel_agree():
     _, serial = solve(MPI.COMM_SELF, method="nitsche", material="neo-hookean")
     _, parallel = solve(MPI.COMM_WORLD, method="nitsche", material="neo-hookean")
