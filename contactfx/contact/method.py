@@ -100,6 +100,9 @@ class Supports:
     #: finite-strain bodies (a hyperelastic ``--material``): the law in the deformed
     #: configuration
     finite_strain: bool = True
+    #: axisymmetric bodies (integrals weighted by r): a law at Gauss points, none collocated
+    #: at the nodes (whose weight vanishes at the axis)
+    axisymmetric: bool = False
     why_not: dict[str, str] = field(default_factory=dict)
 
 

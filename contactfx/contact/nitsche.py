@@ -59,6 +59,7 @@ class Nitsche(TrialFriction, MethodBase):
     name = "nitsche"
     sweep = ("theta", (1, 0, -1))
     supports = Supports(
+        axisymmetric=True,
         friction=("none", "tresca", "coulomb"),
         mixed_up=True,
         nodal_quadrature=True,

@@ -51,6 +51,7 @@ class Penalty(TrialFriction, MethodBase):
     name = "penalty"
     sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
+        axisymmetric=True,
         friction=("none", "tresca", "coulomb"),
         mixed_up=True,
         nodal_quadrature=True,

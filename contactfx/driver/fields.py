@@ -15,6 +15,7 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 from contactfx.contact.surface import Expr
+from contactfx.mechanics.axisymmetric import unweighted
 
 __all__ = [
     "vertex_rule",
@@ -133,12 +134,13 @@ def assemble_array(form: Any) -> NDArray[np.float64]:
 class NodalProjection:
     """Lumped L2 projection onto the nodes of a surface: target = (int f q dS) / (int q dS)
     where the mass is > 0, 0 elsewhere. With the vertex rule it gives f's exact nodal values;
-    it serves interior-facet quantities, which cannot be interpolated cellwise."""
+    it serves interior-facet quantities, which cannot be interpolated cellwise. An average:
+    the measure's weight (an axisymmetric body's r) is left out."""
 
     def __init__(self, measure: ufl.Measure, space: Any, restrict: str | None = None) -> None:
         q = ufl.TestFunction(space)
         self.q = q if restrict is None else q(restrict)
-        self.measure = measure
+        self.measure = measure = unweighted(measure)
         shape = q.ufl_shape
         ones = ufl.as_vector([1.0] * shape[0]) if shape else 1.0
         self.mass = assemble_array(dolfinx.fem.form(ufl.inner(ones, self.q) * measure))

@@ -42,6 +42,7 @@ from contactfx.driver.problem import (
     Solver,
     SurfaceSetup,
 )
+from contactfx.mechanics.axisymmetric import measure
 from contactfx.results import Friction, Quantities
 
 __all__ = ["ObstacleProblem", "closed_form_errors"]
@@ -52,6 +53,7 @@ class ObstacleProblem(Problem):
 
     nested = True
     nonlinear_bulk = True
+    axisymmetric = True
 
     surface: ContactSurface
     obstacle: Any
@@ -100,7 +102,7 @@ class ObstacleProblem(Problem):
 
     def make_surface(self) -> SurfaceSetup:
         mesh, scene, mat = self.mesh, self.scene, self.material
-        self.ds = ufl.Measure("ds", domain=mesh, subdomain_data=self.facet_tags)
+        self.ds = measure("ds", mesh, scene.axisymmetric, subdomain_data=self.facet_tags)
         self.dsc = self.ds(scene.contact_tag, metadata=self.contact_rule())
         self.dsc_fine = self.ds(scene.contact_tag, metadata={"quadrature_degree": 12})
         self.offset = dolfinx.fem.Constant(mesh, np.zeros(self.gdim))
@@ -134,18 +136,24 @@ class ObstacleProblem(Problem):
 
     def bulk_form(self) -> ufl.Form:
         eps_v = ufl.sym(ufl.grad(self.V_test))
-        a = ufl.inner(self.material.sigma(self.dU, self.dp), eps_v) * ufl.dx
+        a = ufl.inner(self.material.sigma(self.dU, self.dp), eps_v) * self.dx
+        hoop = self.material.hoop_work(self.dU, self.dp, self.V_test)
+        if hoop is not None:
+            a += hoop * self.dx
         if self.up:
-            a += self.material.pressure_law(self.dU, self.dp, self.q) * ufl.dx
+            a += self.material.pressure_law(self.dU, self.dp, self.q) * self.dx
         pattern = self.tangent_pattern()
         return a if pattern is None else a + pattern
 
     def internal_form(self) -> ufl.Form:
         """int S(u, p) : grad v dx (+ the pressure's law, mixed u-p): the material's weak
         stress."""
-        f = ufl.inner(self.material.weak_stress(self.U, self.p), ufl.grad(self.V_test)) * ufl.dx
+        f = ufl.inner(self.material.weak_stress(self.U, self.p), ufl.grad(self.V_test)) * self.dx
+        hoop = self.material.hoop_work(self.U, self.p, self.V_test)
+        if hoop is not None:
+            f += hoop * self.dx
         if self.up:
-            f += self.material.pressure_law(self.U, self.p, self.q) * ufl.dx
+            f += self.material.pressure_law(self.U, self.p, self.q) * self.dx
         return f
 
     def tangent_pattern(self) -> ufl.Form | None:
@@ -436,7 +444,7 @@ class _FieldErrors:
         self.forms: dict[str, tuple[Any, ...]] = {}
         if exact is not None:
             e = pb.surface.u - exact
-            dxq = ufl.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
+            dxq = pb.dx(metadata={"quadrature_degree": 2 * pb.num.degree + 4})
             for key, op in (("L2", lambda f: f), ("H1", ufl.grad)):
                 self.forms[key] = tuple(
                     dolfinx.fem.form(ufl.inner(op(f), op(f)) * dxq) for f in (e, exact)

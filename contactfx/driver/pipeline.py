@@ -83,6 +83,16 @@ def _checked_method(scene: Scene, numerics: Numerics) -> Method:
             f"elasticity), not --material {numerics.material}; finite strain is offered "
             "against rigid obstacles"
         )
+    if scene.axisymmetric:
+        if not scene.problem.axisymmetric:
+            raise ValueError(f"scene '{scene.name}': its problem kind is not offered axisymmetric")
+        if not method.supports.axisymmetric or numerics.quadrature != "gauss":
+            raise ValueError(
+                f"axisymmetric scene '{scene.name}': method {method.name} with --quadrature "
+                f"{numerics.quadrature} is not offered (a law collocated at the nodes has no "
+                "weight at the axis r = 0); use --quadrature gauss with "
+                + ", ".join(methods_supporting(lambda c: c.axisymmetric))
+            )
     if material.finite_strain and not method.supports.finite_strain:
         raise ValueError(
             f"--material {numerics.material}: method {method.name} is small-strain only ("

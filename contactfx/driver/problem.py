@@ -36,6 +36,7 @@ from contactfx.driver.fields import (
     surface_mask,
     vertex_rule,
 )
+from contactfx.mechanics.axisymmetric import hoop_strain, measure
 from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
@@ -102,6 +103,9 @@ class Problem:
     nested = False
     #: whether the kind writes its bulk for a material that is not linear (``internal_form``)
     nonlinear_bulk = False
+    #: whether the kind solves axisymmetric bodies (its integrals weighted by r, the hoop term;
+    #: :mod:`contactfx.mechanics.axisymmetric`)
+    axisymmetric = False
 
     scene: Scene
     num: Numerics
@@ -165,6 +169,11 @@ class Problem:
         self.friction = numerics.friction_law()
         #: the bulk's material: the scene's, under ``--material`` (a finite-strain model)
         self.material = numerics.bulk_material(self.material_of(mesh))
+        #: the volume measure: weighted by r for an axisymmetric body, whose material then
+        #: carries the hoop strain
+        self.dx = measure("dx", mesh, scene.axisymmetric)
+        if scene.axisymmetric:
+            self.material = dataclasses.replace(self.material, hoop=hoop_strain(mesh))
         self.tload = dolfinx.fem.Constant(mesh, 0.0)
         self.h = _compat.cell_diameter(mesh)
         self.mult_shape = (self.gdim,) if self.friction is not None else ()
@@ -351,7 +360,7 @@ class Problem:
         if L is None:
             L = (
                 ufl.inner(dolfinx.fem.Constant(self.mesh, np.zeros(self.gdim)), self.v_load)
-                * ufl.dx
+                * self.dx
             )
         L = self.extra_load(L)
         # two bodies: no UFL surface, the contact terms are the solver's coupling

@@ -20,7 +20,7 @@ doi:10.1016/0045-7930(73)90027-3.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -89,6 +89,9 @@ class Elastic:
     modulus: object = None
     poisson: object = None
     density: float | None = None
+    #: an axisymmetric body (2D, r-z): its hoop strain, linear in u (u -> u_r / r,
+    #: :func:`contactfx.mechanics.axisymmetric.hoop_strain`); None: plane strain, 3D, 1D
+    hoop: Callable[[Any], Any] | None = field(default=None, compare=False)
 
     #: sigma is linear in (u, p): the bulk is assembled once
     linear = True
@@ -130,11 +133,34 @@ class Elastic:
 
     def sigma(self, u: Expr, p: Expr | None = None) -> Expr:
         """Stress of the displacement u, or of the pair (u, p) of the mixed u-p formulation
-        (p the pressure -lambda div u): 2 mu eps(u) - p I."""
+        (p the pressure -lambda div u): 2 mu eps(u) - p I. Axisymmetric: the in-plane (r, z)
+        block, the trace of the strain with the hoop strain."""
         eps = ufl.sym(ufl.grad(u))
         if p is not None:
             return 2.0 * self._moduli()[1] * eps - p * ufl.Identity(ufl.shape(eps)[0])
+        if self.hoop is not None:
+            _, mu, lmbda = self._moduli()
+            return 2.0 * mu * eps + lmbda * self.volumetric_strain(u) * ufl.Identity(2)
         return self.stress(eps)
+
+    def volumetric_strain(self, u: Expr) -> Expr:
+        """tr eps: div u, plus the hoop strain of an axisymmetric body."""
+        return ufl.div(u) if self.hoop is None else ufl.div(u) + self.hoop(u)
+
+    def hoop_stress(self, u: Expr, p: Expr | None = None) -> Expr:
+        """sigma_tt of an axisymmetric body: 2 mu eps_tt + lambda tr eps (mixed: 2 mu eps_tt
+        - p)."""
+        assert self.hoop is not None
+        _, mu, lmbda = self._moduli()
+        if p is not None:
+            return 2.0 * mu * self.hoop(u) - p
+        return 2.0 * mu * self.hoop(u) + lmbda * self.volumetric_strain(u)
+
+    def hoop_work(self, u: Expr, p: Expr | None, v: Expr) -> Expr | None:
+        """sigma_tt(u, p) v_r / r: the hoop term of the weak form (None: not axisymmetric)."""
+        if self.hoop is None:
+            return None
+        return self.hoop_stress(u, p) * self.hoop(v)
 
     # -- the Material protocol -----------------------------------------------------------------
     def weak_stress(self, u: Expr, p: Expr | None = None) -> Expr:
@@ -176,7 +202,7 @@ class Elastic:
     def pressure_law(self, u: Expr, p: Expr, q: Expr) -> Expr:
         """Integrand -(div u + p / lambda) q: the pressure's constitutive law p = -lambda div u
         tested with q (mixed u-p formulation; needs lambda > 0)."""
-        return -(ufl.div(u) + p / self._moduli()[2]) * q
+        return -(self.volumetric_strain(u) + p / self._moduli()[2]) * q
 
     def von_mises(self, u: Expr, p: Expr | None = None) -> Expr:
         """von Mises stress of u, or of the mixed pair (u, p)."""
@@ -187,6 +213,8 @@ class Elastic:
         if d == 2:  # plane strain: add sigma_zz = nu (sigma_xx + sigma_yy), = -p when mixed
             nu = self.nu if self.poisson is None else self.poisson
             szz = nu * (s[0, 0] + s[1, 1]) if p is None else -p
+            if self.hoop is not None:  # axisymmetric: the hoop stress
+                szz = self.hoop_stress(u, p)
             dev = s - (s[0, 0] + s[1, 1] + szz) / 3.0 * ufl.Identity(2)
             j2 = 0.5 * (ufl.inner(dev, dev) + (szz - (s[0, 0] + s[1, 1] + szz) / 3.0) ** 2)
         else:

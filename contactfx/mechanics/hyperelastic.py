@@ -234,6 +234,13 @@ class Hyperelastic:
         """The modulus of the mixed formulation's pressure law (K; None: not offered)."""
         return self.K
 
+    def hoop_work(self, u: Expr, p: Expr | None, v: Expr) -> Expr | None:
+        """P_tt(u, p) v_r / r: the hoop term of the weak form of an axisymmetric body (None:
+        not axisymmetric)."""
+        if self.hoop is None:
+            return None
+        return self.piola(u, p)[2, 2] * self.hoop(v)
+
     def pressure_law(self, u: Expr, p: Expr, q: Expr) -> Expr:
         """Integrand -(ln J + p / K) q: the pressure's law p = -K ln J tested with q."""
         if self.K is None:

@@ -9,6 +9,8 @@ A material answers in UFL, for the state u (and the pressure p of a mixed u-p fo
 * ``traction(u, p, N)`` = S(u) N on a facet of reference unit normal N and
   ``traction_derivative(u, p, v, q, N)``: what a contact method's consistency terms read
   (Nitsche's n . sigma(u) n, its tangential part);
+* ``hoop_work(u, p, v)``: an axisymmetric body's hoop term S_tt v_r / r of the weak form (None
+  for other bodies; :mod:`contactfx.mechanics.axisymmetric`);
 * ``cauchy(u, p)`` and ``von_mises(u, p)`` for the output;
 * ``E`` (the reference modulus of the closed forms; the scenes' contact modulus scales the
   methods' parameters, gamma_N = gamma0 E / h) and ``density`` (None in a static run);
@@ -50,6 +52,8 @@ class Material(Protocol):
     def traction(self, u: Any, p: Any, N: Any) -> Any: ...
 
     def traction_derivative(self, u: Any, p: Any, v: Any, q: Any, N: Any) -> Any: ...
+
+    def hoop_work(self, u: Any, p: Any, v: Any) -> Any: ...
 
     def cauchy(self, u: Any, p: Any = None) -> Any: ...
 

@@ -7,7 +7,7 @@ from contactfx.scenes.bar import Bar1D
 from contactfx.scenes.base import Scene
 from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
-from contactfx.scenes.hertz import Hertz2D, Hertz3D
+from contactfx.scenes.hertz import Hertz2D, Hertz3D, HertzAxi
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
@@ -22,6 +22,7 @@ SCENES: dict[str, type[Scene]] = {
     for cls in (
         Hertz2D,
         Hertz3D,
+        HertzAxi,
         Westergaard,
         FlatPunch2D,
         FlatPunch3D,

@@ -69,6 +69,9 @@ class Scene:
     Params: ClassVar[type]
     problem: ClassVar[type]
     numerics_defaults: ClassVar[dict] = {}
+    #: a body of revolution computed on its (r, z) section (x[0] = r >= 0):
+    #: :mod:`contactfx.mechanics.axisymmetric`
+    axisymmetric: ClassVar[bool] = False
 
     def __init__(self, params) -> None:
         self.p = params

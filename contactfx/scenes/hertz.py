@@ -325,3 +325,73 @@ class Hertz3D(QuarterBlock):
     def friction_reference(self, q, friction) -> dict[str, float]:
         ref = hertz_3d(q.force, self.p.radius, self.material().E_star)
         return cattaneo_mindlin(q.friction, ref["a"], exponent=1.0 / 3.0)
+
+
+@dataclass(frozen=True)
+class HertzAxiParams(elastic(1000.0, 0.3)):
+    radius: float = param(1.0, "indenter radius R", positive=True)
+    profile: str = param("parabola", "indenter profile", choices=("circle", "parabola"))
+    depth: float = param(0.01, "indentation depth (ramped over the load steps)", positive=True)
+    block_radius: float = param(1.0, "radius of the cylindrical block", positive=True)
+    height: float = param(1.0, "block height", positive=True)
+    h_contact: float = param(5e-3, "element size in the contact zone", positive=True)
+    h_far: float = param(0.1, "element size far from the contact zone", positive=True)
+    refine_radius: float = param(0.15, "radius of the refined zone", positive=True)
+
+
+class HertzAxi(ObstacleScene):
+    """The indentation of hertz3d as a body of revolution: a rigid sphere (or paraboloid) of
+    radius R pressed into a cylindrical block of radius ``block_radius`` and height
+    ``height``, computed on its (r, z) section [0, block_radius] x [-height, 0]
+    (:mod:`contactfx.mechanics.axisymmetric`): the axis r = 0 holds u_r = 0, the bottom is
+    clamped, the side free. Hertz's 3D closed forms at the computed force (Johnson 1985,
+    doi:10.1017/CBO9781139171731, 4.2), with a 2D mesh."""
+
+    name = "hertz-axi"
+    summary = (
+        "rigid sphere pressed into a cylindrical block, axisymmetric (r-z section); reference "
+        "Hertz 3D a and p0"
+    )
+    Params = HertzAxiParams
+    contact_tag = RectangleFacets.TOP
+    axisymmetric = True
+    #: forces and areas are 2 pi times their integrals over the section (weighted by r)
+    symmetry = 2.0 * np.pi
+    #: the radial tangential tractions cancel over the revolution
+    tangential_symmetry = (0.0, 0.0, 0.0)
+
+    def mesh_builder(self):
+        p = self.p
+        return functools.partial(
+            rectangle,
+            x0=0.0,
+            x1=p.block_radius,
+            y0=-p.height,
+            y1=0.0,
+            refine_x0=0.0,
+            refine_x1=p.refine_radius,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+        ), 2
+
+    def obstacle(self) -> Obstacle:
+        return _indenter(self.p.profile, self.p.radius)
+
+    def obstacle_offset(self, t: float, gdim: int) -> np.ndarray:
+        return _indent_then_shift(t, self.p.depth, 0.0, gdim)
+
+    def dirichlet(self, V, facet_tags):
+        return [
+            *fix(V, facet_tags, RectangleFacets.BOTTOM),
+            fix_component(V, facet_tags, RectangleFacets.LEFT, 0),
+        ]
+
+    def contact_size(self, measure: float) -> float:
+        """The contact radius of the contact area pi a^2 (2 pi times int r dl)."""
+        return float(np.sqrt(measure / np.pi))
+
+    def reference(self, force: float) -> dict[str, float]:
+        return hertz_3d(force, self.p.radius, self.material().E_star)
+
+    def exact_pressure(self, x, ref: dict):
+        return _elliptic(ref["p0"], x[0] ** 2 / ref["a"] ** 2)

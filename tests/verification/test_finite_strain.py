@@ -27,6 +27,7 @@ Measured (h = 0.1, two load steps):
 from __future__ import annotations
 
 import dataclasses
+import functools
 from pathlib import Path
 
 import dolfinx.fem
@@ -103,12 +104,71 @@ class UniaxialBlock(SlidingBlock):
         diff = ufl.grad(problem.U) - G
         form = dolfinx.fem.form(ufl.inner(diff, diff) * ufl.dx)
         comm = problem.mesh.comm
-        area = self.p.width * self.p.height
+        area = (0.5 if self.axisymmetric else 1.0) * self.p.width * self.p.height
         err = np.sqrt(comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM) / area)
         self.grad_error = err / np.hypot(l1 - 1.0, l2 - 1.0)
 
 
 PARAMS = dataclasses.replace(UniaxialBlock.Params(), pressure=P, shift=0.0, h=0.1)
+
+
+def axial_stretches(model: str, m, p: float) -> np.ndarray:
+    """(l1, l2) of a cylinder in uniaxial stress along its axis: F = diag(l1, l2, l1) (r, z,
+    theta) with P_rr = P_tt = 0, P_zz = -p (the complex-step derivatives of psi); linear:
+    1 + the small-strain strains nu p / E, -p / E."""
+    if model == "linear":
+        return np.array([1.0 + m.nu * p / m.E, 1.0 - p / m.E])
+
+    def residual(lam):
+        def energy(a, b):
+            return psi(model, m, np.diag([a, b, lam[0]]).astype(complex))
+
+        e = 1e-30
+        return np.array(
+            [energy(lam[0] + 1j * e, lam[1]).imag / e, energy(lam[0], lam[1] + 1j * e).imag / e + p]
+        )
+
+    lam = np.array([1.0, 1.0])
+    for _ in range(30):
+        r = residual(lam)
+        Jm = np.column_stack([(residual(lam + d) - r) / 1e-7 for d in np.eye(2) * 1e-7])
+        lam = lam - np.linalg.solve(Jm, r)
+    # round-off of the energy's terms, the largest lambda (ln J)^2
+    assert np.linalg.norm(residual(lam)) < 1e-12 * p + 1e-15 * m.lmbda
+    return lam
+
+
+class UniaxialCylinder(UniaxialBlock):
+    """The block as a body of revolution: the cylinder r < L/2, -H < z < 0 (its section
+    [0, L/2] x [-H, 0], the roller on r = 0 the axis) pushed by the dead pressure p on its
+    bottom against the plane; the exact state is the homogeneous uniaxial stress
+    F = diag(l1, l2, l1) in (r, z, theta), u_r = (l1 - 1) r."""
+
+    name = "uniaxial-cylinder"
+    axisymmetric = True
+    symmetry = 2.0 * np.pi
+
+    def mesh_builder(self):
+        builder, gdim = super().mesh_builder()
+        return functools.partial(builder, x0=0.0, refine_x0=0.0), gdim
+
+    def contact_size(self, measure: float) -> float:
+        return float(np.sqrt(measure / np.pi))
+
+    def reference(self, force: float) -> dict[str, float]:
+        return {"force": self.p.pressure * np.pi * (0.5 * self.p.width) ** 2}
+
+    def on_step(self, problem, solver, load, quantities) -> None:
+        material = self.material_used = problem.material
+        model = material.name if material.finite_strain else "linear"
+        l1, l2 = axial_stretches(model, material, min(2.0 * load, 1.0) * self.p.pressure)
+        G = ufl.as_matrix([[l1 - 1.0, 0.0], [0.0, l2 - 1.0]])
+        diff = ufl.grad(problem.U) - G
+        form = dolfinx.fem.form(ufl.inner(diff, diff) * ufl.dx)
+        comm = problem.mesh.comm
+        area = (0.5 if self.axisymmetric else 1.0) * self.p.width * self.p.height
+        err = np.sqrt(comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM) / area)
+        self.grad_error = err / np.hypot(l1 - 1.0, l2 - 1.0)
 
 
 def solve(comm=MPI.COMM_WORLD, pressure=P, **numerics):
@@ -161,6 +221,32 @@ def test_finite_strain_fields(tmp_path):
     np.testing.assert_allclose(sigma[:, 0, 0], 0.0, atol=1e-9 * P)
     np.testing.assert_allclose(surface["contact_pressure"], P, rtol=1e-9)
     np.testing.assert_allclose(surface["contact_pressure_current"], P / l1, rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "model, options",
+    [
+        ("linear", {}),
+        ("neo-hookean", {}),
+        ("mooney-rivlin:c10=150,c01=40", {}),
+        ("neo-hookean:E=1000,nu=0.4999", {"degree": 2, "formulation": "mixed-up"}),
+    ],
+)
+@pytest.mark.parametrize("method", ["nitsche", "penalty"])
+def test_axisymmetric_patch(model, options, method):
+    scene = UniaxialCylinder(PARAMS)
+    num = Numerics(friction="none", mu=0.0, steps=2, method=method, material=model, **options)
+    res = scene.run(num, verbose=False)
+    # the weight r in every integral and the hoop term: the force is 2 pi int p r dr =
+    # p pi (L/2)^2 (equilibrium, exact); Nitsche reproduces the homogeneous state to the solver's
+    # tolerance (measured 1e-12), penalty's stiffness follows the facets' jitter (as in
+    # plane strain, test_uniaxial_patch_stiffness_methods)
+    assert res.force == pytest.approx(P * np.pi * (0.5 * PARAMS.width) ** 2, rel=1e-9)
+    if method == "nitsche":
+        assert scene.grad_error < 1e-9
+        assert res.peak_pressure == pytest.approx(P, rel=1e-9)
+    else:
+        assert abs(res.peak_pressure / P - 1.0) < 5e-3
 
 
 def test_uniaxial_patch_uzawa():
