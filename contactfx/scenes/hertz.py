@@ -357,8 +357,8 @@ class HertzAxi(ObstacleScene):
     axisymmetric = True
     #: forces and areas are 2 pi times their integrals over the section (weighted by r)
     symmetry = 2.0 * np.pi
-    #: the radial tangential tractions cancel over the revolution
-    tangential_symmetry = (0.0, 0.0, 0.0)
+    #: the radial tangential tractions cancel over the revolution, the axial ones add
+    tangential_symmetry = (0.0, 2.0 * np.pi, 0.0)
 
     def mesh_builder(self):
         p = self.p

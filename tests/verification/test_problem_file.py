@@ -64,6 +64,7 @@ def test_contact_pair_problem_reactions_balance():
         "pressurised-crack.toml",
         "bored-block.toml",
         "rubber-pad.toml",
+        "o-ring.toml",
     ],
 )
 def test_problem_file_ranks_agree(name):
@@ -85,6 +86,28 @@ def test_set_overrides_a_key():
     assert len(res.steps) == 1
     # half the indentation: a smaller force (Hertz-like growth, faster than linear)
     assert 0.2 * full.force < res.force < 0.5 * full.force
+
+
+def test_axisymmetric_o_ring():
+    scene, res = _solve("o-ring.toml")
+    reaction = scene.reaction_rows[-1]["midplane_y"]
+    # the flat plate presses along z only: the mid-plane's reaction carries the contact force
+    # exactly (both totals over the circumference, 2 pi times the section's per-radian
+    # integrals), to the solver's tolerance
+    assert res.force > 0.0
+    assert reaction == pytest.approx(res.force, rel=1e-8)
+    # the reported size is the contact area (output.contact_size = "measure"): a band of the
+    # ring's circumference 2 pi 10 and of a width below the section's diameter 3
+    assert 0.0 < res.contact_size < 2.0 * np.pi * 11.5 * 3.0
+
+
+@pytest.mark.serial_only
+def test_axisymmetric_mesh_must_lie_in_r_positive(tmp_path):
+    text = GOOD.replace("size = 1.0", "size = 1.0\naxisymmetric = true")
+    path = _write(tmp_path, text)
+    scene, _, _ = load_problem(path)
+    with pytest.raises(ValueError, match=r"mesh.axisymmetric: .* needs x = r >= 0, got x = -1"):
+        scene.build_mesh(MPI.COMM_SELF)
 
 
 def test_hyperelastic_body():

@@ -111,6 +111,13 @@ class Reader:
         """The number ``name`` of ``data`` if given, else None."""
         return self.number(data, key, name, positive=positive) if name in data else None
 
+    def flag(self, data: dict, key: str, name: str, default: bool = False) -> bool:
+        """The boolean ``name`` of ``data`` (``true`` / ``false``)."""
+        value = data.get(name, default)
+        if not isinstance(value, bool):
+            self.fail(f"{key}.{name}", f"expected true or false, got {value!r}")
+        return value
+
     def string(
         self, data: dict, key: str, name: str, choices: Any = None, default: Any = None
     ) -> str:

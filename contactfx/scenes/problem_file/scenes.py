@@ -63,9 +63,15 @@ class _FileMesh:
         self.summary = f"problem file {problem.path.name}"
         self.reaction_rows: list[dict] = []
         self._constants: list[tuple[dolfinx.fem.Constant, list, np.ndarray]] = []
-        self.symmetry = problem.output.symmetry
+        self.axisymmetric = problem.mesh.axisymmetric
+        # a body of revolution: forces and areas 2 pi times the section's (weighted) integrals;
+        # the radial forces cancel over the revolution, the axial ones add
+        turn = 2.0 * np.pi if self.axisymmetric else 1.0
+        self.symmetry = problem.output.symmetry * turn
         if problem.output.tangential_symmetry is not None:
             self.tangential_symmetry = tuple(problem.output.tangential_symmetry)
+        elif self.axisymmetric:
+            self.tangential_symmetry = (0.0, turn * problem.output.symmetry, 0.0)
 
     def _fail(self, key: str, message: str):
         raise ProblemError(f"{self.spec.path}: {key}: {message}")
@@ -88,7 +94,22 @@ class _FileMesh:
         self.cell_tags = data.cell_tags
         self._facet_tags = data.facet_tags
         self._check_groups()
+        if self.axisymmetric:
+            self._check_axisymmetric(data.mesh)
         return data.mesh, data.facet_tags
+
+    def _check_axisymmetric(self, mesh) -> None:
+        """An axisymmetric mesh is 2D and lies in r = x >= 0 (collective)."""
+        if self.gdim != 2:
+            self._fail("mesh.axisymmetric", f"needs a 2D mesh (r, z), got {self.gdim}D")
+        x = mesh.geometry.x[:, 0]
+        lowest = mesh.comm.allreduce(float(x.min(initial=np.inf)), op=MPI.MIN)
+        extent = mesh.comm.allreduce(float(np.abs(x).max(initial=0.0)), op=MPI.MAX)
+        if lowest < -1e-10 * max(extent, 1.0):
+            self._fail(
+                "mesh.axisymmetric",
+                f"the mesh is the (r, z) section: it needs x = r >= 0, got x = {lowest:.6g}",
+            )
 
     def group_list(self) -> str:
         return ", ".join(f"{g.name} ({g.dim}D)" for g in self.groups.values())
@@ -226,7 +247,7 @@ class _FileMesh:
         half-width (2D) or the radius of the disc of the same area (3D); ``output.contact_size``
         chooses half-measure, measure or disc-radius."""
         rule = self.spec.output.contact_size or (
-            "disc-radius" if self.gdim == 3 else "half-measure"
+            "disc-radius" if self.gdim == 3 or self.axisymmetric else "half-measure"
         )
         if rule == "measure":
             return measure
@@ -291,7 +312,8 @@ class _FileMesh:
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float, quantities) -> None:
         """The step's contact force, the probes, and the reaction force of each group of
-        ``output.reactions``: the force the supports exert on the body there, per component.
+        ``output.reactions``: the force the supports exert on the body there, per component
+        (axisymmetric: totals over the circumference).
         At a solution f_int(u) - f_ext + F_c(u) = R, nonzero on the supported dofs only
         (ContactSNES.reactions); R is summed over the group's owned dofs. (The condensed
         mortar rewrites the rows of the slave nodes: a support sharing nodes with a mortar
@@ -303,6 +325,10 @@ class _FileMesh:
             return
         r = solver.reactions()
         values = r.getArray()
+        # axisymmetric: the residual is per radian; report the total over the circumference
+        # (Abaqus's convention for CAX elements: the radial one is the sum of the radial
+        # forces all around, whose vector sum vanishes)
+        turn = 2.0 * np.pi if self.axisymmetric else 1.0
         n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
         for g in self.spec.output.reactions:
             facets = self._facet_tags.indices[self._facet_tags.values == self.groups[g].tag]
@@ -311,7 +337,7 @@ class _FileMesh:
                     _compat.locate_dofs_topological(problem.V.sub(c), self.gdim - 1, facets)
                 )
                 owned = dofs[dofs < n_owned]
-                total = float(np.sum(values[owned]))
+                total = float(np.sum(values[owned])) * turn
                 row[f"{g}_{AXES[c]}"] = problem.mesh.comm.allreduce(total, op=MPI.SUM)
         r.destroy()
         self.reaction_rows.append(row)

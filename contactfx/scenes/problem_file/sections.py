@@ -43,7 +43,7 @@ from contactfx.scenes.two_body_base import CONTACT_EDGES
 __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read"]
 
 KEYS = {
-    "mesh": ("file", "size", "builder", "parameters"),
+    "mesh": ("file", "size", "builder", "parameters", "axisymmetric"),
     "bodies": (
         "group",
         "material",
@@ -121,6 +121,7 @@ _ROUND = ("circle", "cylinder", "sphere", "parabola", "paraboloid", "punch")
 
 def read_mesh(r: Reader, data: dict) -> MeshSpec:
     mesh = r.table(data.get("mesh", {}), "mesh", KEYS["mesh"])
+    axisymmetric = r.flag(mesh, "mesh", "axisymmetric")
     if "builder" in mesh:
         for k in ("file", "size"):
             if k in mesh:
@@ -132,11 +133,12 @@ def read_mesh(r: Reader, data: dict) -> MeshSpec:
                 "mesh.parameters", f"expected a table of the builder's parameters, got {params!r}"
             )
         params = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
-        return MeshSpec(None, 1.0, (name, params))
+        return MeshSpec(None, 1.0, (name, params), axisymmetric)
     if "parameters" in mesh:
         r.fail("mesh.parameters", "parameters belong to a builder: give mesh.builder")
     mesh_file = (r.path.parent / r.string(mesh, "mesh", "file")).resolve()
-    return MeshSpec(mesh_file, r.number(mesh, "mesh", "size", 1.0, positive=True))
+    size = r.number(mesh, "mesh", "size", 1.0, positive=True)
+    return MeshSpec(mesh_file, size, None, axisymmetric)
 
 
 def read_bodies(r: Reader, data: dict) -> tuple[BodySpec, ...]:

@@ -53,11 +53,14 @@ Expression = Callable[[Any], Any]
 @dataclass(frozen=True)
 class MeshSpec:
     """``[mesh]``: a mesh file (``.msh``, or ``.geo`` meshed with the size factor ``size``)
-    or a built-in geometry ``builder`` = (name, parameters)."""
+    or a built-in geometry ``builder`` = (name, parameters); ``axisymmetric``: the 2D mesh is
+    the (r, z) section of a body of revolution."""
 
     file: Path | None
     size: float = 1.0
     builder: tuple[str, dict] | None = None
+    #: a 2D mesh of the (r, z) section of a body of revolution (x = r >= 0)
+    axisymmetric: bool = False
 
     @property
     def label(self) -> str:
