@@ -58,7 +58,10 @@ def write_problem(
             write_msh(builder, gdim, msh, scene.name, binary=True)  # exact coordinates
             doc = {
                 "title": scene.name,
-                "mesh": {"file": msh.name},
+                "mesh": {
+                    "file": msh.name,
+                    **({"axisymmetric": True} if scene.axisymmetric else {}),
+                },
                 **tables,
                 "numerics": numerics_table(numerics),
             }

@@ -386,6 +386,21 @@ class HertzAxi(ObstacleScene):
             fix_component(V, facet_tags, RectangleFacets.LEFT, 0),
         ]
 
+    def problem_data(self, numerics) -> dict:
+        p = self.p
+        shape = "circle" if p.profile == "circle" else "parabola"
+        return {
+            "bodies": [export.body("domain", self.material())],
+            "boundary": [export.fixed("bottom", (0, 1)), export.fixed("left", (0,))],
+            "obstacle": {
+                "shape": shape,
+                "contact": "top",
+                "radius": p.radius,
+                "h": p.h_contact,
+                **export.motion(self.obstacle_offset, 2),
+            },
+        }
+
     def contact_size(self, measure: float) -> float:
         """The contact radius of the contact area pi a^2 (2 pi times int r dl)."""
         return float(np.sqrt(measure / np.pi))

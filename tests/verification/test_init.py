@@ -30,7 +30,10 @@ OBSTACLE_CASES = [
     ("punch3d", {"h_contact": 0.02, "h_far": 0.4}, {"method": "penalty"}),
     ("westergaard", {"h_contact": 1.0 / 32}, {}),
     ("sliding-block", {"h": 0.1}, {"steps": 4}),
+    ("sliding-block", {"h": 0.1, "pressure": 100.0}, {"steps": 4, "material": "neo-hookean"}),
     ("bar1d", {}, {}),
+    ("hertz-axi", {"h_contact": 0.01}, {}),
+    ("hertz-axi", {"h_contact": 0.01, "profile": "circle"}, {"material": "neo-hookean"}),
 ]
 _PLATE = {"plate_width": 8.0, "h_crack": 0.1, "h_tip": 0.05, "h_far": 1.0, "grading": 0.3}
 INTERFACE_CASES = [
