@@ -81,6 +81,26 @@ CASES: dict[str, BenchCase] = {
     ),
     # level 0 has about 2e3 dofs and level 4 about 9e5 (P1)
     "hertz3d": BenchCase("hertz3d", {}, 1.4, "Hertz sphere, quarter model", p2_levels=2),
+    # the sphere on its axisymmetric section (r, z): level 0 has about 700 dofs
+    "hertz-axi": BenchCase("hertz-axi", {}, 2.0, "Hertz sphere, axisymmetric (r, z) section"),
+    # finite strain (neo-Hookean) at a / R = 0.13 (2D) and 0.2 (3D): the errors are against
+    # small-strain Hertz, which the nonlinearity leaves by about 0.1 a / R (docs/verification.md
+    # section 15); the columns to read are the Newton counts and the times
+    "hertz2d-finite": BenchCase(
+        "hertz2d",
+        {"profile": "circle", "depth": 0.024, "refine_half_width": 0.15},
+        2.0,
+        "Hertz cylinder, neo-Hookean, a / R = 0.13 (against small-strain Hertz)",
+        numerics={"material": "neo-hookean", "steps": 2},
+    ),
+    "hertz3d-finite": BenchCase(
+        "hertz3d",
+        {"profile": "circle", "depth": 0.04, "refine_radius": 0.3},
+        1.4,
+        "Hertz sphere, neo-Hookean, a / R = 0.2 (against small-strain Hertz)",
+        p2_levels=1,
+        numerics={"material": "neo-hookean", "steps": 2},
+    ),
     "westergaard-partial": BenchCase(
         "westergaard", {"mean_pressure_ratio": 0.5}, 2.0, "Westergaard, partial contact p_m = p*/2"
     ),
