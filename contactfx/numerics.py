@@ -74,7 +74,8 @@ class _General:
     )
     search_update: str = param(
         "step",
-        "two-body contact search: once per load step, or at every Newton iteration",
+        "two-body contact search: once per load step, or at every Newton iteration (always "
+        "with a finite-strain --material: the contact in the deformed configuration)",
         choices=("step", "newton"),
     )
 

@@ -130,6 +130,7 @@ class Mortar(MethodBase):
             "interfaces": "a mortar pair joins two meshed surfaces",
             "friction": "mortar has Coulomb friction only",
             "iterative": "its condensed Jacobian is not symmetric: use LU",
+            "two_body_finite_strain": "not verified between finite-strain bodies yet",
         },
     )
 

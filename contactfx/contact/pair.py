@@ -227,6 +227,9 @@ class ContactPair:
     E: float
     search_each_newton: bool = False
     fixed: np.ndarray | None = None
+    #: finite-strain bodies: the couplings linearise the variation of the master normal and
+    #: of the projection (:mod:`contactfx.contact.point_coupling`)
+    finite_strain: bool = False
     searches: int = 0
     search_time: float = 0.0
     radius: float = field(default=0.0)

@@ -58,6 +58,7 @@ class Penalty(TrialFriction, MethodBase):
         interfaces=True,
         two_body=True,
         two_body_friction=False,
+        two_body_finite_strain=True,
         why_not={"two_body_friction": "its traction history is kept on one body's surface only"},
     )
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)

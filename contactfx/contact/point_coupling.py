@@ -29,6 +29,26 @@ left out is the curvature (geometric) stiffness.
 Points whose projection falls off the master surface (no candidate facet within the search
 radius, or the closest point on an edge of the master surface that no other master facet
 shares) are not in contact.
+
+Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
+the penalty only, and always searched at every Newton iteration): everything above is already
+in the current configuration, x = X + u on both sides: the slave Gauss points, the master facets,
+their normal n_m and the closest point y. The weights are the Gauss weights of the REFERENCE
+slave facet, so P = kappa [-g]_+ is a nominal pressure (force per unit reference area of the
+slave) acting along the current master normal: the large-deformation penalty of Wriggers 2006
+(Computational Contact Mechanics, 2nd ed., doi:10.1007/978-3-540-32609-0, chapter 4, the
+penalty term int kappa g_N delta g_N dA over the reference slave surface; section 4.2 for
+the closest-point projection and its variations). Under finite strain the terms the small-
+strain Jacobian leaves out (the variation of the master normal with the rotation of the
+master facet, and of the projection's coordinate with the sliding of the point, of relative
+size q / E per Newton step) stall Newton at strains of several %; the Jacobian of a point
+whose projection falls inside its master facet is then the exact derivative of its residual
+w kappa [-g]_+ ([v_s(x)] - [v_m(y(u))]) . n(u) in the dofs of the slave cell and the master
+facet, with y the closest point on the master facet's line (2D) or plane (3D) and n its unit
+normal, both functions of u: computed by complex-step differentiation of the vectorised
+residual (Squire and Trapp 1998, doi:10.1137/S003614459631241X), exact to round-off, which
+gives Newton's quadratic convergence without writing Wriggers' geometric terms by hand.
+Points at a vertex of the master surface keep the Jacobian above.
 """
 
 from __future__ import annotations
@@ -124,6 +144,9 @@ class PointCoupling:
             dirs.append(_Directed(pair.master, pair.slave, 0.5, pair.master_lame))
         self.dirs = dirs
         self.scatter: PETSc.Scatter | None = None
+        #: finite strain (penalty): the Jacobian with the variation of the master normal and
+        #: of the projection (module docstring)
+        self.geometric = pair.finite_strain and law.kind == "penalty"
         #: Coulomb coefficient (None: frictionless) and the last converged state (history)
         self.mu = pair.mu
         self.previous = pair.previous
@@ -237,6 +260,8 @@ class PointCoupling:
         return dict(
             **extra,
             rows=rows,
+            N=N,
+            inside=paired & np.asarray(pick.inside, dtype=bool),
             Jn=Jn,
             S=S,
             w=w,
@@ -409,10 +434,62 @@ class PointCoupling:
                 if theta != 0:
                     A -= tt * np.einsum("pig,pjg->pij", p["ST"], p["ST"])
             A *= p["w"][:, None, None]
+            if self.geometric:
+                inside = p["inside"]
+                A[inside] = self._geometric_tangent(p, vals, inside)
             keep = np.any(A != 0.0, axis=(1, 2))
             for rows, block in zip(p["rows"][keep], A[keep], strict=True):
                 J.setValues(rows, rows, block, addv=add)
         J.assemble()
+
+    def _point_residual(self, p: _Points, x: np.ndarray, sel: np.ndarray) -> np.ndarray:
+        """The penalty residual w kappa [-g]_+ [N n, -N_m(y) n] of the points ``sel`` of p at
+        the current nodal positions x (P, 2d + 1, gdim) of their slave cell and master facet
+        (real or complex: what :meth:`_geometric_tangent` differentiates), with the master
+        facet's unit normal and the closest point y on its line / plane recomputed from x."""
+        d = x.shape[1] // 2
+        N = p["N"][sel]
+        xs = np.einsum("pa,pag->pg", N, x[:, : d + 1])
+        xm = x[:, d + 1 :]
+        e = xm[:, 1:] - xm[:, :1]  # (P, d - 1, gdim) the facet's edge vectors from vertex 0
+        r = xs - xm[:, 0]
+        if d == 2:
+            t = e[:, 0]
+            nm = np.stack([t[:, 1], -t[:, 0]], axis=1)
+            xi = np.einsum("pg,pg->p", r, t) / np.einsum("pg,pg->p", t, t)
+            bary = np.stack([1.0 - xi, xi], axis=1)
+        else:
+            nm = np.cross(e[:, 0], e[:, 1])
+            G = np.einsum("pig,pjg->pij", e, e)
+            b = np.einsum("pig,pg->pi", e, r)
+            det = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] * G[:, 1, 0]
+            a1 = (G[:, 1, 1] * b[:, 0] - G[:, 0, 1] * b[:, 1]) / det
+            a2 = (G[:, 0, 0] * b[:, 1] - G[:, 1, 0] * b[:, 0]) / det
+            bary = np.stack([1.0 - a1 - a2, a1, a2], axis=1)
+        # the unit normal without conjugation (analytic: complex steps pass through)
+        nm = nm / np.sqrt(np.einsum("pg,pg->p", nm, nm))[:, None]
+        y = np.einsum("pb,pbg->pg", bary, xm)
+        g = np.einsum("pg,pg->p", xs - y, nm)
+        arg = -p["scale"][sel] * g
+        P = np.where(arg.real > -p["tie"][sel], arg, 0.0)
+        n = -nm
+        Jn = np.concatenate([N[:, :, None] * n[:, None, :], -bary[:, :, None] * n[:, None, :]], 1)
+        return (p["w"][sel] * P)[:, None] * Jn.reshape(len(N), -1)
+
+    def _geometric_tangent(self, p: _Points, vals: np.ndarray, sel: np.ndarray) -> np.ndarray:
+        """(P, m, m): the exact derivative of :meth:`_point_residual` of the points ``sel`` in
+        their m dofs, by complex steps (one per dof, vectorised over the points)."""
+        gdim = self.layout.gdim
+        x = (p["X"][sel] + vals[p["idx"][sel]]).astype(complex)
+        m = x.shape[1]
+        x = x.reshape(len(x), -1, gdim)
+        A = np.zeros((len(x), m, m))
+        step = 1e-30  # Im r(x + i h e_j) / h = dr / dx_j to round-off (no cancellation)
+        for j in range(m):
+            xj = x.reshape(len(x), m).copy()
+            xj[:, j] += 1j * step
+            A[:, :, j] = self._point_residual(p, xj.reshape(x.shape), sel).imag / step
+        return A
 
     def search_gaps(self) -> np.ndarray:
         """The gaps of this rank's paired Gauss points at the last search."""

@@ -2,6 +2,14 @@
 no node), a material per body, and a contact pair (slave surface, master surface) enforced by
 a two-body method's coupling (:mod:`contactfx.contact.coupling`).
 
+Materials: small-strain elasticity with a DG0 field of E and nu over the bodies' cells (a
+bilinear bulk, assembled once), or under a finite-strain ``--material`` (a hyperelastic model
+of :mod:`contactfx.mechanics.hyperelastic`) the same model in every body, each with its own
+small-strain E and nu from the scene: the internal work sum_i int_{body i} P_i(u) : grad v dX
+over the cell tags (a nonlinear bulk, assembled at every Newton iteration). Finite strain
+searches the pair at every Newton iteration (the contact in the deformed configuration,
+:mod:`contactfx.contact.point_coupling`) and is offered with the penalty method for now.
+
 Unknown: the P1 displacement of all bodies. Surface: the pair's two sides
 (:class:`contactfx.contact.pair.ContactPair`). Post-processing: the contact force of the pair,
 the nodal pressure and gap on the slave surface, the contact size, penetration and
@@ -13,6 +21,8 @@ against the scene's closed form, ``pressure.png``, when an output folder is give
 
 from __future__ import annotations
 
+import functools
+import operator
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -53,8 +63,15 @@ def _not_offered(
 class TwoBodyProblem(Problem):
     """Bodies in contact through a pair of non-matching surfaces (see the module docstring)."""
 
+    #: a hyperelastic material is written as an internal work (``internal_form``)
+    nonlinear_bulk = True
+
     #: no UFL surface: the contact is the solver's coupling of the pair
     surface: None
+    #: whether the bodies are finite-strain (a hyperelastic ``--material``)
+    finite_strain: bool
+    #: finite strain: each body's material by its cell tag (empty for small strain)
+    body_materials: dict[int, Any]
     layout: NodeLayout
     pair: ContactPair
     _coupling: Any
@@ -83,6 +100,16 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
+        if numerics.bulk_material(scene.material()).finite_strain:
+            if not method.supports.two_body_finite_strain:
+                raise _not_offered(
+                    method,
+                    "two_body_finite_strain",
+                    f"is not offered between two finite-strain bodies (--material "
+                    f"{numerics.material}): finite strain between two meshed bodies is offered "
+                    "with penalty for now",
+                    lambda c: c.two_body and c.two_body_finite_strain,
+                )
 
     def __init__(
         self,
@@ -93,9 +120,21 @@ class TwoBodyProblem(Problem):
         facet_tags: Any,
     ) -> None:
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.slave_tag]
+        self.finite_strain = numerics.bulk_material(scene.material()).finite_strain
+        self.body_materials = {}
+        if self.finite_strain:
+            self.body_materials = {
+                int(scene.cells[body]): numerics.bulk_material(elastic)
+                for body, elastic in scene.materials().items()
+            }
         super().__init__(scene, numerics, method, mesh, facet_tags)
 
     def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
+        """Small strain: the bodies' material with DG0 fields of E and nu. Finite strain: the
+        slave body's (homogeneous) elastic material, which ``--material`` makes hyperelastic
+        (the bulk is written per body with ``body_materials``)."""
+        if self.finite_strain:
+            return self.scene.material()
         return self.scene.body_material(mesh)
 
     def boundary_conditions(self) -> list[Any]:
@@ -122,8 +161,11 @@ class TwoBodyProblem(Problem):
             side_of(self.V, self.facet_tags, scene.slave_tag),
             side_of(self.V, self.facet_tags, scene.master_tag),
             scene.contact_modulus(),
-            search_each_newton=self.num.search_update == "newton",
+            # finite strain: the contact in the deformed configuration, searched at every
+            # Newton iteration (large sliding moves a point across master facets in a step)
+            search_each_newton=self.num.search_update == "newton" or self.finite_strain,
             fixed=fixed,
+            finite_strain=self.finite_strain,
         )
         if self.friction is not None:
             assert isinstance(self.friction, Coulomb)  # (check: no Tresca between two bodies)
@@ -133,7 +175,14 @@ class TwoBodyProblem(Problem):
         return SurfaceSetup(None, self.ds, self.v_load)
 
     def _lame(self, side: Side) -> NDArray[np.float64]:
-        """(m, 3): E, lambda, mu of the cell of each facet of ``side``."""
+        """(m, 3): E, lambda, mu of the cell of each facet of ``side`` (finite strain: the
+        small-strain constants of the cell's body's material)."""
+        if self.finite_strain:
+            tags = self._cell_body(side.cell)
+            out = np.zeros((len(side.cell), 3))
+            for tag, m in self.body_materials.items():
+                out[tags == tag] = (m.E, m.lmbda, m.mu)
+            return out
         mat = self.material
         fields = [mat.modulus, mat.poisson]
         dofs = np.array(
@@ -147,9 +196,46 @@ class TwoBodyProblem(Problem):
             self._coupling = self.method.coupling(self.pair)
         return self._coupling
 
+    def _cell_body(self, cells: NDArray[np.int64]) -> NDArray[np.int64]:
+        """The body (cell tag) of each local cell of ``cells``; -1 for an untagged cell."""
+        cell_tags = self.scene.cell_tags
+        imap = self.mesh.topology.index_map(self.mesh.topology.dim)
+        tag = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
+        tag[cell_tags.indices] = cell_tags.values
+        return tag[np.asarray(cells, dtype=np.int64)]
+
     def bulk_form(self) -> ufl.Form:
         eps = ufl.sym(ufl.grad(self.V_test))
         return ufl.inner(self.material.sigma(self.dU), eps) * ufl.dx
+
+    def internal_form(self) -> ufl.Form:
+        """sum over the bodies of int_{body i} P_i(u) : grad v dX: each body's first Piola
+        stress (its own small-strain E and nu in the same ``--material`` model) over its
+        cells (the cell tags), in the reference configuration."""
+        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.scene.cell_tags)
+        grad_v = ufl.grad(self.V_test)
+        forms = [
+            ufl.inner(m.weak_stress(self.U), grad_v) * dx(tag)
+            for tag, m in self.body_materials.items()
+        ]
+        return functools.reduce(operator.add, forms)
+
+    def von_mises(self) -> Any:
+        """The von Mises stress of the state: of the Cauchy stress of each body's material
+        (finite strain: a DG0 indicator of each body's cells times its material's)."""
+        if not self.finite_strain:
+            return self.material.von_mises(self.state)
+        DG0 = _compat.function_space(self.mesh, "DG", 0)
+        imap = self.mesh.topology.index_map(self.mesh.topology.dim)
+        cells = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int64)
+        dofs = np.array([DG0.dofmap.cell_dofs(c)[0] for c in cells], dtype=np.int64)
+        body = self._cell_body(cells)
+        terms = []
+        for tag, m in self.body_materials.items():
+            chi = dolfinx.fem.Function(DG0)
+            chi.x.array[dofs] = (body == tag).astype(float)
+            terms.append(chi * m.von_mises(self.state))
+        return functools.reduce(operator.add, terms)
 
     # -- load program ------------------------------------------------------------------------
     def apply_load(self, t: float) -> None:
@@ -213,7 +299,7 @@ class TwoBodyPost:
             ]
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
-        self.vm_expr = _compat.expression(pb.material.von_mises(pb.state), DG0)
+        self.vm_expr = _compat.expression(pb.von_mises(), DG0)
         self.start = pb.layout.start
         self.x = _compat.dof_coordinates(self.Q1)
         self.gdim = mesh.geometry.dim
