@@ -213,7 +213,7 @@ def _numbers(value, path: str = ""):
 
 def _compare(args) -> int:
     before, after = Path(args.before), Path(args.after)
-    compared = differ = missing = identical = 0
+    compared = differ = missing = identical = unpaired = status = 0
     runs = [a for a in sorted(before.glob("*/run.json")) if args.only in a.parent.name]
     for a in runs:
         b = after / a.parent.name / "run.json"
@@ -226,7 +226,7 @@ def _compare(args) -> int:
         for key in sorted(set(na) | set(nb)):
             if key not in na or key not in nb:
                 print(f"{a.parent.name}: {key} only in {'before' if key in na else 'after'}")
-                differ += 1
+                unpaired += 1
                 continue
             x, y = na[key], nb[key]
             compared += 1
@@ -241,13 +241,14 @@ def _compare(args) -> int:
         for key in ("status",):
             if ja.get(key) != jb.get(key):
                 print(f"{a.parent.name}: {key}: {ja.get(key)} -> {jb.get(key)}")
-                differ += 1
+                status += 1
     print(
         f"{len(runs)} runs, {compared} numbers compared: {identical} bit-identical, "
         f"{compared - identical - differ} within rtol {args.rtol:g} + atol {args.atol:g}, "
-        f"{differ} differ; {missing} runs missing"
+        f"{differ} differ; {unpaired} keys in one run only; {status} statuses changed; "
+        f"{missing} runs missing"
     )
-    return 1 if differ or missing else 0
+    return 1 if differ or missing or unpaired or status else 0
 
 
 def main() -> int:
