@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import ufl
 
@@ -260,12 +260,12 @@ def _invariants(F: Expr) -> tuple[Expr, Expr, Expr]:
 
 
 @dataclass(frozen=True)
-class NeoHookean(Hyperelastic):
-    """psi = mu/2 (I1 - 3 - 2 ln J) + lambda/2 (ln J)^2 (Bonet and Wood 2008, 6.4.3)."""
+class _LameModel(Hyperelastic):
+    """A model of the two Lame constants (neo-Hookean, Saint Venant-Kirchhoff): mu > 0 and a
+    bulk modulus kappa = lambda + 2 mu / 3 > 0, given as (E, nu) or (mu, kappa)."""
 
     shear: float
     lame_lambda: float
-    name: ClassVar[str] = "neo-hookean"
 
     def __post_init__(self) -> None:
         _positive(self.name, mu=self.shear)
@@ -276,7 +276,7 @@ class NeoHookean(Hyperelastic):
             )
 
     @classmethod
-    def from_E_nu(cls, E: float, nu: float, **kw: Any) -> NeoHookean:
+    def from_E_nu(cls, E: float, nu: float, **kw: Any) -> Self:
         _positive(cls.name, E=E)
         if not -1.0 < nu < 0.5:
             raise ValueError(f"material {cls.name}: nu must lie in (-1, 0.5), got {nu}")
@@ -284,7 +284,7 @@ class NeoHookean(Hyperelastic):
         return cls(mu, lm, **kw)
 
     @classmethod
-    def from_mu_kappa(cls, mu: float, kappa: float, **kw: Any) -> NeoHookean:
+    def from_mu_kappa(cls, mu: float, kappa: float, **kw: Any) -> Self:
         _positive(cls.name, mu=mu, kappa=kappa)
         return cls(mu, kappa - 2.0 * mu / 3.0, **kw)
 
@@ -295,6 +295,13 @@ class NeoHookean(Hyperelastic):
     @property
     def lmbda(self) -> float:
         return self.lame_lambda
+
+
+@dataclass(frozen=True)
+class NeoHookean(_LameModel):
+    """psi = mu/2 (I1 - 3 - 2 ln J) + lambda/2 (ln J)^2 (Bonet and Wood 2008, 6.4.3)."""
+
+    name: ClassVar[str] = "neo-hookean"
 
     @property
     def K(self) -> float:
@@ -351,35 +358,12 @@ class MooneyRivlin(Hyperelastic):
 
 
 @dataclass(frozen=True)
-class SaintVenantKirchhoff(Hyperelastic):
+class SaintVenantKirchhoff(_LameModel):
     """psi = lambda/2 (tr E)^2 + mu E : E, E = (C - I) / 2: Hooke's law between the Green
     strain and the second Piola stress (Holzapfel 2000, 6.5). Not polyconvex: it softens and
     loses stability in strong compression (a stretch below about 0.58 in uniaxial stress)."""
 
-    shear: float
-    lame_lambda: float
     name: ClassVar[str] = "svk"
-
-    def __post_init__(self) -> None:
-        _positive(self.name, mu=self.shear)
-        if not self.lame_lambda + 2.0 * self.shear / 3.0 > 0.0:
-            raise ValueError(f"material {self.name}: the bulk modulus must be > 0")
-
-    @classmethod
-    def from_E_nu(cls, E: float, nu: float, **kw: Any) -> SaintVenantKirchhoff:
-        _positive(cls.name, E=E)
-        if not -1.0 < nu < 0.5:
-            raise ValueError(f"material {cls.name}: nu must lie in (-1, 0.5), got {nu}")
-        lm, mu = lame(E, nu)
-        return cls(mu, lm, **kw)
-
-    @property
-    def mu(self) -> float:
-        return self.shear
-
-    @property
-    def lmbda(self) -> float:
-        return self.lame_lambda
 
     def W(self, F: Expr) -> Expr:
         E = 0.5 * (ufl.dot(F.T, F) - ufl.Identity(3))
