@@ -56,3 +56,63 @@ def run_cli(*args: str, ranks: int = 1, timeout: float = 300, cwd=None):
         env=clean_env(),
         cwd=cwd,
     )
+
+
+def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "fd_"):
+    """(error(eps), coupling, solver) of a two-body scene: the relative error of J du against
+    the central difference of the residual (contact terms included) at the state
+    ``displace(X, upper)`` (X: the owned nodes' reference coordinates, upper: the upper body's
+    nodes among them) plus noise. ``freeze``: the projection searched once at that state (else
+    the coupling's own search at every residual, as finite strain does)."""
+    import numpy as np
+
+    from contactfx.driver import setup
+    from contactfx.solvers.snes import ContactSNES
+
+    pb = setup(scene, num)
+    forms = pb.forms()
+    solver = ContactSNES(
+        pb.state,
+        bulk=forms.bulk(),
+        bcs=[],
+        prefix=f"{prefix}{num.method}_",
+        coupling=pb.coupling(),
+    )
+    x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
+    rng = np.random.default_rng(7)
+    X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
+    # the upper body's owned nodes (coordinates cannot tell the coinciding contact faces)
+    tags = scene.cell_tags
+    cells = tags.indices[tags.values == scene.cells["upper"]]
+    nodes = np.unique([pb.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
+    upper = np.zeros(len(X), dtype=bool)
+    nodes = np.asarray(nodes, dtype=np.int64)
+    upper[nodes[nodes < len(X)]] = True
+    u = displace(X, upper) + 1e-5 * rng.standard_normal(X.shape)
+    x.getArray()[:] = u.ravel()
+    x.ghostUpdate()
+    solver._sync(x)
+    if freeze:
+        solver.coupling.update(solver.u.x.array)
+    x0 = x.copy()  # x is the solver's state: every residual evaluation overwrites it
+    F0, F1, F2 = (solver.bulk.create_vector() for _ in range(3))
+    solver._residual(None, x0, F0)
+    J = solver.J
+    solver._jacobian(None, x0, J, J)
+    du = x.duplicate()
+    du.getArray()[:] = rng.standard_normal(len(du.getArray())) * 1e-4
+    Jdu = J.createVecLeft()
+    J.mult(du, Jdu)
+
+    def error(eps):
+        for sign, F in ((1.0, F1), (-1.0, F2)):
+            xs = x0.copy()
+            xs.axpy(sign * eps, du)
+            solver._residual(None, xs, F)
+        fd = F1.copy()
+        fd.axpy(-1.0, F2)
+        fd.scale(0.5 / eps)
+        fd.axpy(-1.0, Jdu)
+        return fd.norm() / Jdu.norm()
+
+    return error, solver.coupling, solver

@@ -18,6 +18,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
+from conftest import jacobian_check
 from contactfx import _compat
 from contactfx.contact.projection import gauss_segment
 from contactfx.driver.fields import global_sum
@@ -291,58 +292,6 @@ def test_hertz_spheres_coarse(num):
         assert res.friction.excess < 1e-6
 
 
-def _jacobian_check(scene, num, displace):
-    """(error(eps), coupling, solver): the relative error of J du against the central
-    difference of the residual (contact terms included) at the state ``displace(X, upper)``
-    (X: the owned nodes' reference coordinates, upper: the upper body's nodes among them),
-    the projection frozen at that state."""
-    from contactfx.driver import setup
-    from contactfx.solvers.snes import ContactSNES
-
-    pb = setup(scene, num)
-    forms = pb.forms()
-    solver = ContactSNES(
-        pb.state, bulk=forms.bulk(), bcs=[], prefix=f"fd_{num.method}_", coupling=pb.coupling()
-    )
-    x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
-    rng = np.random.default_rng(7)
-    X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
-    # the upper body's owned nodes (coordinates cannot tell the coinciding contact faces)
-    tags = scene.cell_tags
-    cells = tags.indices[tags.values == scene.cells["upper"]]
-    nodes = np.unique([pb.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
-    upper = np.zeros(len(X), dtype=bool)
-    nodes = np.asarray(nodes, dtype=np.int64)
-    upper[nodes[nodes < len(X)]] = True
-    u = displace(X, upper) + 1e-5 * rng.standard_normal(X.shape)
-    x.getArray()[:] = u.ravel()
-    x.ghostUpdate()
-    solver._sync(x)
-    solver.coupling.update(solver.u.x.array)
-    x0 = x.copy()  # x is the solver's state: every residual evaluation overwrites it
-    F0, F1, F2 = (solver.bulk.create_vector() for _ in range(3))
-    solver._residual(None, x0, F0)
-    J = solver.J
-    solver._jacobian(None, x0, J, J)
-    du = x.duplicate()
-    du.getArray()[:] = rng.standard_normal(len(du.getArray())) * 1e-4
-    Jdu = J.createVecLeft()
-    J.mult(du, Jdu)
-
-    def error(eps):
-        for sign, F in ((1.0, F1), (-1.0, F2)):
-            xs = x0.copy()
-            xs.axpy(sign * eps, du)
-            solver._residual(None, xs, F)
-        fd = F1.copy()
-        fd.axpy(-1.0, F2)
-        fd.scale(0.5 / eps)
-        fd.axpy(-1.0, Jdu)
-        return fd.norm() / Jdu.norm()
-
-    return error, solver.coupling, solver
-
-
 def _check_both_friction_branches(num, c) -> None:
     """Closed points in stick and in slip are both present (Coulomb)."""
     sticks = [c.stick[c.xi > 0]] if num.method == "mortar" else [s[3][s[0] > 0] for s in c.state]
@@ -390,7 +339,7 @@ def test_coupling_jacobian_is_consistent(num):
         u[upper, 0] = np.where(X[upper, 0] < 0.01, 1e-7, far)
         return u
 
-    error, coupling, solver = _jacobian_check(scene, num, displace)
+    error, coupling, solver = jacobian_check(scene, num, displace)
     # the residual is piecewise linear in u for the min / max laws (a frozen projection,
     # linear elasticity): away from a switch of the active set the central difference is
     # exact up to round-off (measured 2e-11), a switch within eps du would show as an O(1)
@@ -441,7 +390,7 @@ def test_coupling_jacobian_is_consistent_3d(num):
             u[up, 1] = np.where(slide, 1e-3 * X[up, 1], 0.0)
         return u
 
-    error, coupling, solver = _jacobian_check(scene, num, displace)
+    error, coupling, solver = jacobian_check(scene, num, displace)
     if num.friction == "coulomb":
         _check_both_friction_branches(num, coupling)
     # exact central differences up to round-off away from a switch of the active set or of

@@ -47,6 +47,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
+from conftest import jacobian_check
 from contactfx.scenes import Numerics
 from contactfx.scenes.two_body import PatchTest
 
@@ -180,56 +181,15 @@ def test_finite_strain_patch_test(penalty):
 
 def _jacobian_error(scene, num, displace):
     """error(eps): |J du - central difference of the residual| / |J du| at the state
-    ``displace(X, upper)`` (X the owned nodes' reference coordinates, upper the upper body's
-    among them) plus noise; with the finite-strain search at every residual, the difference
-    quotient sees the projection and the normal move (the contact in the deformed
-    configuration). Also the numbers of closed points and of points inside a master facet."""
-    from contactfx.driver import setup
-    from contactfx.solvers.snes import ContactSNES
-
-    pb = setup(scene, num)
-    forms = pb.forms()
-    solver = ContactSNES(
-        pb.state, bulk=forms.bulk(), bcs=[], prefix="fd_fs_", coupling=pb.coupling()
-    )
-    x = solver.u.x.petsc_vec if hasattr(solver.u.x, "petsc_vec") else solver.u.vector
-    rng = np.random.default_rng(7)
-    X = pb.layout.X.getArray().reshape(-1, pb.layout.gdim)
-    tags = scene.cell_tags
-    cells = tags.indices[tags.values == scene.cells["upper"]]
-    nodes = np.unique([pb.V.dofmap.cell_dofs(c) for c in cells]) if len(cells) else []
-    nodes = np.asarray(nodes, dtype=np.int64)
-    upper = np.zeros(len(X), dtype=bool)
-    upper[nodes[nodes < len(X)]] = True
-    u = displace(X, upper) + 1e-5 * rng.standard_normal(X.shape)
-    x.getArray()[:] = u.ravel()
-    x.ghostUpdate()
-    solver._sync(x)
-    x0 = x.copy()
-    F0, F1, F2 = (solver.bulk.create_vector() for _ in range(3))
-    solver._residual(None, x0, F0)
-    J = solver.J
-    solver._jacobian(None, x0, J, J)
-    du = x.duplicate()
-    du.getArray()[:] = rng.standard_normal(len(du.getArray())) * 1e-4
-    Jdu = J.createVecLeft()
-    J.mult(du, Jdu)
-    coupling, comm = solver.coupling, MPI.COMM_WORLD
+    ``displace(X, upper)`` (conftest.jacobian_check) with the finite-strain search at every
+    residual: the difference quotient sees the projection and the normal move (the contact in
+    the deformed configuration). Also the numbers of closed points and of points inside a
+    master facet."""
+    error, coupling, _ = jacobian_check(scene, num, displace, freeze=False, prefix="fd_fs_")
+    comm = MPI.COMM_WORLD
     closed = comm.allreduce(int(np.sum(coupling.state[0][0] > 0.0)), op=MPI.SUM)
     points = comm.allreduce(len(coupling.state[0][0]), op=MPI.SUM)
     inside = comm.allreduce(int(np.sum(coupling.points[0]["inside"])), op=MPI.SUM)
-
-    def error(eps):
-        for sign, F in ((1.0, F1), (-1.0, F2)):
-            xs = x0.copy()
-            xs.axpy(sign * eps, du)
-            solver._residual(None, xs, F)
-        fd = F1.copy()
-        fd.axpy(-1.0, F2)
-        fd.scale(0.5 / eps)
-        fd.axpy(-1.0, Jdu)
-        return fd.norm() / Jdu.norm()
-
     return error, (closed, inside, points)
 
 
