@@ -247,10 +247,6 @@ class Hyperelastic:
             raise ValueError(f"material {self.name} has no mixed u-p formulation")
         return -(ufl.ln(self.jacobian(u)) + p / self.K) * q
 
-    def describe(self) -> dict[str, Any]:
-        """The model and its parameters (run.json)."""
-        raise NotImplementedError
-
 
 def _invariants(F: Expr) -> tuple[Expr, Expr, Expr]:
     C = ufl.dot(F.T, F)
@@ -316,9 +312,6 @@ class NeoHookean(_LameModel):
         I1, _, J = _invariants(F)
         return 0.5 * self.mu * (I1 - 3.0 - 2.0 * ufl.ln(J))
 
-    def describe(self) -> dict[str, Any]:
-        return {"model": self.name, "mu": self.mu, "lambda": self.lmbda, "kappa": self.kappa}
-
 
 @dataclass(frozen=True)
 class MooneyRivlin(Hyperelastic):
@@ -353,9 +346,6 @@ class MooneyRivlin(Hyperelastic):
         I1, I2, J = _invariants(F)
         return self.c10 * (J ** (-2.0 / 3.0) * I1 - 3.0) + self.c01 * (J ** (-4.0 / 3.0) * I2 - 3.0)
 
-    def describe(self) -> dict[str, Any]:
-        return {"model": self.name, "c10": self.c10, "c01": self.c01, "kappa": self.bulk}
-
 
 @dataclass(frozen=True)
 class SaintVenantKirchhoff(_LameModel):
@@ -368,9 +358,6 @@ class SaintVenantKirchhoff(_LameModel):
     def W(self, F: Expr) -> Expr:
         E = 0.5 * (ufl.dot(F.T, F) - ufl.Identity(3))
         return 0.5 * self.lame_lambda * ufl.tr(E) ** 2 + self.mu * ufl.inner(E, E)
-
-    def describe(self) -> dict[str, Any]:
-        return {"model": self.name, "mu": self.mu, "lambda": self.lmbda}
 
 
 #: the models of ``--material`` and their parameter keys
