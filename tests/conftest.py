@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import weakref
 
 import pytest
 from mpi4py import MPI
@@ -116,3 +117,28 @@ def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "
         return fd.norm() / Jdu.norm()
 
     return error, solver.coupling, solver
+
+
+#: the compiled gradient-error forms of each problem, by measure (see grad_error)
+_GRAD_FORMS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def grad_error(problem, measure, l1: float, l2: float) -> float:
+    """sqrt(int |grad u - diag(l1 - 1, l2 - 1)|^2) over ``measure``, u the problem's
+    displacement (2D): the distance to a homogeneous stretch. The stretch is a Constant, so the
+    form is compiled once per problem and measure (and found in the JIT cache for the next
+    problem), whatever the stretches."""
+    import dolfinx.fem
+    import numpy as np
+    import ufl
+
+    forms = _GRAD_FORMS.setdefault(problem, {})
+    key = repr(measure)
+    if key not in forms:
+        G = dolfinx.fem.Constant(problem.mesh, np.zeros((2, 2)))
+        diff = ufl.grad(problem.U) - G
+        forms[key] = (G, dolfinx.fem.form(ufl.inner(diff, diff) * measure))
+    G, form = forms[key]
+    G.value[:] = np.diag([l1 - 1.0, l2 - 1.0])
+    total = problem.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
+    return float(np.sqrt(total))

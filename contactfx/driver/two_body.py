@@ -226,10 +226,8 @@ class TwoBodyProblem(Problem):
         if not self.finite_strain:
             return self.material.von_mises(self.state)
         DG0 = _compat.function_space(self.mesh, "DG", 0)
-        imap = self.mesh.topology.index_map(self.mesh.topology.dim)
-        cells = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int64)
-        dofs = np.array([DG0.dofmap.cell_dofs(c)[0] for c in cells], dtype=np.int64)
-        body = self._cell_body(cells)
+        dofs = _compat.cell_dofs(DG0)[:, 0]  # every local cell's dof, in cell order
+        body = self._cell_body(np.arange(len(dofs), dtype=np.int64))
         terms = []
         for tag, m in self.body_materials.items():
             chi = dolfinx.fem.Function(DG0)

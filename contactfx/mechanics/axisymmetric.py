@@ -45,14 +45,7 @@ class WeightedMeasure(ufl.Measure):
 
     def reconstruct(self, **kwargs: Any) -> WeightedMeasure:
         m = super().reconstruct(**kwargs)
-        return WeightedMeasure(
-            m.integral_type(),
-            domain=m.ufl_domain(),
-            subdomain_id=m.subdomain_id(),
-            metadata=m.metadata(),
-            subdomain_data=m.subdomain_data(),
-            weight=self.weight,
-        )
+        return WeightedMeasure(m.integral_type(), **_where(m), weight=self.weight)
 
     def __rmul__(self, integrand: Expr) -> Any:
         return super().__rmul__(self.weight * integrand)
@@ -73,13 +66,17 @@ def unweighted(m: ufl.Measure) -> ufl.Measure:
     zero weight on a node at r = 0)."""
     if not isinstance(m, WeightedMeasure):
         return m
-    return ufl.Measure(
-        m.integral_type(),
-        domain=m.ufl_domain(),
-        subdomain_id=m.subdomain_id(),
-        metadata=m.metadata(),
-        subdomain_data=m.subdomain_data(),
-    )
+    return ufl.Measure(m.integral_type(), **_where(m))
+
+
+def _where(m: ufl.Measure) -> dict[str, Any]:
+    """A measure's domain, subdomain, metadata and subdomain data (to build another)."""
+    return {
+        "domain": m.ufl_domain(),
+        "subdomain_id": m.subdomain_id(),
+        "metadata": m.metadata(),
+        "subdomain_data": m.subdomain_data(),
+    }
 
 
 def hoop_strain(mesh: Any) -> Callable[[Expr], Expr]:

@@ -103,9 +103,6 @@ class Hyperelastic:
     name: ClassVar[str]
     linear: ClassVar[bool] = False
     finite_strain: ClassVar[bool] = True
-    #: no modulus or Poisson field (heterogeneous bodies are small-strain only)
-    modulus: ClassVar[None] = None
-    poisson: ClassVar[None] = None
 
     # -- what a model defines ----------------------------------------------------------------
     @property
