@@ -59,12 +59,14 @@ def run_cli(*args: str, ranks: int = 1, timeout: float = 300, cwd=None):
     )
 
 
-def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "fd_"):
+def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "fd_", history=None):
     """(error(eps), coupling, solver) of a two-body scene: the relative error of J du against
     the central difference of the residual (contact terms included) at the state
     ``displace(X, upper)`` (X: the owned nodes' reference coordinates, upper: the upper body's
     nodes among them) plus noise. ``freeze``: the projection searched once at that state (else
-    the coupling's own search at every residual, as finite strain does)."""
+    the coupling's own search at every residual, as finite strain does). ``history(coupling)``
+    sets a history (penalty friction's last converged traction, gap and normal) before the
+    residuals."""
     import numpy as np
 
     from contactfx.driver import setup
@@ -93,6 +95,8 @@ def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "
     x.getArray()[:] = u.ravel()
     x.ghostUpdate()
     solver._sync(x)
+    if history is not None:
+        history(solver.coupling)
     if freeze:
         solver.coupling.update(solver.u.x.array)
     x0 = x.copy()  # x is the solver's state: every residual evaluation overwrites it

@@ -55,8 +55,8 @@ BAD = [
     (["run", "hertz2d", "--mu", "0.3"], "--mu needs --friction coulomb"),
     (["run", "sliding-block", "--method", "vi"], "not supported by method 'vi'"),
     (
-        ["run", "cattaneo-cylinders", "--method", "penalty", "--friction", "coulomb", "--mu=0.3"],
-        "method penalty has no friction between two meshed bodies",
+        ["run", "cattaneo-cylinders", "--friction", "tresca", "--mu=0", "--threshold=0.3"],
+        "method nitsche has no Tresca friction between two meshed bodies",
     ),
     (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
     (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),

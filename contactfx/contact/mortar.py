@@ -625,6 +625,9 @@ class MortarCoupling:
         return A, B
 
     # -- what the post-processing reads ----------------------------------------------------
+    def converged(self) -> None:
+        """Nothing to move on: the slip history is the problem's last converged state."""
+
     def force(self) -> float:
         """The normal contact force sum_j D_j lambda_j of the pair."""
         from mpi4py import MPI

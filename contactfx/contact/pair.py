@@ -236,10 +236,12 @@ class ContactPair:
     #: (m, 3) E, lambda, mu of the cell of each slave / master facet (set by the problem)
     slave_lame: np.ndarray | None = None
     master_lame: np.ndarray | None = None
-    #: Coulomb friction coefficient (None: frictionless) and the last converged displacement
-    #: (a Function: the history of the slip increments), set by the problem
+    #: Coulomb friction coefficient (None: frictionless or Tresca) and the last converged
+    #: displacement (a Function: the history of the slip increments), set by the problem
     mu: float | None = None
     previous: dolfinx.fem.Function | None = None
+    #: Tresca friction's threshold (None: Coulomb with ``mu``, or frictionless)
+    threshold: float | None = None
 
     def search(
         self, slave: Facets, master: Facets, pairs: bool = True

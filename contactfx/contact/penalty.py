@@ -57,9 +57,8 @@ class Penalty(TrialFriction, MethodBase):
         nodal_quadrature=True,
         interfaces=True,
         two_body=True,
-        two_body_friction=False,
+        two_body_tresca=True,
         two_body_finite_strain=True,
-        why_not={"two_body_friction": "its traction history is kept on one body's surface only"},
     )
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
     traction_history: ClassVar[bool] = True

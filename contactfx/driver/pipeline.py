@@ -236,6 +236,7 @@ class _Run:
             confined=problem.confined,
             iterate=problem.iterate,
             deadline=self.deadline,
+            roundoff_stop=problem.material.finite_strain,
         )
         solver.timer.assembly += assembly
         return solver

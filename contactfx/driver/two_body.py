@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
-from contactfx.contact.laws import Coulomb
+from contactfx.contact.laws import Coulomb, Tresca
 from contactfx.contact.pair import ContactPair, Side, side_of
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
@@ -93,10 +93,12 @@ class TwoBodyProblem(Problem):
                 "has no friction between two meshed bodies",
                 lambda c: c.two_body and c.two_body_friction and "coulomb" in c.friction,
             )
-        if numerics.friction == "tresca":
-            raise ValueError(
-                "Tresca friction between two meshed bodies is not implemented: use "
-                "--friction coulomb or none"
+        if numerics.friction == "tresca" and not method.supports.two_body_tresca:
+            raise _not_offered(
+                method,
+                "two_body_tresca",
+                "has no Tresca friction between two meshed bodies",
+                lambda c: c.two_body and c.two_body_tresca,
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
@@ -128,6 +130,12 @@ class TwoBodyProblem(Problem):
                 for body, elastic in scene.materials().items()
             }
         super().__init__(scene, numerics, method, mesh, facet_tags)
+        # penalty friction's history is the coupling's (per Gauss point of the slave surface)
+        self.t_prev = None
+
+    def converged(self) -> None:
+        super().converged()
+        self.coupling().converged()
 
     def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
         """Small strain: the bodies' material with DG0 fields of E and nu. Finite strain: the
@@ -167,9 +175,11 @@ class TwoBodyProblem(Problem):
             fixed=fixed,
             finite_strain=self.finite_strain,
         )
-        if self.friction is not None:
-            assert isinstance(self.friction, Coulomb)  # (check: no Tresca between two bodies)
-            self.pair.mu, self.pair.previous = self.friction.mu, self.prev
+        if isinstance(self.friction, Coulomb):
+            self.pair.mu = self.friction.mu
+        elif isinstance(self.friction, Tresca):
+            self.pair.threshold = self.friction.threshold
+        self.pair.previous = self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)
         return SurfaceSetup(None, self.ds, self.v_load)

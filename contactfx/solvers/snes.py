@@ -193,6 +193,52 @@ class _ReversalGuard:
             self.initial_norm = norm
 
 
+class _RoundOffStop:
+    """Newton's convergence test for finite-strain bodies: PETSc's default one (the residual
+    below ``atol`` or below ``rtol`` times the first, ``stol`` on the update, the divergence
+    tolerance), and a stop at the residual's round-off level: an iterate whose residual
+    is no longer falling (above 0.1 of the last) once the last is 1e-8 of the first is
+    converged. Newton falls quadratically to that level; below it the residual is the
+    round-off of terms far larger than it (the gap of the contact in the deformed
+    configuration is the difference of current positions, x_s - y, of size |x| where the
+    penalty kappa multiplies it: a floor of kappa eps |x| w, 2e-11 on a block pressed to
+    1e-10 of a small load increment's residual), which the relative tolerance of a step
+    whose predictor was already close does not reach."""
+
+    #: how far below the first residual the last must be before a stall counts as round-off
+    DEPTH = 1e-8
+
+    def __init__(self, snes: PETSc.SNES, divergence: float) -> None:
+        self.first = self.last = 0.0
+        self.divergence = divergence
+        self.stalled = 0  # solves stopped at the round-off level (a statistic)
+        snes.setConvergenceTest(self)
+
+    def __call__(self, snes: PETSc.SNES, it: int, norms: tuple[float, float, float]) -> int:
+        xnorm, ynorm, fnorm = norms
+        rtol, atol, stol, _ = snes.getTolerances()
+        R = PETSc.SNES.ConvergedReason
+        last, self.last = self.last, fnorm
+        if it == 0:
+            self.first = fnorm
+        if not np.isfinite(fnorm):
+            return R.DIVERGED_FNORM_NAN
+        if fnorm < atol:
+            return R.CONVERGED_FNORM_ABS
+        if it == 0:
+            return R.CONVERGED_ITERATING
+        if fnorm <= rtol * self.first:
+            return R.CONVERGED_FNORM_RELATIVE
+        if ynorm < stol * xnorm:
+            return R.CONVERGED_SNORM_RELATIVE
+        if self.divergence > 0 and fnorm > self.divergence * self.first:
+            return R.DIVERGED_DTOL
+        if it >= 2 and last <= self.DEPTH * self.first and fnorm > 0.1 * last:
+            self.stalled += 1
+            return R.CONVERGED_FNORM_RELATIVE
+        return R.CONVERGED_ITERATING
+
+
 class ContactSNES:
     """Newton (or SNES-VI) for F(u) = R(u) + F_c(u) = 0 with Dirichlet conditions.
 
@@ -206,7 +252,9 @@ class ContactSNES:
     enrichment that the unknown carries on the whole mesh), ``iterate`` (a Function of u's
     space that the contact forms read as Newton's previous iterate: the friction law's
     reversal guard), ``deadline`` (a ``time.perf_counter()`` value past which a solve stops
-    with :class:`TimeLimitExceeded`, checked collectively at every residual).
+    with :class:`TimeLimitExceeded`, checked collectively at every residual),
+    ``roundoff_stop`` (finite strain: Newton also stops at the residual's round-off level,
+    :class:`_RoundOffStop`).
 
     Its collaborators: the options database (:class:`contactfx.solvers.options.OptionsDB`),
     the reduced system on the kept dofs (:class:`contactfx.solvers.reduced.ReducedSystem`:
@@ -245,6 +293,7 @@ class ContactSNES:
         confined: Sequence[Any] = (),
         iterate: dolfinx.fem.Function | None = None,
         deadline: float | None = None,
+        roundoff_stop: bool = False,
     ) -> None:
         self.u = u
         self.comm = u.function_space.mesh.comm
@@ -298,6 +347,11 @@ class ContactSNES:
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
         self.guard = None if iterate is None else _ReversalGuard(iterate, u, self.snes)
+        #: finite strain: PETSc's convergence test and a stop at the round-off level
+        self.roundoff = None
+        if roundoff_stop:
+            divergence = PETSc.Options().getReal(f"{prefix}snes_divergence_tolerance", 1e4)
+            self.roundoff = _RoundOffStop(self.snes, divergence)
         self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
 
