@@ -197,10 +197,19 @@ class _Checks:
 
     def bulk_material(self, base):
         """The body's material: ``base`` (the scene's elastic material) under ``--material``
-        (:func:`contactfx.mechanics.hyperelastic.material_from_spec`)."""
+        (:func:`contactfx.mechanics.hyperelastic.material_from_spec`). A ``base`` that is
+        finite-strain already (a problem file's body of its own hyperelastic model) is kept
+        under the default ``--material linear``; any other ``--material`` would replace the
+        model the file gives, and is refused (ValueError, one line): ``--material`` turns a
+        linear body's E and nu into a model."""
         model, params = parse_spec(self.material)
         if model == "linear" and not params:
             return base
+        if base.finite_strain:
+            raise ValueError(
+                f"--material {self.material}: the body's material is {base.name} already (its "
+                "problem file's [[bodies]] material); --material applies to linear bodies only"
+            )
         return material_from_spec(model, params, base)
 
     def friction_law(self):

@@ -146,3 +146,25 @@ def grad_error(problem, measure, l1: float, l2: float) -> float:
     G.value[:] = np.diag([l1 - 1.0, l2 - 1.0])
     total = problem.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
     return float(np.sqrt(total))
+
+
+def psi(model: str, m, F):
+    """The strain energies of contactfx.mechanics.hyperelastic written in NumPy, independently
+    of UFL (Bonet and Wood 2008, doi:10.1017/CBO9780511755446, 6.4.3; Holzapfel 2000, ISBN
+    978-0-471-82319-3, 6.5), of a 3 x 3 F (complex: a complex step passes through); ``m``
+    has mu and lmbda (neo-hookean, svk) or c10, c01 and bulk (mooney-rivlin)."""
+    import numpy as np
+
+    C = F.T @ F
+    J, I1 = np.linalg.det(F), np.trace(C)
+    if model == "svk":
+        E = 0.5 * (C - np.eye(3))
+        return 0.5 * m.lmbda * np.trace(E) ** 2 + m.mu * np.sum(E * E)
+    if model == "mooney-rivlin":
+        I2 = 0.5 * (I1**2 - np.trace(C @ C))
+        return (
+            m.c10 * (J ** (-2 / 3) * I1 - 3)
+            + m.c01 * (J ** (-4 / 3) * I2 - 3)
+            + 0.5 * m.bulk * np.log(J) ** 2
+        )
+    return 0.5 * m.mu * (I1 - 3 - 2 * np.log(J)) + 0.5 * m.lmbda * np.log(J) ** 2

@@ -117,6 +117,22 @@ def _plot_history(rows: list[dict], path: Path, title: str) -> None:
     plt.close(fig)
 
 
+def _describe(material, finite: bool) -> str:
+    """A body's material for ``check``: linear E, nu (small strain among finite-strain bodies
+    when ``finite``), or the hyperelastic model, its parameters and small-strain E, nu."""
+    if not material.finite_strain:
+        note = " (small strain among finite-strain bodies)" if finite else ""
+        return f"E = {material.E:g}, nu = {material.nu:g}{note}"
+    if material.name == "mooney-rivlin":
+        given = f"c10 = {material.c10:g}, c01 = {material.c01:g}, kappa = {material.K:g}"
+    elif material.name == "neo-hookean":
+        given = f"mu = {material.mu:g}, kappa = {material.kappa:g}"
+    else:
+        given = f"E = {material.E:g}, nu = {material.nu:g}"
+    small = "" if material.name == "svk" else f" (E = {material.E:g}, nu = {material.nu:g})"
+    return f"{material.name}, {given}{small}"
+
+
 def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     """Validate the file and its mesh and print a summary, without solving."""
     import numpy as np
@@ -137,9 +153,11 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     )
     print(f"  mesh       {where}, {scene.gdim}D, {problem.dofs()} dofs")
     print("  groups     " + scene.group_list())
-    for body in pb.bodies:
-        mat = body.material
-        print(f"  body       {body.group}: E = {mat.E:g}, nu = {mat.nu:g}")
+    # each body's material as the run takes it: its own, or a linear one under numerics.material
+    materials = [numerics.bulk_material(body.material) for body in pb.bodies]
+    finite = any(m.finite_strain for m in materials)
+    for body, material in zip(pb.bodies, materials, strict=True):
+        print(f"  body       {body.group}: {_describe(material, finite)}")
     for b in pb.boundary:
         what = []
         if b.fix:

@@ -3,20 +3,34 @@ no node), a material per body, and a contact pair (slave surface, master surface
 a two-body method's coupling (:mod:`contactfx.contact.coupling`).
 
 Materials: small-strain elasticity with a DG0 field of E and nu over the bodies' cells (a
-bilinear bulk, assembled once), or under a finite-strain ``--material`` (a hyperelastic model
-of :mod:`contactfx.mechanics.hyperelastic`) the same model in every body, each with its own
-small-strain E and nu from the scene: the internal work sum_i int_{body i} P_i(u) : grad v dX
-over the cell tags (a nonlinear bulk, assembled at every Newton iteration). Finite strain
-searches the pair at every Newton iteration (the contact in the deformed configuration,
-:mod:`contactfx.contact.point_coupling`) and is offered with the penalty method for now.
+bilinear bulk, assembled once), or finite strain when any body is hyperelastic (a model of
+:mod:`contactfx.mechanics.hyperelastic`): under a finite-strain ``--material`` the same model
+in every body, each with its own small-strain E and nu from the scene; in a problem file each
+body's own model and parameters (``scene.materials()``). The internal work is then
+sum_i int_{body i} S_i(u) : grad v dX over the cell tags (a nonlinear bulk, assembled at every
+Newton iteration), S_i the body's weak stress (a hyperelastic body's first Piola stress).
+Finite strain searches the pair at every Newton iteration (the contact in the deformed
+configuration, :mod:`contactfx.contact.point_coupling`) and is offered with the penalty
+method for now; the contact's parameters scale with the small-strain E, lambda, mu of each
+facet's body (a hyperelastic model's linearisation at F = I).
 
-Unknown: the P1 displacement of all bodies. Surface: the pair's two sides
-(:class:`contactfx.contact.pair.ContactPair`). Post-processing: the contact force of the pair,
-the nodal pressure and gap on the slave surface, the contact size, penetration and
-complementarity, and the errors against the scene's closed forms; per step the force vector
-the pair exerts on the upper body (from the nodal pressures and normals; the scene scores its
-history), written to ``pair_forces.csv``, and the pressure profile along the slave surface
-against the scene's closed form, ``pressure.png``, when an output folder is given.
+A linear body among finite-strain ones (a problem file's stiff steel part on a rubber one)
+keeps its small-strain stress, S = sigma(u), its term sigma(u) : eps(v): the model the file
+names, geometrically linear, as a linearised-elasticity term on one region of a model whose
+other regions are finite-strain (GetFEM's linearized and finite-strain elasticity bricks).
+It is exact for translations, the motion of a stiff indenter, and for small strains and
+rotations, but not objective: a rigid rotation by theta gives the small strain
+(cos(theta) - 1) I, about -theta^2 / 2, and its stress (Bonet and Wood 2008,
+doi:10.1017/CBO9780511755446, the kinematics chapter). A linear-elastic part of a
+geometrically nonlinear analysis in the commercial codes (Abaqus's NLGEOM) is instead
+Hooke's law in a rotating frame: for small strains under large rotations that is ``svk``
+with the same E and nu (Hooke's law between the Green strain and the second Piola stress,
+objective). We keep the named model rather than refuse it (a stiff indenter that translates
+is the common case, and refusing would force a finite-strain model where it changes
+nothing) or replace it silently, and report the largest |skew grad u| over the linear
+bodies' cells at the last step (sin theta of a rigid rotation by theta) as run.json's score
+``linear_body_rotation``: its square over two is the spurious strain, to compare with the
+body's strains.
 """
 
 from __future__ import annotations
@@ -122,13 +136,24 @@ class TwoBodyProblem(Problem):
         facet_tags: Any,
     ) -> None:
         self.contact_facets = facet_tags.indices[facet_tags.values == scene.slave_tag]
-        self.finite_strain = numerics.bulk_material(scene.material()).finite_strain
-        self.body_materials = {}
-        if self.finite_strain:
-            self.body_materials = {
-                int(scene.cells[body]): numerics.bulk_material(elastic)
-                for body, elastic in scene.materials().items()
-            }
+        # each body's material: the scene's (a problem file's own model, or the small-strain
+        # E and nu of a built-in scene) under --material
+        materials = {
+            int(scene.cells[body]): numerics.bulk_material(m)
+            for body, m in scene.materials().items()
+        }
+        self.finite_strain = any(m.finite_strain for m in materials.values())
+        self.body_materials = materials if self.finite_strain else {}
+        if self.finite_strain and not method.supports.two_body_finite_strain:
+            # (check refuses it from the slave's material; a problem file may make another
+            # body finite-strain)
+            raise _not_offered(
+                method,
+                "two_body_finite_strain",
+                "is not offered between two bodies when one is finite-strain: finite strain "
+                "between two meshed bodies is offered with penalty for now",
+                lambda c: c.two_body and c.two_body_finite_strain,
+            )
         super().__init__(scene, numerics, method, mesh, facet_tags)
         # penalty friction's history is the coupling's (per Gauss point of the slave surface)
         self.t_prev = None
@@ -138,12 +163,18 @@ class TwoBodyProblem(Problem):
         self.coupling().converged()
 
     def material_of(self, mesh: dolfinx.mesh.Mesh) -> Any:
-        """Small strain: the bodies' material with DG0 fields of E and nu. Finite strain: the
-        slave body's (homogeneous) elastic material, which ``--material`` makes hyperelastic
-        (the bulk is written per body with ``body_materials``)."""
-        if self.finite_strain:
-            return self.scene.material()
-        return self.scene.body_material(mesh)
+        """Small strain: the bodies' material with DG0 fields of E and nu. Finite strain: a
+        finite-strain body's material before ``--material`` (the slave's if it is one), which
+        makes the bulk nonlinear and answers the volume ratio of ``diagnose``; the bulk is
+        written per body with ``body_materials``."""
+        if not self.finite_strain:
+            return self.scene.body_material(mesh)
+        slave = self.scene.material()
+        if self.num.bulk_material(slave).finite_strain:
+            return slave
+        return next(
+            m for m in self.scene.materials().values() if self.num.bulk_material(m).finite_strain
+        )
 
     def boundary_conditions(self) -> list[Any]:
         return self.scene.dirichlet(self.V, self.facet_tags)
@@ -185,8 +216,10 @@ class TwoBodyProblem(Problem):
         return SurfaceSetup(None, self.ds, self.v_load)
 
     def _lame(self, side: Side) -> NDArray[np.float64]:
-        """(m, 3): E, lambda, mu of the cell of each facet of ``side`` (finite strain: the
-        small-strain constants of the cell's body's material)."""
+        """(m, 3): E, lambda, mu of the cell of each facet of ``side``, which scale the
+        contact's parameters (the penalty kappa E / h) and its small-strain traction (finite
+        strain: the small-strain constants of the cell's body's own material, a hyperelastic
+        model's E, lambda, mu of its linearisation at F = I)."""
         if self.finite_strain:
             tags = self._cell_body(side.cell)
             out = np.zeros((len(side.cell), 3))
@@ -219,9 +252,11 @@ class TwoBodyProblem(Problem):
         return ufl.inner(self.material.sigma(self.dU), eps) * ufl.dx
 
     def internal_form(self) -> ufl.Form:
-        """sum over the bodies of int_{body i} P_i(u) : grad v dX: each body's first Piola
-        stress (its own small-strain E and nu in the same ``--material`` model) over its
-        cells (the cell tags), in the reference configuration."""
+        """sum over the bodies of int_{body i} S_i(u) : grad v dX over each body's cells (the
+        cell tags), in the reference configuration, with S_i the weak stress of the body's own
+        material (``body_materials``): a hyperelastic body's first Piola stress P_i(F); a
+        linear body's small-strain stress sigma(u), so that its term is sigma(u) : eps(v), as
+        in a small-strain run (see the module docstring: geometrically linear)."""
         dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.scene.cell_tags)
         grad_v = ufl.grad(self.V_test)
         forms = [
@@ -232,18 +267,36 @@ class TwoBodyProblem(Problem):
 
     def von_mises(self) -> Any:
         """The von Mises stress of the state: of the Cauchy stress of each body's material
-        (finite strain: a DG0 indicator of each body's cells times its material's)."""
+        (finite strain: a DG0 indicator of each body's cells times its material's; a linear
+        body's small-strain stress)."""
         if not self.finite_strain:
             return self.material.von_mises(self.state)
+        terms = [
+            self._indicator([tag]) * m.von_mises(self.state)
+            for tag, m in self.body_materials.items()
+        ]
+        return functools.reduce(operator.add, terms)
+
+    @property
+    def small_strain_tags(self) -> list[int]:
+        """The cell tags of the linear (small-strain) bodies of a finite-strain problem."""
+        return [tag for tag, m in self.body_materials.items() if not m.finite_strain]
+
+    def small_strain_rotation(self) -> Any:
+        """|skew grad u| = sqrt(W : W / 2), W = skew(grad u), on the cells of the linear bodies
+        (0 elsewhere): sin(theta) of a rigid rotation by theta, whose small-strain strain is
+        the spurious (cos(theta) - 1) I, about -|W|^2 / 2 (the module docstring)."""
+        W = ufl.skew(ufl.grad(self.U))
+        return self._indicator(self.small_strain_tags) * ufl.sqrt(0.5 * ufl.inner(W, W))
+
+    def _indicator(self, tags: list[int]) -> dolfinx.fem.Function:
+        """The DG0 indicator of the cells of the bodies ``tags``."""
         DG0 = _compat.function_space(self.mesh, "DG", 0)
         dofs = _compat.cell_dofs(DG0)[:, 0]  # every local cell's dof, in cell order
         body = self._cell_body(np.arange(len(dofs), dtype=np.int64))
-        terms = []
-        for tag, m in self.body_materials.items():
-            chi = dolfinx.fem.Function(DG0)
-            chi.x.array[dofs] = (body == tag).astype(float)
-            terms.append(chi * m.von_mises(self.state))
-        return functools.reduce(operator.add, terms)
+        chi = dolfinx.fem.Function(DG0)
+        chi.x.array[dofs] = np.isin(body, tags).astype(float)
+        return chi
 
     # -- load program ------------------------------------------------------------------------
     def apply_load(self, t: float) -> None:
@@ -308,6 +361,12 @@ class TwoBodyPost:
         DG0 = _compat.function_space(mesh, "DG", 0)
         self.vm = dolfinx.fem.Function(DG0, name="von_mises")
         self.vm_expr = _compat.expression(pb.von_mises(), DG0)
+        #: finite strain with linear bodies: their rotation (the run.json score
+        #: linear_body_rotation, the largest over their cells)
+        self.rotation = None
+        if pb.small_strain_tags:
+            self.rotation = dolfinx.fem.Function(DG0)
+            self.rotation_expr = _compat.expression(pb.small_strain_rotation(), DG0)
         self.start = pb.layout.start
         self.x = _compat.dof_coordinates(self.Q1)
         self.gdim = mesh.geometry.dim
@@ -432,6 +491,11 @@ class TwoBodyPost:
         if q.friction is not None:
             scores["tangential_over_bound"] = self.slip_ratio
         pair = self.pb.pair
+        if self.rotation is not None:
+            self.rotation.interpolate(self.rotation_expr)
+            owned = self.rotation.function_space.dofmap.index_map.size_local
+            largest = float(np.max(self.rotation.x.array[:owned], initial=0.0))
+            scores["linear_body_rotation"] = self.comm.allreduce(largest, op=MPI.MAX)
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
         plot = None

@@ -35,7 +35,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-from conftest import grad_error
+from conftest import grad_error, psi
 from contactfx.io.vtk import read_vtu
 from contactfx.meshes import RectangleFacets
 from contactfx.scenes import Numerics
@@ -45,23 +45,6 @@ from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.solvers.base import ConvergenceError
 
 P = 200.0
-
-
-def psi(model: str, m, F: np.ndarray) -> float:
-    """The strain energies of contactfx.mechanics.hyperelastic, in NumPy (3 x 3 F)."""
-    C = F.T @ F
-    J, I1 = np.linalg.det(F), np.trace(C)
-    if model == "svk":
-        E = 0.5 * (C - np.eye(3))
-        return 0.5 * m.lmbda * np.trace(E) ** 2 + m.mu * np.sum(E * E)
-    if model == "mooney-rivlin":
-        I2 = 0.5 * (I1**2 - np.trace(C @ C))
-        return (
-            m.c10 * (J ** (-2 / 3) * I1 - 3)
-            + m.c01 * (J ** (-4 / 3) * I2 - 3)
-            + 0.5 * m.bulk * np.log(J) ** 2
-        )
-    return 0.5 * m.mu * (I1 - 3 - 2 * np.log(J)) + 0.5 * m.lmbda * np.log(J) ** 2
 
 
 def homogeneous_stretches(model: str, m, p: float, hoop: bool = False) -> np.ndarray:

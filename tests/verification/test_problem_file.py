@@ -6,13 +6,16 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import ufl
 from mpi4py import MPI
 
-from contactfx.scenes.problem_file import load_problem
+from conftest import grad_error, psi
+from contactfx.scenes import Numerics
+from contactfx.scenes.problem_file import FileTwoBodyScene, load_problem
 
 DEMOS = Path(__file__).resolve().parents[2] / "demos" / "problems"
 
@@ -685,3 +688,344 @@ def test_petsc_table_reaches_the_solver():
     assert lu.ksp_iterations == lu.newton_iterations
     assert it.ksp_iterations > 10 * it.newton_iterations
     assert it.force == pytest.approx(lu.force, rel=1e-8)
+
+
+# -- two bodies of their own materials (finite strain) -----------------------------------------
+
+#: two stacked blocks [0, 1] x [-0.5, 0] (Mooney-Rivlin) and [0, 1] x [0, 0.5] (neo-Hookean),
+#: non-matching along y = 0, rollers on every lateral face and at the bottom, a dead (nominal)
+#: traction q = 150 on the top: uniaxial strain F = diag(1, l2) in each block, of its own l2
+STACKED = """
+title = "stacked-rubber"
+
+[mesh]
+builder = "stacked-blocks"
+parameters = { width = 1.0, h_lower = 0.5, h_upper = 0.5, h1 = 0.1, ratio = 0.7, offset = 0.3 }
+
+[[bodies]]
+group = "lower"
+material = "mooney-rivlin"
+c10 = 150.0
+c01 = 40.0
+kappa = 1000.0
+
+[[bodies]]
+group = "upper"
+material = "neo-hookean"
+mu = 600.0
+kappa = 2000.0
+
+[[boundary]]
+group = "lower_bottom"
+fix = ["y"]
+
+[[boundary]]
+group = "lower_left"
+fix = ["x"]
+
+[[boundary]]
+group = "lower_right"
+fix = ["x"]
+
+[[boundary]]
+group = "upper_left"
+fix = ["x"]
+
+[[boundary]]
+group = "upper_right"
+fix = ["x"]
+
+[[boundary]]
+group = "upper_top"
+traction = [0.0, -150.0]
+
+[[contact]]
+slave = "upper_bottom"
+master = "lower_top"
+
+[numerics]
+method = "penalty"
+penalty = 1000.0
+steps = 2
+
+[output]
+reactions = ["lower_right", "upper_right", "lower_bottom"]
+"""
+Q_STACKED = 150.0
+
+
+def uniaxial_strain(model: str, m, q: float) -> tuple[float, float]:
+    """(l2, P11) of plane-strain uniaxial strain F = diag(1, l2, 1) with P22 = -q, P = d psi / d F
+    of the NumPy energy (conftest.psi) by complex steps (Squire and Trapp 1998,
+    doi:10.1137/S003614459631241X), Newton on l2 with a difference derivative."""
+
+    def piola(l2: float, i: int) -> float:
+        F = np.diag([1.0, l2, 1.0]).astype(complex)
+        F[i, i] += 1e-30j
+        return psi(model, m, F).imag / 1e-30
+
+    l2 = 1.0
+    for _ in range(30):
+        r = piola(l2, 1) + q
+        l2 -= r / ((piola(l2 + 1e-7, 1) + q - r) / 1e-7)
+    # exact to round-off: the energy's terms are ~1e-16 of the moduli (1e3 here)
+    assert abs(piola(l2, 1) + q) < 1e-10 * q
+    return l2, piola(l2, 0)
+
+
+#: the file's materials as the NumPy energies read them (from the file's numbers: lambda =
+#: kappa - 2 mu / 3)
+LOWER = SimpleNamespace(c10=150.0, c01=40.0, bulk=1000.0)
+UPPER = SimpleNamespace(mu=600.0, lmbda=2000.0 - 2.0 * 600.0 / 3.0)
+
+
+class RecordingPair(FileTwoBodyScene):
+    """A problem file's pair that records, at the last step, the L2 error of grad u over each
+    body against the homogeneous F - I = diag(0, l2 - 1) of ``exact`` (body: l2), relative to
+    |l2 - 1| per unit area, and the pair's force on the slave body (collective)."""
+
+    exact: dict[str, float] = {}
+
+    def on_step(self, problem, solver, load, quantities) -> None:
+        super().on_step(problem, solver, load, quantities)
+        self.slave_force = problem.coupling().slave_force()
+        dx = ufl.Measure("dx", domain=problem.mesh, subdomain_data=self.cell_tags)
+        self.grad_errors = {
+            body: grad_error(problem, dx(self.cells[body]), 1.0, l2) / np.sqrt(0.5) / abs(l2 - 1.0)
+            for body, l2 in self.exact.items()
+        }
+
+
+def _solve_pair(path: Path, sets=(), exact=None, comm=MPI.COMM_WORLD):
+    loaded, numerics, petsc = load_problem(path, list(sets))
+    scene = RecordingPair(loaded.spec)
+    scene.exact = exact or {}
+    res = scene.run(numerics, comm=comm, petsc_options=petsc, verbose=False)
+    return scene, res
+
+
+def _stacked(tmp_path: Path, text: str = STACKED) -> Path:
+    path = tmp_path / "stacked.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        path.write_text(text)
+    MPI.COMM_WORLD.barrier()
+    return path
+
+
+@pytest.fixture
+def shared_tmp(tmp_path):
+    """One temporary folder for all ranks (rank 0's)."""
+    return Path(MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+
+
+def test_two_hyperelastic_bodies_homogeneous_state(shared_tmp):
+    """Each block takes the uniaxial strain of its own material: the lower (Mooney-Rivlin)
+    shortens by 8.7 %, the upper (neo-Hookean) by 5.1 % under the same nominal stress; the
+    lateral rollers carry each one's own P11 (-68.6 and -83.2). The penalty's error shrinks
+    with the penalty."""
+    l2 = {"lower": uniaxial_strain("mooney-rivlin", LOWER, Q_STACKED)}
+    l2["upper"] = uniaxial_strain("neo-hookean", UPPER, Q_STACKED)
+    assert 0.08 < 1.0 - l2["lower"][0] < 0.09 and 0.05 < 1.0 - l2["upper"][0] < 0.06
+    # the reference at a small load (q / E ~ 1e-4): Hooke's uniaxial strain, eps22 = -q / M
+    # and sigma11 = lambda eps22 (M = lambda + 2 mu), to O(q / E)
+    for model, m, lam, mu in (
+        ("mooney-rivlin", LOWER, 1000.0 - 2.0 * 380.0 / 3.0, 380.0),
+        ("neo-hookean", UPPER, UPPER.lmbda, UPPER.mu),
+    ):
+        small, p11 = uniaxial_strain(model, m, 0.15)
+        assert small - 1.0 == pytest.approx(-0.15 / (lam + 2.0 * mu), rel=1e-3)
+        assert p11 == pytest.approx(-0.15 * lam / (lam + 2.0 * mu), rel=1e-3)
+    # the two materials' states differ by far more than the tolerances below
+    assert abs(l2["lower"][0] - l2["upper"][0]) > 0.03
+    assert abs(l2["lower"][1] - l2["upper"][1]) > 0.1 * abs(l2["upper"][1])
+    errors = {}
+    for penalty, tol in ((10.0, 2e-2), (1000.0, 2e-3)):
+        scene, res = _solve_pair(
+            _stacked(shared_tmp),
+            [f"numerics.penalty={penalty}"],
+            exact={body: v[0] for body, v in l2.items()},
+        )
+        row = scene.reaction_rows[-1]
+        # equilibrium: the bottom carries the dead load q * width (the rollers carry no
+        # vertical force), and so does the pair on the upper block: to Newton's tolerance
+        assert row["lower_bottom_y"] == pytest.approx(Q_STACKED, rel=1e-8)
+        assert scene.slave_force[1] == pytest.approx(Q_STACKED, rel=1e-8)
+        # grad u against each body's exact state. The penalty at the slave's Gauss points does
+        # not pass the pressure patch test between non-matching meshes (test_two_body_finite_
+        # strain.py: 5.8e-3 at penalty 10, 6.2e-4 at 1000 in one neo-Hookean material on this
+        # mesh); measured 6.6e-3, 9.7e-3 (lower, upper) at penalty 10, 6.0e-4, 9.6e-4 at 1000
+        # (and 1.2e-4 at 1e4): bounds 2e-2 and 2e-3
+        for body in ("lower", "upper"):
+            assert scene.grad_errors[body] < tol, body
+            # the lateral support carries P11 (nominal) over the block height 0.5: its force
+            # on the right face is P11 * 0.5 along +x (measured within 2.3e-4 and 1.4e-5)
+            assert row[f"{body}_right_x"] == pytest.approx(0.5 * l2[body][1], rel=tol), body
+        # the contact force is the nominal pressure over the slave's reference face: q * width
+        # but for the tilt theta of the master normals, 1 - cos(theta) ~ (grad u error)^2 / 2
+        # (measured 1.2e-6 and 9e-9)
+        assert res.force == pytest.approx(Q_STACKED, rel=tol**2)
+        errors[penalty] = max(scene.grad_errors.values())
+    # the penalty's error shrinks with its stiffness (measured by 10 for 100 times the penalty)
+    assert errors[1000.0] < 0.2 * errors[10.0]
+
+
+def test_linear_body_among_hyperelastic_ones(shared_tmp):
+    """A linear upper block in the same file keeps its small-strain stress (geometrically
+    linear): uniaxial strain eps22 = -q / M (M = E (1 - nu) / ((1 + nu)(1 - 2 nu))), sigma11 =
+    lambda eps22 exactly, while the lower block is the Mooney-Rivlin one of the file; the run
+    reports the linear body's rotation (none here, to the penalty's error)."""
+    E, nu = 2000.0, 0.3
+    text = STACKED.replace(
+        'material = "neo-hookean"\nmu = 600.0\nkappa = 2000.0', f"E = {E}\nnu = {nu}"
+    )
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    eps = -Q_STACKED / (lam + 2 * mu)
+    l2 = uniaxial_strain("mooney-rivlin", LOWER, Q_STACKED)
+    scene, res = _solve_pair(_stacked(shared_tmp, text), exact={"lower": l2[0], "upper": 1.0 + eps})
+    assert "small strain in the linear body upper" in scene.summary
+    row = scene.reaction_rows[-1]
+    assert res.force == pytest.approx(Q_STACKED, rel=1e-8)
+    assert scene.grad_errors["lower"] < 2e-3 and scene.grad_errors["upper"] < 2e-3
+    assert row["upper_right_x"] == pytest.approx(0.5 * lam * eps, rel=2e-3)
+    assert row["lower_right_x"] == pytest.approx(0.5 * l2[1], rel=2e-3)
+    # no rotation but the penalty's error (the grad u errors above; measured 1.0e-4, 0.18 % of
+    # the strain, the largest over the cells)
+    assert 0.0 <= res.scores["linear_body_rotation"] < 5e-3 * abs(eps)
+
+
+def test_linear_body_rotation_indicator(shared_tmp):
+    """The rotation the run reports for the linear bodies: |skew grad u| of a rigid rotation
+    by theta is sin(theta) on the linear body's cells, 0 on the hyperelastic one's."""
+    import dolfinx
+
+    from contactfx import _compat
+    from contactfx.driver import setup
+
+    text = STACKED.replace(
+        'material = "neo-hookean"\nmu = 600.0\nkappa = 2000.0', "E = 1.0\nnu = 0.3"
+    )
+    scene, numerics, _ = load_problem(_stacked(shared_tmp, text))
+    pb = setup(scene, numerics)
+    theta = 0.3
+    c, s = np.cos(theta), np.sin(theta)
+    pb.U.interpolate(lambda x: np.stack([(c - 1) * x[0] - s * x[1], s * x[0] + (c - 1) * x[1]]))
+    DG0 = _compat.function_space(pb.mesh, "DG", 0)
+    rotation = dolfinx.fem.Function(DG0)
+    rotation.interpolate(_compat.expression(pb.small_strain_rotation(), DG0))
+    tags = scene.cell_tags
+    for body, expected in (("upper", s), ("lower", 0.0)):
+        cells = tags.indices[tags.values == scene.cells[body]]
+        values = rotation.x.array[_compat.cell_dofs(DG0)[cells, 0]]
+        assert np.allclose(values, expected, rtol=1e-12, atol=1e-14), body
+
+
+def test_two_body_hyperelastic_demo_reactions_balance():
+    """demos/problems/indenter-on-rubber.toml: the neo-Hookean half-cylinder 0.3 R into the
+    Mooney-Rivlin block. Each body's supports balance the pair's force on it, to Newton's
+    tolerance (every free residual row vanishes); the scalar contact force (the nominal
+    pressure over the slave's reference face) exceeds the vertical reaction by the tilt of the
+    current normals, 1 - cos(theta) <= (a / R)^2 / 2 with theta <= a / R on the indenter."""
+    scene, res = _solve_pair(DEMOS / "indenter-on-rubber.toml")
+    row = scene.reaction_rows[-1]
+    bottom = np.array([row["block_bottom_x"], row["block_bottom_y"]])
+    top = np.array([row["rounded_top_x"], row["rounded_top_y"]])
+    f = scene.slave_force  # the pair's force on the slave (block) body
+    scale = np.linalg.norm(f)
+    assert f[1] < 0.0 and scale > 0.0  # the indenter pushes the block down
+    assert np.linalg.norm(bottom + f) <= 1e-8 * scale
+    assert np.linalg.norm(top - f) <= 1e-8 * scale
+    a = res.contact_size
+    assert 0.0 < res.force - bottom[1] <= 0.5 * a**2 * res.force
+    assert "linear_body_rotation" not in res.scores  # both bodies hyperelastic
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size == 1, reason="compares the run on all ranks with one rank")
+def test_two_body_hyperelastic_ranks_agree(shared_tmp):
+    path = _stacked(shared_tmp)
+    exact = {"lower": 0.9, "upper": 0.95}
+    p_scene, parallel = _solve_pair(path, exact=exact)
+    s_scene, serial = _solve_pair(path, exact=exact, comm=MPI.COMM_SELF)
+    assert parallel.force == pytest.approx(serial.force, rel=1e-8)
+    for body in exact:
+        assert p_scene.grad_errors[body] == pytest.approx(s_scene.grad_errors[body], rel=1e-6)
+    for key, value in s_scene.reaction_rows[-1].items():
+        assert p_scene.reaction_rows[-1][key] == pytest.approx(value, rel=1e-8, abs=1e-10)
+    _, demo = _solve("indenter-on-rubber.toml")
+    _, demo_serial = _solve("indenter-on-rubber.toml", comm=MPI.COMM_SELF)
+    assert demo.force == pytest.approx(demo_serial.force, rel=1e-8)
+    assert demo.contact_size == pytest.approx(demo_serial.contact_size, rel=1e-8)
+
+
+@pytest.mark.serial_only
+@pytest.mark.parametrize(
+    "edit, sets, message",
+    [
+        (lambda t: t.replace("mu = 600.0", "mu = -1.0"), [], "bodies.1.mu: must be > 0"),
+        (lambda t: t.replace("c10 = 150.0", "c10 = -1.0"), [], "bodies.0.c10: must be >= 0"),
+        (
+            lambda t: t.replace("kappa = 1000.0", "kappa = 1000.0\nnu = 0.3"),
+            [],
+            "bodies.0.nu: not a parameter of material mooney-rivlin",
+        ),
+        (
+            lambda t: t,
+            ["numerics.material=neo-hookean"],
+            "numerics.material: 'neo-hookean' conflicts with bodies.0.material = 'mooney-rivlin'",
+        ),
+        (
+            lambda t: t,
+            ["numerics.material=linear:E=5"],
+            "numerics.material: 'linear:E=5' conflicts with bodies.0.material",
+        ),
+        (
+            lambda t: t,
+            ["numerics.method=nitsche"],
+            "numerics.method: nitsche is not offered between two bodies when one is "
+            "finite-strain (bodies.0.material = 'mooney-rivlin'",
+        ),
+    ],
+)
+def test_bad_two_body_materials(tmp_path, edit, sets, message):
+    path = _stacked(tmp_path, edit(STACKED))
+    with pytest.raises(ValueError) as err:
+        load_problem(path, sets)
+    assert message in str(err.value)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.serial_only
+def test_finite_strain_material_per_body_refusals(tmp_path, capsys):
+    """Several bodies against an obstacle stay linear; a file body's own model does not take
+    --material through the Python API either; ``contactfx check`` accepts the demo and names
+    each body's model, and refuses a conflicting --set in one line."""
+    from contactfx.cli import main
+
+    text = PAIR.replace('group = "block"', 'group = "block"\nmaterial = "svk"')
+    text = text.split("[[contact]]")[0] + '[obstacle]\nshape = "plane"\ncontact = "block_top"\n'
+    with pytest.raises(ValueError) as err:
+        load_problem(_write_pair(tmp_path, text))
+    assert "bodies.1.material: a finite-strain material is offered for one body against " in (
+        str(err.value)
+    )
+    scene, _, _ = load_problem(_stacked(tmp_path))
+    with pytest.raises(ValueError, match=r"^--material svk: the body's material is neo-hookean"):
+        scene.run(Numerics(method="penalty", material="svk"), verbose=False)
+    # a linear slave on a finite-strain master: the problem kind refuses the method itself
+    linear = STACKED.replace(
+        'material = "neo-hookean"\nmu = 600.0\nkappa = 2000.0', "E = 2000.0\nnu = 0.3"
+    )
+    scene, _, _ = load_problem(_stacked(tmp_path, linear))
+    with pytest.raises(ValueError) as err:
+        scene.run(Numerics(method="nitsche"), verbose=False)
+    assert str(err.value).startswith(
+        "method nitsche is not offered between two bodies when one is finite-strain"
+    )
+    assert "\n" not in str(err.value)
+    demo = str(DEMOS / "indenter-on-rubber.toml")
+    assert main(["check", demo]) == 0
+    out = capsys.readouterr().out
+    assert "body       block: mooney-rivlin, c10 = 0.4, c01 = 0.1, kappa = 10 (E = 2.9" in out
+    assert "body       rounded: neo-hookean, mu = 10, kappa = 30 (E = 27, nu = 0.35)" in out
+    assert main(["check", demo, "--set", "numerics.material=svk"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "numerics.material: 'svk' conflicts with bodies.0.material" in err[0]

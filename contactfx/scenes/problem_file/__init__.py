@@ -2,7 +2,8 @@
 
 The file names a mesh (a ``.msh`` file, a ``.geo`` file meshed at run time with a size factor,
 or a geometry of :data:`contactfx.meshes.BUILDERS` with its parameters; 1D, 2D or 3D), the
-bodies (a cell group each, with E and nu, optionally a body force), the boundary conditions on
+bodies (a cell group each, with its material: linear E and nu, or a hyperelastic model and its
+parameters; optionally a body force), the boundary conditions on
 named facet groups (fixed components, prescribed displacement components, tractions, normal
 pressures, each scaled by a piecewise-linear load amplitude), and a rigid obstacle touching one
 facet group (plane, circle / cylinder, sphere, parabola / paraboloid, sinusoid, punch with
@@ -80,7 +81,7 @@ from contactfx.scenes.problem_file.scenes import (
     FileParams,
     FileTwoBodyScene,
 )
-from contactfx.scenes.problem_file.sections import read
+from contactfx.scenes.problem_file.sections import check_materials, read
 from contactfx.scenes.problem_file.specs import ProblemFile
 
 __all__ = [
@@ -107,6 +108,7 @@ def load_problem(path, sets: list[str] = ()):
     except (TypeError, ValueError) as err:
         msg = str(err).replace("--", "numerics.")
         raise ProblemError(f"{path}: {msg}") from None
+    check_materials(problem, numerics)
     if problem.pair is not None:
         return FileTwoBodyScene(problem), numerics, petsc
     if problem.interface is not None:

@@ -454,7 +454,19 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
 
 
 class FileTwoBodyScene(_FileMesh, TwoBodyScene):
-    """A problem file with a contact pair between two bodies."""
+    """A problem file with a contact pair between two bodies, each of its own material: the
+    problem is finite strain when either is hyperelastic, and a linear body then keeps its
+    small-strain stress (:mod:`contactfx.driver.two_body`), which the summary notes."""
+
+    def __init__(self, problem: ProblemFile) -> None:
+        super().__init__(problem)
+        linear = [b.group for b in problem.bodies if not b.material.finite_strain]
+        if linear and len(linear) < len(problem.bodies):
+            self.summary += (
+                f"; small strain in the linear body {', '.join(linear)} (exact for "
+                "translations, not objective under large rotations: run.json's "
+                "linear_body_rotation)"
+            )
 
     def build_mesh(self, comm):
         mesh, facet_tags = self.read_mesh(comm)

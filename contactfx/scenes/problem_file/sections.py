@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from contactfx.contact.interface import BartonBandis
+from contactfx.contact.registry import method_class, methods_supporting
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.mechanics.hyperelastic import (
     MODELS,
@@ -20,6 +21,7 @@ from contactfx.mechanics.hyperelastic import (
     MooneyRivlin,
     NeoHookean,
     SaintVenantKirchhoff,
+    parse_spec,
 )
 from contactfx.meshes import BUILDERS
 from contactfx.numerics import Numerics
@@ -40,7 +42,7 @@ from contactfx.scenes.problem_file.specs import (
 )
 from contactfx.scenes.two_body_base import CONTACT_EDGES
 
-__all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read"]
+__all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read", "check_materials"]
 
 KEYS = {
     "mesh": ("file", "size", "builder", "parameters", "axisymmetric"),
@@ -159,19 +161,28 @@ def read_bodies(r: Reader, data: dict) -> tuple[BodySpec, ...]:
         elif "amplitude" in b:
             r.fail(f"{key}.amplitude", "an amplitude scales a body_force: give one")
         bodies.append(BodySpec(group, material, force, amplitude))
-    if len(bodies) > 1 and any(b.material.finite_strain for b in bodies):
-        r.fail(
-            "bodies",
-            "a finite-strain material is offered for one body against a rigid obstacle (give "
-            "the other bodies' groups to the same [[bodies]] table, or use linear materials)",
-        )
     return tuple(bodies)
+
+
+def _check_finite_strain(r: Reader, bodies: tuple[BodySpec, ...], kind: str) -> None:
+    """Finite strain is offered for one body against an obstacle, and for each of the two
+    bodies of a [[contact]] pair (a material per body: :func:`_material`)."""
+    finite = [i for i, b in enumerate(bodies) if b.material.finite_strain]
+    if finite and len(bodies) > 1 and kind != "contact":
+        r.fail(
+            f"bodies.{finite[0]}.material",
+            "a finite-strain material is offered for one body against a rigid obstacle or for "
+            "the bodies of a [[contact]] pair (give the other bodies' groups to the same "
+            "[[bodies]] table, or use linear materials)",
+        )
 
 
 def _material(r: Reader, b: dict, key: str) -> Elastic | Hyperelastic:
     """A body's material: ``material`` (linear, the default; neo-hookean, mooney-rivlin,
     svk) with its parameters (linear and svk: E, nu; neo-hookean: E, nu or mu, kappa;
-    mooney-rivlin: c10, c01 (default 0), kappa)."""
+    mooney-rivlin: c10, c01 (default 0), kappa). Each body has its own: a problem with a
+    hyperelastic body is finite strain, and a linear body in a finite-strain pair keeps its
+    small-strain stress (:mod:`contactfx.driver.two_body`)."""
     model = r.string(b, key, "material", tuple(MODELS), default="linear")
     allowed = MODELS[model]
     for k in ("E", "nu", "mu", "kappa", "c10", "c01"):
@@ -503,6 +514,37 @@ def _check_interface(
             )
 
 
+def check_materials(problem: ProblemFile, numerics: Numerics) -> None:
+    """The bodies' materials against the numerics: ``numerics.material`` (``--set
+    numerics.material=...``) turns every linear body into one model with the body's E and nu,
+    as ``--material`` does for a built-in scene, so it cannot be combined with a body that
+    names its own finite-strain model; a pair with a finite-strain body needs a method that
+    offers finite strain between two bodies (the problem kind's check sees the slave body's
+    material only)."""
+    r = Reader(problem.path)
+    finite = [(i, b) for i, b in enumerate(problem.bodies) if b.material.finite_strain]
+    if not finite:
+        return
+    i, body = finite[0]
+    if parse_spec(numerics.material) != ("linear", {}):
+        r.fail(
+            "numerics.material",
+            f"{numerics.material!r} conflicts with bodies.{i}.material = "
+            f"{body.material.name!r}: numerics.material makes every linear body one model (with "
+            "its E and nu); give each body's model in its [[bodies]] table instead",
+        )
+    supports = method_class(numerics.method).supports
+    if problem.pair is not None and not supports.two_body_finite_strain:
+        offered = methods_supporting(lambda c: c.two_body and c.two_body_finite_strain)
+        r.fail(
+            "numerics.method",
+            f"{numerics.method} is not offered between two bodies when one is finite-strain "
+            f"(bodies.{i}.material = {body.material.name!r}; "
+            f"{supports.why_not.get('two_body_finite_strain', 'not implemented')}); use "
+            + ", ".join(offered),
+        )
+
+
 def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     """(problem, numerics overrides, PETSc options) of the file, without the mesh."""
     if not path.is_file():
@@ -521,6 +563,7 @@ def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
     boundary = read_boundary(r, data)
     pins = read_pins(r, data)
     kind = _contact_kind(r, data)
+    _check_finite_strain(r, bodies, kind)
     obstacle = pair = interface = None
     if kind == "interface":
         interface = read_interface(r, data)
