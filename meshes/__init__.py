@@ -19,7 +19,7 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
 
 Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.two_body`: the
 bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
-:func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`.
+:func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`, :func:`die_on_block`.
 
 Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,penny-block,joint-column,
 stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block} ...
@@ -53,6 +53,8 @@ from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangl
 from contactfx.meshes.two_body import (
     CylindersCells,
     CylindersFacets,
+    DieOnBlockCells,
+    DieOnBlockFacets,
     PunchFoundationCells,
     PunchFoundationFacets,
     RoundedOnBlockCells,
@@ -64,6 +66,7 @@ from contactfx.meshes.two_body import (
     StackedBoxesCells,
     StackedBoxesFacets,
     cylinders,
+    die_on_block,
     punch_foundation,
     rounded_on_block,
     spheres,
@@ -86,6 +89,7 @@ BUILDERS = {
     "spheres": (spheres, 3),
     "punch-foundation": (punch_foundation, 2),
     "rounded-on-block": (rounded_on_block, 2),
+    "die-on-block": (die_on_block, 2),
 }
 
 __all__ = [
@@ -99,6 +103,8 @@ __all__ = [
     "IntervalFacets",
     "CylindersCells",
     "CylindersFacets",
+    "DieOnBlockCells",
+    "DieOnBlockFacets",
     "Group",
     "JointColumnCells",
     "JointColumnFacets",
@@ -129,6 +135,7 @@ __all__ = [
     "structured_plate",
     "interval",
     "cylinders",
+    "die_on_block",
     "joint_column",
     "penny_block",
     "punch_foundation",

@@ -1051,3 +1051,158 @@ def spheres(
         grading=grading,
     )
     _generate(model, 3)
+
+
+class DieOnBlockCells(IntEnum):
+    """Cell tags of :func:`die_on_block`."""
+
+    BLOCK = 1
+    DIE = 2
+
+
+class DieOnBlockFacets(IntEnum):
+    """Facet tags of :func:`die_on_block`.
+
+    ``BLOCK_TOP`` (the whole top edge) and ``DIE_CONTACT`` (the die's arc) are the contact
+    surfaces.
+    """
+
+    BLOCK_TOP = 1
+    BLOCK_RIGHT = 2
+    BLOCK_BOTTOM = 3
+    BLOCK_LEFT = 4
+    DIE_CONTACT = 5
+    DIE_SIDES = 6
+    DIE_TOP = 7
+
+
+def die_on_block(
+    model: type[gmsh.model],
+    *,
+    radius: float,
+    half_width: float,
+    height: float,
+    left: float,
+    right: float,
+    depth: float,
+    track: float,
+    h_contact: float,
+    h_far: float,
+    refine: float,
+    ratio: float,
+    offset: float = 0.0,
+    grading: float = 0.3,
+) -> None:
+    """Build and mesh a die with a rounded bottom touching a wide block at the origin (a gmsh
+    builder; the ironing problem's geometry).
+
+    Full model, for a die dragged along the block. The block is [-left, right] x [-depth, 0].
+    The die is the strip |x| <= w = ``half_width`` below y = ``height`` cut from below by the
+    circle of radius R = ``radius`` centred at (0, R): its contact surface is the arc from
+    (-w, e) through the origin to (w, e), e = R - sqrt(R^2 - w^2), split at the origin; its
+    sides are the segments x = -w and x = w from y = e to y = height; its top is the segment
+    y = height. Sizes as in :func:`rounded_on_block`: the block's element size is h_contact
+    within ``refine`` of the track [0, track] x {0}, the die's ratio * h_contact within
+    ``refine`` of its arc's lowest point; both grow by ``grading`` per unit distance up to
+    ``h_far``. With offset > 0 the arc is also split at the arc length l0
+    (:func:`offset_length`) right of the origin.
+
+    ``model``: the ``gmsh.model`` namespace of an open gmsh session; ``radius``: the radius R of
+    the die's arc (length); ``half_width``: the die's half-width w, in (0, R] (length);
+    ``height``: the height of the die's top above its lowest point, > e (length); ``left``,
+    ``right``: the extent of the block left and right of the origin, left > w, right > track + w
+    (length); ``depth``: the depth of the block (length); ``track``: the length of the refined
+    track on the block, >= 0 (length); ``h_contact``: the element size of the block along the
+    track (length); ``h_far``: the element size far from the contact zones, >= h_contact and
+    >= ratio * h_contact (length); ``refine``: the distance from the track / the origin meshed
+    with the contact sizes (length); ``ratio``: the element size of the die / that of the block
+    (dimensionless); ``offset``: the shift of the die's contact nodes, a fraction of its element
+    (in [0, 1)); ``grading``: the size increase per unit distance from the refined zones
+    (dimensionless).
+
+    Raises ValueError before any gmsh call if a parameter is invalid.
+    """
+    check_finite(
+        radius=radius,
+        half_width=half_width,
+        height=height,
+        left=left,
+        right=right,
+        depth=depth,
+        track=track,
+    )
+    check_positive(
+        radius=radius, half_width=half_width, height=height, left=left, right=right, depth=depth
+    )
+    check_less_equal("half_width", half_width, "radius", radius)
+    if not track >= 0.0:
+        raise ValueError(f"track must be >= 0, got {track}")
+    check_less("half_width", half_width, "left", left)
+    check_less("track + half_width", track + half_width, "right", right)
+    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    r, w = radius, half_width
+    half = math.asin(w / r)  # half the arc's angle
+    e = r * (1.0 - math.cos(half))
+    check_less("the arc's height", e, "height", height)
+    l0 = offset_length(offset, ratio * h_contact)
+    if offset > 0:
+        _check_first_element(l0, "the right half of the arc", half * r)
+
+    occ = model.occ
+    block_points = [
+        occ.addPoint(x, y, 0.0)
+        for x, y in ((-left, 0.0), (right, 0.0), (right, -depth), (-left, -depth))
+    ]
+    block_top, block_right, block_bottom, block_left = _polyline(
+        model, [*block_points, block_points[0]]
+    )
+    block = _surface(model, [block_top, block_right, block_bottom, block_left])
+
+    # The arc from (-w, e) through the origin (and the offset point) to (w, e), then the
+    # right side, the top and the left side.
+    centre = occ.addPoint(0.0, r, 0.0)
+    angles = [-half, 0.0, *([l0 / r] if offset > 0 else []), half]
+    arc_points = [occ.addPoint(r * math.sin(a), r * (1 - math.cos(a)), 0.0) for a in angles]
+    arcs = [
+        occ.addCircleArc(a, centre, b) for a, b in zip(arc_points[:-1], arc_points[1:], strict=True)
+    ]
+    corners = [occ.addPoint(w, height, 0.0), occ.addPoint(-w, height, 0.0)]
+    right_side, top, left_side = _polyline(model, [arc_points[-1], *corners, arc_points[0]])
+    die = _surface(model, [*arcs, right_side, top, left_side])
+    occ.remove([(0, centre)])  # the arc's centre is no vertex of the body: no free point
+    occ.synchronize()
+    if offset > 0:
+        model.mesh.setTransfiniteCurve(arcs[1], 2)
+
+    f = DieOnBlockFacets
+    _add_body_groups(
+        model,
+        {
+            DieOnBlockCells.BLOCK: (
+                block,
+                {
+                    f.BLOCK_TOP: [block_top],
+                    f.BLOCK_RIGHT: [block_right],
+                    f.BLOCK_BOTTOM: [block_bottom],
+                    f.BLOCK_LEFT: [block_left],
+                },
+            ),
+            DieOnBlockCells.DIE: (
+                die,
+                {f.DIE_CONTACT: arcs, f.DIE_SIDES: [right_side, left_side], f.DIE_TOP: [top]},
+            ),
+        },
+    )
+    # The block: distance to the track [0, track] x {0}, as in rectangle(); the die: to the
+    # arc's lowest point.
+    end = matheval_number(track)
+    along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
+    _set_body_sizes(
+        model,
+        2,
+        [(block, h_contact, h_far), (die, ratio * h_contact, h_far)],
+        [f"Sqrt(({along})^2+y^2)", "Sqrt(x^2+y^2)"],
+        dist_min=refine,
+        grading=grading,
+    )
+    _generate(model, 2)

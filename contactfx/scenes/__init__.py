@@ -8,6 +8,7 @@ from contactfx.scenes.base import Scene
 from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D, HertzAxi
+from contactfx.scenes.ironing import ShallowIroning
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
@@ -42,6 +43,7 @@ SCENES: dict[str, type[Scene]] = {
         PunchFoundation,
         SlidingContact,
         CattaneoCylinders,
+        ShallowIroning,
     )
 }
 

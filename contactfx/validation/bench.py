@@ -170,6 +170,23 @@ CASES: dict[str, BenchCase] = {
     "cattaneo-cylinders": BenchCase(
         "cattaneo-cylinders", {}, 2.0, "identical cylinders sheared, Cattaneo-Mindlin, mu 0.3"
     ),
+    # level 0 is the scene's default mesh; penalty only (two finite-strain bodies)
+    "shallow-ironing": BenchCase(
+        "shallow-ironing",
+        {},
+        1.0,
+        "neo-Hookean die ironing a block, frictionless (force plateau against Yang et al. 2005)",
+        p2_levels=0,
+    ),
+    "shallow-ironing-coulomb": BenchCase(
+        "shallow-ironing",
+        {},
+        1.0,
+        "neo-Hookean die ironing a block, Coulomb mu 0.3 (plateaus P, Q against Yang et al.)",
+        p2_levels=0,
+        numerics={"friction": "coulomb", "mu": 0.3},
+        beside="shallow-ironing",
+    ),
 }
 
 #: relative errors below this are round-off (e.g. the force under force control): no rate
@@ -276,6 +293,7 @@ def run_case(
         status="ok",
         reason="",
         dofs=res.dofs,
+        steps=len(res.steps),
         newton=res.newton_iterations,
         ksp=res.ksp_iterations,
         outer=res.outer_iterations,
@@ -295,6 +313,10 @@ def run_case(
     for key in ("Q_over_bound", "c_over_a_computed"):  # partial slip: values, not errors
         if key in res.reference:
             row[key] = float(res.reference[key])
+    # force plateaus against published curves (shallow ironing): signed errors and values
+    for key in ("P_plateau_error", "Q_plateau_error", "Q_over_P", "P_jump", "Q_jump"):
+        if key in res.scores:
+            row[key] = float(res.scores[key])
     return row, scene, num
 
 

@@ -1,0 +1,277 @@
+"""``shallow-ironing``: a stiff die with a rounded bottom pressed into a soft block and dragged
+along it, plane strain, finite strain (neo-Hookean), frictionless or with Coulomb friction.
+
+The two-dimensional ironing benchmark of Yang, Laursen and Meng (B. Yang, T. A. Laursen,
+X. Meng, Two dimensional mortar contact methods for large deformation frictional sliding,
+Int. J. Numer. Meth. Engng 62 (2005) 1183-1225, doi:10.1002/nme.1222), computed again by
+Poulios and Renard (K. Poulios, Y. Renard, An unconstrained integral approximation of large
+sliding frictional contact between deformable solids, Computers and Structures 153 (2015)
+75-90, doi:10.1016/j.compstruc.2015.02.027). Its set-up and published force curves are those of
+the KratosMultiphysics/Examples repository, ``contact_structural_mechanics/validation/
+shallow_ironing_3D`` (the 2D section extruded by a thickness 1; the numbers below are read from
+its ``source/shallow_ironing3D.mdpa``, ``source/StructuralMaterials.json``,
+``source/ProjectParameters_literature.json``, ``source/ProjectParameters_frictional.json`` and
+the plots ``data/solution_frictionless.png`` and ``data/solution_frictional.png``):
+
+- block 12 x 4 (mdpa: x in [0, 12], y in [0, 4]), its bottom clamped; here [-0.8, 11.2] x
+  [-4, 0], the die's lowest point at the origin;
+- die 1.2 wide and 1.2 high (mdpa: x in [0.2, 1.4], y in [4, 5.2]), its bottom the arc of
+  radius 0.75 centred 0.75 above its lowest point (through (0.2, 4.3), (0.8, 4), (1.4, 4.3));
+  its top moved as a rigid face;
+- neo-Hookean, E = 68.96e8 (die) and 68.96e7 (block), nu = 0.32 for both
+  (StructuralMaterials.json);
+- load program (ProjectParameters_literature.json): the die's top moves down by 0.8 (from
+  touching; the published set-up starts 0.2 above the block and moves 1), then along +x by 10
+  at that depth;
+- Coulomb friction mu = 0.3 (ProjectParameters_frictional.json, ``friction_coefficients``);
+- published force on the die while it slides (per unit thickness, read off the plots, about
+  3 %): vertical plateau 3.40e8 (frictionless; the frictional plot shows the same level) and
+  horizontal plateau 1.02e8 with mu = 0.3 (frictionless: about 0).
+
+Differences: the Kratos model is 3D with the out-of-plane displacement held on one face only;
+this scene is plane strain, as the 2D benchmark of Yang et al. The die's vertical sides are no
+contact surface (the Kratos contact group holds the arc and the block's top only).
+
+Forces: the pair's force on the die (``pair_forces.csv``): P = its y component (the block
+pushes the die up), Q = minus its x component (the drag force needed to move the die along +x;
+positive with friction). Scores over the plateau (the steps whose slide is within
+[plateau_from, plateau_to] of ``slide``: the die far from both ends of the block, where the
+published curves are flat): ``P_plateau`` and ``Q_plateau`` (means), their relative errors
+against the published plateaus (``P_plateau_error``; ``Q_plateau_error`` with Coulomb mu = 0.3
+only), ``Q_over_P`` = Q_plateau / P_plateau (and ``Q_over_P_over_mu`` with friction),
+``P_jump`` and ``Q_jump``: the largest change of P or Q between consecutive plateau steps over
+P_plateau. With ``--out`` the scene writes ``history.png``: P and Q against the slide, with the
+published plateaus.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+import dolfinx
+import numpy as np
+from mpi4py import MPI
+
+from contactfx.meshes import DieOnBlockCells, DieOnBlockFacets, die_on_block
+from contactfx.params import param
+from contactfx.scenes import export
+from contactfx.scenes._common import fix, prescribe_component
+from contactfx.scenes.two_body_2d import press_then_drag
+from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
+
+__all__ = ["ShallowIroning", "PUBLISHED_P", "PUBLISHED_Q", "PUBLISHED_MU"]
+
+#: the published vertical force plateau while sliding, per unit thickness (read off the plots
+#: of KratosMultiphysics/Examples shallow_ironing_3D, about 3 %)
+PUBLISHED_P = 3.40e8
+#: the published horizontal force plateau with Coulomb friction mu = PUBLISHED_MU
+PUBLISHED_Q = 1.02e8
+PUBLISHED_MU = 0.3
+
+
+@dataclass(frozen=True)
+class ShallowIroningParams(two_elastic(68.96e7, 0.32)):
+    # E_lower / nu_lower: the block; E_upper / nu_upper: the die
+    E_upper: float = param(68.96e8, "Young's modulus of the upper body (the die)", positive=True)
+    slave: str = param(
+        "lower",
+        "the slave surface of the contact pair (the block: with the die's arc as the slave, "
+        "Newton fails as the die starts to slide)",
+        choices=("upper", "lower"),
+    )
+    radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
+    half_width: float = param(0.6, "half-width of the die", positive=True)
+    height: float = param(1.2, "height of the die (its top above its lowest point)", positive=True)
+    press: float = param(0.8, "downward displacement of the die's top", positive=True)
+    slide: float = param(
+        10.0, "displacement of the die's top along +x after pressing", positive=True
+    )
+    press_fraction: float = param(
+        0.1, "fraction of the load program spent pressing, in (0, 1)", positive=True
+    )
+    left: float = param(0.8, "extent of the block left of the die's lowest point", positive=True)
+    right: float = param(11.2, "extent of the block right of the die's lowest point", positive=True)
+    depth: float = param(4.0, "depth of the block", positive=True)
+    h_contact: float = param(0.1, "element size of the block along the track", positive=True)
+    h_far: float = param(0.8, "element size far from the contact", positive=True)
+    refine: float = param(
+        0.3, "distance from the track meshed with the contact sizes", positive=True
+    )
+    ratio: float = param(0.6, "element size of the die / that of the block", positive=True)
+    offset: float = param(
+        0.3,
+        "shift of the die's contact nodes (fraction of an element, in [0, 1))",
+        nonnegative=True,
+    )
+    plateau_from: float = param(
+        0.3, "start of the plateau, a fraction of the slide", nonnegative=True
+    )
+    plateau_to: float = param(0.7, "end of the plateau, a fraction of the slide", positive=True)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not self.press_fraction < 1.0:
+            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
+        if not self.plateau_from < self.plateau_to <= 1.0:
+            raise ValueError(
+                "need plateau_from < plateau_to <= 1, got "
+                f"{self.plateau_from} and {self.plateau_to}"
+            )
+
+
+class ShallowIroning(TwoBodyScene):
+    name = "shallow-ironing"
+    summary = (
+        "neo-Hookean die with a rounded bottom pressed into a block and dragged 10 along it "
+        "(Yang et al. 2005); force plateaus against the published curves"
+    )
+    Params = ShallowIroningParams
+    cells = {"lower": DieOnBlockCells.BLOCK, "upper": DieOnBlockCells.DIE}
+    surfaces = {"lower": DieOnBlockFacets.BLOCK_TOP, "upper": DieOnBlockFacets.DIE_CONTACT}
+    numerics_defaults = {"method": "penalty", "material": "neo-hookean", "steps": 40}
+
+    friction = "none"
+    mu = 0.0
+
+    def configure(self, numerics) -> None:
+        super().configure(numerics)
+        self.friction, self.mu = numerics.friction, float(numerics.mu)
+
+    def mesh_builder(self):
+        p = self.p
+        builder = functools.partial(
+            die_on_block,
+            radius=p.radius,
+            half_width=p.half_width,
+            height=p.height,
+            left=p.left,
+            right=p.right,
+            depth=p.depth,
+            track=p.slide,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
+        return builder, 2
+
+    def make_constants(self, mesh) -> None:
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        self.drag = dolfinx.fem.Constant(mesh, 0.0)
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = DieOnBlockFacets
+        return [
+            *fix(V, facet_tags, f.BLOCK_BOTTOM),
+            prescribe_component(V, facet_tags, f.DIE_TOP, 0, self.drag),
+            prescribe_component(V, facet_tags, f.DIE_TOP, 1, self.push),
+        ]
+
+    def boundary_data(self) -> list[dict]:
+        p = self.p
+        return [
+            export.fixed("block_bottom", (0, 1)),
+            *press_then_drag("die_top", p.slide, -p.press, p.press_fraction),
+        ]
+
+    def top_displacement(self, t: float) -> tuple[float, float]:
+        """(tangential, vertical) displacement of the die's top at load factor t."""
+        f = self.p.press_fraction
+        pressed = min(t / f, 1.0)
+        dragged = max(t - f, 0.0) / (1.0 - f)
+        return dragged * self.p.slide, -pressed * self.p.press
+
+    def set_load(self, t: float) -> None:
+        self.drag.value, self.push.value = self.top_displacement(t)
+
+    def published_Q(self) -> float | None:
+        """The published horizontal plateau: with Coulomb mu = 0.3 only."""
+        coulomb = self.friction == "coulomb" and abs(self.mu - PUBLISHED_MU) < 1e-12
+        return PUBLISHED_Q if coulomb else None
+
+    def reference(self, force: float) -> dict[str, float]:
+        ref = {"P_plateau_published": PUBLISHED_P}
+        Q = self.published_Q()
+        if Q is not None:
+            ref["Q_plateau_published"] = Q
+        return ref
+
+    def plateau(self, loads: np.ndarray) -> np.ndarray:
+        """The indices of the steps on the plateau (slide within [plateau_from, plateau_to] of
+        ``slide``)."""
+        slide = np.array([self.top_displacement(t)[0] for t in loads]) / self.p.slide
+        f = self.p.press_fraction
+        on = (loads > f * (1.0 + 1e-9)) & (slide >= self.p.plateau_from - 1e-9)
+        return np.flatnonzero(on & (slide <= self.p.plateau_to + 1e-9))
+
+    def force_scores(self, loads, forces):
+        """The plateau means of P and Q, their errors against the published plateaus, Q / P,
+        and the largest step-to-step jumps of P and Q on the plateau (over P_plateau)."""
+        P, Q = forces[:, 1], -forces[:, 0]
+        scores = {"P": float(P[-1]), "Q": float(Q[-1])}
+        on = self.plateau(loads)
+        if len(on) < 2:
+            return scores
+        Pm, Qm = float(np.mean(P[on])), float(np.mean(Q[on]))
+        scores.update(
+            P_plateau=Pm,
+            Q_plateau=Qm,
+            P_plateau_error=(Pm - PUBLISHED_P) / PUBLISHED_P,
+            Q_over_P=Qm / Pm,
+            P_jump=float(np.max(np.abs(np.diff(P[on])))) / Pm,
+            Q_jump=float(np.max(np.abs(np.diff(Q[on])))) / Pm,
+            plateau_steps=float(len(on)),
+        )
+        published = self.published_Q()
+        if published is not None:
+            scores["Q_plateau_error"] = (Qm - published) / published
+        if self.friction == "coulomb" and self.mu > 0.0:
+            scores["Q_over_P_over_mu"] = Qm / Pm / self.mu
+        return scores
+
+    def run(self, numerics, *, comm=MPI.COMM_WORLD, out=None, **kwargs):
+        """The run, then ``history.png`` from ``pair_forces.csv`` when ``out`` is given."""
+        res = super().run(numerics, comm=comm, out=out, **kwargs)
+        if out is not None and comm.rank == 0:
+            forces = Path(out) / "pair_forces.csv"
+            if forces.exists():
+                plot_history(
+                    self,
+                    np.loadtxt(forces, delimiter=",", skiprows=1, ndmin=2),
+                    Path(out) / "history.png",
+                )
+        return res
+
+
+def plot_history(scene: ShallowIroning, rows: np.ndarray, path: Path) -> None:
+    """P and Q (the force on the die) against the die's top displacement along x (the pressing
+    at slide 0, drawn against its depth on a second axis would hide nothing more), with the
+    published plateaus over the plateau window."""
+    from contactfx.driver.interface_post import pyplot
+
+    plt = pyplot()
+    loads = rows[:, 0]
+    P, Q = rows[:, 2], -rows[:, 1]
+    # the x axis: the published load program's time (0.2 -> 1 pressing, 1 -> 2 sliding)
+    f = scene.p.press_fraction
+    time = np.where(loads <= f, 0.2 + 0.8 * loads / f, 1.0 + (loads - f) / (1.0 - f))
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ax.plot(time, P, "o-", ms=3, label="P (vertical)")
+    ax.plot(time, Q, "s-", ms=3, label="Q (horizontal)")
+    window = [1.0 + scene.p.plateau_from, 1.0 + scene.p.plateau_to]
+    ax.plot(window, [PUBLISHED_P] * 2, "k--", label=f"published P plateau {PUBLISHED_P:.3g}")
+    published = scene.published_Q()
+    if published is not None:
+        ax.plot(window, [published] * 2, "k:", label=f"published Q plateau {published:.3g}")
+    ax.set_xlabel("time of the published load program (0.2-1 pressing, 1-2 sliding)")
+    ax.set_ylabel("force on the die per unit thickness")
+    friction = f"Coulomb mu = {scene.mu:g}" if scene.friction == "coulomb" else scene.friction
+    ax.set_title(f"shallow ironing ({friction})")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
