@@ -9,8 +9,9 @@ doi:10.1051/m2an/2014046: theta = 1 needs gamma0 large enough, theta = -1 is sta
 gamma0), the penalty parameter, Poisson's ratio up to 0.4999 (P1, P2, mixed u-p where
 available), friction mu up to 1 and a stiff stick (1000), contact onset (zero gap, grazing,
 clearance, a front crossing many element edges), the flat punch's singular edge, one huge load
-step against many small ones, interference (the indenter starts inside the body), and 1 / 2 / 3
-ranks.
+step against many small ones, interference (the indenter starts inside the body), finite strain
+(indentation to 0.3 R, nu to 0.4999, stiffness contrast 1e3 between two bodies, sliding over 50
+elements with mu up to 1), and 1 / 2 / 3 ranks.
 
 Outputs (``--out``): stress.csv, stress.md and gamma0.png (error and Newton iterations against
 gamma0, one line per theta).
@@ -216,6 +217,7 @@ def cases() -> list[StressCase]:
             )
         )
     out += _interface_cases()
+    out += _finite_strain_cases()
     for ranks in (1, 2, 3):
         out.append(
             StressCase(
@@ -226,6 +228,68 @@ def cases() -> list[StressCase]:
                 {"method": "nitsche"},
                 quick=ranks < 3,
                 ranks=ranks,
+            )
+        )
+    return out
+
+
+def _finite_strain_cases() -> list[StressCase]:
+    """Neo-Hookean bodies (``--material neo-hookean``): a rigid cylinder pressed ever
+    deeper (to 0.3 R, where the elements at the contact's edge reach J of about 0.3), Poisson's
+    ratio to 0.4999 (the P2/P1 mixed formulation), two bodies of stiffness contrast 1e3 either
+    way, and a rounded body dragged over 50 elements of a block, frictionless and with mu up
+    to 1 (penalty, the only method between two finite-strain bodies)."""
+    out: list[StressCase] = []
+    fs = {"material": "neo-hookean"}
+    circle = {"profile": "circle", "h_contact": 0.01, "refine_half_width": 0.6, "h_far": 0.2}
+    for depth in (0.01, 0.05, 0.1, 0.2, 0.3):
+        out.append(
+            StressCase(
+                f"depth {depth:g} R, nitsche theta=0",
+                "finite strain: indentation",
+                "hertz2d",
+                {**circle, "depth": depth},
+                {**fs, "method": "nitsche", "theta": 0, "steps": 10},
+                quick=depth == 0.1,
+            )
+        )
+    for nu, extra in (
+        (0.3, {"degree": 1}),
+        (0.49, {"degree": 2, "formulation": "mixed-up"}),
+        (0.4999, {"degree": 2, "formulation": "mixed-up"}),
+        (0.4999, {"degree": 1}),
+    ):
+        name = "P2/P1 mixed u-p" if extra.get("formulation") else "P1"
+        out.append(
+            StressCase(
+                f"nu={nu:g} {name}, depth 0.05 R",
+                "finite strain: Poisson ratio",
+                "hertz2d",
+                {**circle, "depth": 0.05, "nu": nu},
+                {**fs, "method": "nitsche", "theta": 0, "steps": 5, **extra},
+            )
+        )
+    for ratio in (1.0, 1e3, 1e-3):
+        out.append(
+            StressCase(
+                f"E_upper/E_lower={ratio:g}",
+                "finite strain: stiffness contrast",
+                "hertz-cylinders",
+                {"E_upper": 1000.0 * ratio, "depth": 0.02, "h_contact": 0.01},
+                {**fs, "method": "penalty", "steps": 4},
+                quick=ratio == 1e3,
+            )
+        )
+    for mu in (0.0, 0.3, 1.0):
+        friction = {"friction": "coulomb", "mu": mu} if mu else {}
+        out.append(
+            StressCase(
+                f"slide 50 elements, mu={mu:g}",
+                "finite strain: sliding",
+                "sliding-contact",
+                {"press": 5e-3},
+                {**fs, "method": "penalty", "steps": 25, **friction},
+                quick=mu == 0.3,
             )
         )
     return out

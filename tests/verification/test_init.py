@@ -71,6 +71,11 @@ TWO_BODY_CASES = [
         {"h_contact": 0.005, "h_far": 0.3, "refine": 0.06, "slave": "lower"},
         {"steps": 4},
     ),
+    (
+        "shallow-ironing",
+        {"h_contact": 0.3, "h_far": 1.5, "press": 0.2, "slide": 0.6, "right": 3.0},
+        {"steps": 4},
+    ),
 ]
 CASES = OBSTACLE_CASES + INTERFACE_CASES + TWO_BODY_CASES
 
