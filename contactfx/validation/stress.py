@@ -280,6 +280,16 @@ def _finite_strain_cases() -> list[StressCase]:
                 quick=ratio == 1e3,
             )
         )
+    # the soft body as the slave (the penalty kappa E / h scales with the slave's E)
+    out.append(
+        StressCase(
+            "E_upper/E_lower=1000, slave lower",
+            "finite strain: stiffness contrast",
+            "hertz-cylinders",
+            {"E_upper": 1e6, "depth": 0.02, "h_contact": 0.01, "slave": "lower"},
+            {**fs, "method": "penalty", "steps": 4},
+        )
+    )
     for mu in (0.0, 0.3, 1.0):
         friction = {"friction": "coulomb", "mu": mu} if mu else {}
         out.append(
