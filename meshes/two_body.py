@@ -915,54 +915,91 @@ def rounded_on_block(
     if offset > 0:
         _check_first_element(l0, "the right half of the arc", half * r)
 
+    # The arc from (-w, height) through the origin (and the offset point) to (w, height).
+    block, block_lines, arc_points, arcs, centre = _block_and_arc(
+        model, left, right, depth, r, half, l0 if offset > 0 else None
+    )
+    (top,) = _polyline(model, [arc_points[-1], arc_points[0]])
+    rounded = _surface(model, [*arcs, top])
+    f = RoundedOnBlockFacets
+    _mesh_body_on_block(
+        model,
+        centre,
+        arcs if offset > 0 else None,
+        (RoundedOnBlockCells.BLOCK, block, dict(zip(_BLOCK_SIDES, block_lines, strict=True))),
+        (RoundedOnBlockCells.ROUNDED, rounded, {f.ROUNDED_CONTACT: arcs, f.ROUNDED_TOP: [top]}),
+        track=track,
+        sizes=(h_contact, h_far, ratio, refine, grading),
+    )
+
+
+#: the block's sides in :func:`_block_and_arc`'s order, as RoundedOnBlockFacets (which
+#: DieOnBlockFacets numbers alike)
+_BLOCK_SIDES = (
+    RoundedOnBlockFacets.BLOCK_TOP,
+    RoundedOnBlockFacets.BLOCK_RIGHT,
+    RoundedOnBlockFacets.BLOCK_BOTTOM,
+    RoundedOnBlockFacets.BLOCK_LEFT,
+)
+
+
+def _block_and_arc(
+    model: type[gmsh.model],
+    left: float,
+    right: float,
+    depth: float,
+    r: float,
+    half: float,
+    l0: float | None,
+) -> tuple[int, list[list[int]], list[int], list[int], int]:
+    """The block [-left, right] x [-depth, 0] (its surface and its sides' curves, top, right,
+    bottom, left) and the arc of radius r centred at (0, r) from the angle -half through the
+    origin (and the point at arc length l0 when given) to +half: its points, its arcs and the
+    centre point (removed by :func:`_mesh_body_on_block`)."""
     occ = model.occ
     block_points = [
         occ.addPoint(x, y, 0.0)
         for x, y in ((-left, 0.0), (right, 0.0), (right, -depth), (-left, -depth))
     ]
-    block_top, block_right, block_bottom, block_left = _polyline(
-        model, [*block_points, block_points[0]]
-    )
-    block = _surface(model, [block_top, block_right, block_bottom, block_left])
-
-    # The arc from (-w, height) through the origin (and the offset point) to (w, height).
+    lines = _polyline(model, [*block_points, block_points[0]])
+    block = _surface(model, lines)
     centre = occ.addPoint(0.0, r, 0.0)
-    angles = [-half, 0.0, *([l0 / r] if offset > 0 else []), half]
+    angles = [-half, 0.0, *([l0 / r] if l0 is not None else []), half]
     arc_points = [occ.addPoint(r * math.sin(a), r * (1 - math.cos(a)), 0.0) for a in angles]
     arcs = [
         occ.addCircleArc(a, centre, b) for a, b in zip(arc_points[:-1], arc_points[1:], strict=True)
     ]
-    (top,) = _polyline(model, [arc_points[-1], arc_points[0]])
-    rounded = _surface(model, [*arcs, top])
-    occ.remove([(0, centre)])  # the arc's centre is no vertex of the body: no free point
-    occ.synchronize()
-    if offset > 0:
-        model.mesh.setTransfiniteCurve(arcs[1], 2)
+    return block, [[line] for line in lines], arc_points, arcs, centre
 
-    f = RoundedOnBlockFacets
-    _add_body_groups(
-        model,
-        {
-            RoundedOnBlockCells.BLOCK: (
-                block,
-                {
-                    f.BLOCK_TOP: [block_top],
-                    f.BLOCK_RIGHT: [block_right],
-                    f.BLOCK_BOTTOM: [block_bottom],
-                    f.BLOCK_LEFT: [block_left],
-                },
-            ),
-            RoundedOnBlockCells.ROUNDED: (rounded, {f.ROUNDED_CONTACT: arcs, f.ROUNDED_TOP: [top]}),
-        },
-    )
-    # The block: distance to the track [0, track] x {0}, as in rectangle(); the body: to the
-    # origin.
+
+def _mesh_body_on_block(
+    model: type[gmsh.model],
+    centre: int,
+    split_arcs: list[int] | None,
+    block: tuple[int, int, dict[int, list[int]]],
+    body: tuple[int, int, dict[int, list[int]]],
+    *,
+    track: float,
+    sizes: tuple[float, float, float, float, float],
+) -> None:
+    """Finish and mesh a body on the block of :func:`_block_and_arc`: the arc's centre
+    removed (no vertex of the body), the first element past the offset point on the arcs
+    ``split_arcs`` (if given), the groups (cell tag, surface, facet groups) of the block and of
+    the body, the sizes (h_contact, h_far, ratio, refine, grading): the block's by the distance
+    to the track [0, track] x {0}, as in rectangle(), the body's by the distance to the
+    origin."""
+    h_contact, h_far, ratio, refine, grading = sizes
+    model.occ.remove([(0, centre)])
+    model.occ.synchronize()
+    if split_arcs is not None:
+        model.mesh.setTransfiniteCurve(split_arcs[1], 2)
+    _add_body_groups(model, {block[0]: block[1:], body[0]: body[1:]})
     end = matheval_number(track)
     along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
     _set_body_sizes(
         model,
         2,
-        [(block, h_contact, h_far), (rounded, ratio * h_contact, h_far)],
+        [(block[1], h_contact, h_far), (body[1], ratio * h_contact, h_far)],
         [f"Sqrt(({along})^2+y^2)", "Sqrt(x^2+y^2)"],
         dist_min=refine,
         grading=grading,
@@ -1148,61 +1185,26 @@ def die_on_block(
     if offset > 0:
         _check_first_element(l0, "the right half of the arc", half * r)
 
-    occ = model.occ
-    block_points = [
-        occ.addPoint(x, y, 0.0)
-        for x, y in ((-left, 0.0), (right, 0.0), (right, -depth), (-left, -depth))
-    ]
-    block_top, block_right, block_bottom, block_left = _polyline(
-        model, [*block_points, block_points[0]]
-    )
-    block = _surface(model, [block_top, block_right, block_bottom, block_left])
-
     # The arc from (-w, e) through the origin (and the offset point) to (w, e), then the
     # right side, the top and the left side.
-    centre = occ.addPoint(0.0, r, 0.0)
-    angles = [-half, 0.0, *([l0 / r] if offset > 0 else []), half]
-    arc_points = [occ.addPoint(r * math.sin(a), r * (1 - math.cos(a)), 0.0) for a in angles]
-    arcs = [
-        occ.addCircleArc(a, centre, b) for a, b in zip(arc_points[:-1], arc_points[1:], strict=True)
-    ]
+    block, block_lines, arc_points, arcs, centre = _block_and_arc(
+        model, left, right, depth, r, half, l0 if offset > 0 else None
+    )
+    occ = model.occ
     corners = [occ.addPoint(w, height, 0.0), occ.addPoint(-w, height, 0.0)]
     right_side, top, left_side = _polyline(model, [arc_points[-1], *corners, arc_points[0]])
     die = _surface(model, [*arcs, right_side, top, left_side])
-    occ.remove([(0, centre)])  # the arc's centre is no vertex of the body: no free point
-    occ.synchronize()
-    if offset > 0:
-        model.mesh.setTransfiniteCurve(arcs[1], 2)
-
     f = DieOnBlockFacets
-    _add_body_groups(
+    _mesh_body_on_block(
         model,
-        {
-            DieOnBlockCells.BLOCK: (
-                block,
-                {
-                    f.BLOCK_TOP: [block_top],
-                    f.BLOCK_RIGHT: [block_right],
-                    f.BLOCK_BOTTOM: [block_bottom],
-                    f.BLOCK_LEFT: [block_left],
-                },
-            ),
-            DieOnBlockCells.DIE: (
-                die,
-                {f.DIE_CONTACT: arcs, f.DIE_SIDES: [right_side, left_side], f.DIE_TOP: [top]},
-            ),
-        },
+        centre,
+        arcs if offset > 0 else None,
+        (DieOnBlockCells.BLOCK, block, dict(zip(_BLOCK_SIDES, block_lines, strict=True))),
+        (
+            DieOnBlockCells.DIE,
+            die,
+            {f.DIE_CONTACT: arcs, f.DIE_SIDES: [right_side, left_side], f.DIE_TOP: [top]},
+        ),
+        track=track,
+        sizes=(h_contact, h_far, ratio, refine, grading),
     )
-    # The block: distance to the track [0, track] x {0}, as in rectangle(); the die: to the
-    # arc's lowest point.
-    end = matheval_number(track)
-    along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
-    _set_body_sizes(
-        model,
-        2,
-        [(block, h_contact, h_far), (die, ratio * h_contact, h_far)],
-        [f"Sqrt(({along})^2+y^2)", "Sqrt(x^2+y^2)"],
-        dist_min=refine,
-        grading=grading,
-    )
-    _generate(model, 2)

@@ -537,27 +537,10 @@ class PointCoupling:
         add = PETSc.InsertMode.ADD_VALUES
         theta = self.law.theta
         for p in self.points:
-            if self.penalty_friction:
+            if self.penalty_friction:  # the whole law by complex steps (module docstring)
                 A = self._tangent(p, vals, np.ones(len(p["w"]), dtype=bool), geometric=False)
-                if self.geometric:
-                    inside = p["inside"]
-                    A[inside] = self._tangent(p, vals, inside, geometric=True)
-                keep = np.any(A != 0.0, axis=(1, 2))
-                for rows, block in zip(p["rows"][keep], A[keep], strict=True):
-                    J.setValues(rows, rows, block, addv=add)
-                continue
-            P, dP, _, sn = self._law(p, vals)
-            A = np.einsum("pi,pj->pij", p["Jn"], dP)
-            if sn is not None and theta != 0:
-                t = (theta / p["scale"])[:, None]
-                A -= np.einsum("pi,pj->pij", p["S"], t * (dP + p["S"]))
-            if self.frictional:
-                _, dt, _ = self._friction(p, vals, P, dP)
-                tt = (theta / p["scale"])[:, None, None]
-                A -= np.einsum("pig,pgj->pij", p["Jvec"] - tt * p["ST"], dt)
-                if theta != 0:
-                    A -= tt * np.einsum("pig,pjg->pij", p["ST"], p["ST"])
-            A *= p["w"][:, None, None]
+            else:
+                A = self._law_jacobian(p, vals, theta)
             if self.geometric:
                 inside = p["inside"]
                 A[inside] = self._tangent(p, vals, inside, geometric=True)
@@ -565,6 +548,22 @@ class PointCoupling:
             for rows, block in zip(p["rows"][keep], A[keep], strict=True):
                 J.setValues(rows, rows, block, addv=add)
         J.assemble()
+
+    def _law_jacobian(self, p: _Points, vals: np.ndarray, theta: int) -> np.ndarray:
+        """(P, m, m): the Jacobian blocks of the penalty / Nitsche law (with Nitsche's
+        Coulomb friction) at the projection of the last search, weighted."""
+        P, dP, _, sn = self._law(p, vals)
+        A = np.einsum("pi,pj->pij", p["Jn"], dP)
+        if sn is not None and theta != 0:
+            t = (theta / p["scale"])[:, None]
+            A -= np.einsum("pi,pj->pij", p["S"], t * (dP + p["S"]))
+        if self.frictional:
+            _, dt, _ = self._friction(p, vals, P, dP)
+            tt = (theta / p["scale"])[:, None, None]
+            A -= np.einsum("pig,pgj->pij", p["Jvec"] - tt * p["ST"], dt)
+            if theta != 0:
+                A -= tt * np.einsum("pig,pjg->pij", p["ST"], p["ST"])
+        return A * p["w"][:, None, None]
 
     def _point_terms(
         self, p: _Points, x: np.ndarray, sel: np.ndarray, geometric: bool

@@ -50,16 +50,13 @@ import functools
 from dataclasses import dataclass
 from pathlib import Path
 
-import dolfinx
 import numpy as np
 from mpi4py import MPI
 
 from contactfx.meshes import DieOnBlockCells, DieOnBlockFacets, die_on_block
 from contactfx.params import param
-from contactfx.scenes import export
-from contactfx.scenes._common import fix, prescribe_component
-from contactfx.scenes.two_body_2d import press_then_drag
-from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
+from contactfx.scenes.two_body_2d import PressThenDrag
+from contactfx.scenes.two_body_base import two_elastic
 
 __all__ = ["ShallowIroning", "PUBLISHED_P", "PUBLISHED_Q", "PUBLISHED_MU"]
 
@@ -121,7 +118,7 @@ class ShallowIroningParams(two_elastic(68.96e7, 0.32)):
             )
 
 
-class ShallowIroning(TwoBodyScene):
+class ShallowIroning(PressThenDrag):
     name = "shallow-ironing"
     summary = (
         "neo-Hookean die with a rounded bottom pressed into a block and dragged 10 along it "
@@ -158,34 +155,9 @@ class ShallowIroning(TwoBodyScene):
         )
         return builder, 2
 
-    def make_constants(self, mesh) -> None:
-        self.push = dolfinx.fem.Constant(mesh, 0.0)
-        self.drag = dolfinx.fem.Constant(mesh, 0.0)
-
-    def dirichlet(self, V, facet_tags) -> list:
-        f = DieOnBlockFacets
-        return [
-            *fix(V, facet_tags, f.BLOCK_BOTTOM),
-            prescribe_component(V, facet_tags, f.DIE_TOP, 0, self.drag),
-            prescribe_component(V, facet_tags, f.DIE_TOP, 1, self.push),
-        ]
-
-    def boundary_data(self) -> list[dict]:
-        p = self.p
-        return [
-            export.fixed("block_bottom", (0, 1)),
-            *press_then_drag("die_top", p.slide, -p.press, p.press_fraction),
-        ]
-
-    def top_displacement(self, t: float) -> tuple[float, float]:
-        """(tangential, vertical) displacement of the die's top at load factor t."""
-        f = self.p.press_fraction
-        pressed = min(t / f, 1.0)
-        dragged = max(t - f, 0.0) / (1.0 - f)
-        return dragged * self.p.slide, -pressed * self.p.press
-
-    def set_load(self, t: float) -> None:
-        self.drag.value, self.push.value = self.top_displacement(t)
+    #: the block's clamped bottom and the die's driven top: (facet tag, group)
+    clamped = (DieOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
+    driven = (DieOnBlockFacets.DIE_TOP, "die_top")
 
     def published_Q(self) -> float | None:
         """The published horizontal plateau: with Coulomb mu = 0.3 only."""

@@ -54,6 +54,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import ClassVar
 
 import dolfinx
 import numpy as np
@@ -245,7 +246,47 @@ class SlidingContactParams(two_elastic(1000.0, 0.3)):
             raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
 
 
-class SlidingContact(TwoBodyScene):
+class PressThenDrag(TwoBodyScene):
+    """A body's top pressed down by ``press`` on [0, press_fraction] of the load program, then
+    dragged along +x by ``slide`` at that depth, the other body's bottom clamped: ``clamped``
+    and ``driven`` are (facet tag, problem-file group) of the two; the scene's parameters
+    ``press``, ``slide`` and ``press_fraction``."""
+
+    clamped: ClassVar[tuple[int, str]]
+    driven: ClassVar[tuple[int, str]]
+
+    def make_constants(self, mesh) -> None:
+        self.push = dolfinx.fem.Constant(mesh, 0.0)
+        self.drag = dolfinx.fem.Constant(mesh, 0.0)
+
+    def dirichlet(self, V, facet_tags) -> list:
+        top = self.driven[0]
+        return [
+            *fix(V, facet_tags, self.clamped[0]),
+            prescribe_component(V, facet_tags, top, 0, self.drag),
+            prescribe_component(V, facet_tags, top, 1, self.push),
+        ]
+
+    def boundary_data(self) -> list[dict]:
+        p = self.p
+        return [
+            export.fixed(self.clamped[1], (0, 1)),
+            *press_then_drag(self.driven[1], p.slide, -p.press, p.press_fraction),
+        ]
+
+    def top_displacement(self, t: float) -> tuple[float, float]:
+        """(tangential, vertical) displacement of the top at load factor t: pressing on
+        [0, press_fraction], then dragging at the constant vertical displacement."""
+        f = self.p.press_fraction
+        pressed = min(t / f, 1.0)
+        dragged = max(t - f, 0.0) / (1.0 - f)
+        return dragged * self.p.slide, -pressed * self.p.press
+
+    def set_load(self, t: float) -> None:
+        self.drag.value, self.push.value = self.top_displacement(t)
+
+
+class SlidingContact(PressThenDrag):
     name = "sliding-contact"
     summary = (
         "rounded body pressed into a block and dragged along it (frictionless); "
@@ -277,35 +318,9 @@ class SlidingContact(TwoBodyScene):
         )
         return builder, 2
 
-    def make_constants(self, mesh) -> None:
-        self.push = dolfinx.fem.Constant(mesh, 0.0)
-        self.drag = dolfinx.fem.Constant(mesh, 0.0)
-
-    def dirichlet(self, V, facet_tags) -> list:
-        f = RoundedOnBlockFacets
-        return [
-            *fix(V, facet_tags, f.BLOCK_BOTTOM),
-            prescribe_component(V, facet_tags, f.ROUNDED_TOP, 0, self.drag),
-            prescribe_component(V, facet_tags, f.ROUNDED_TOP, 1, self.push),
-        ]
-
-    def boundary_data(self) -> list[dict]:
-        p = self.p
-        return [
-            export.fixed("block_bottom", (0, 1)),
-            *press_then_drag("rounded_top", p.slide, -p.press, p.press_fraction),
-        ]
-
-    def top_displacement(self, t: float) -> tuple[float, float]:
-        """(tangential, vertical) displacement of the top at load factor t: pressing on
-        [0, press_fraction], then dragging at the constant vertical displacement."""
-        f = self.p.press_fraction
-        pressed = min(t / f, 1.0)
-        dragged = max(t - f, 0.0) / (1.0 - f)
-        return dragged * self.p.slide, -pressed * self.p.press
-
-    def set_load(self, t: float) -> None:
-        self.drag.value, self.push.value = self.top_displacement(t)
+    #: the block's clamped bottom and the rounded body's driven top: (facet tag, group)
+    clamped = (RoundedOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
+    driven = (RoundedOnBlockFacets.ROUNDED_TOP, "rounded_top")
 
     def force_scores(self, loads, forces):
         """P, Q, Q / P at the last step; over the steady drag (the drag steps from the fourth
