@@ -238,6 +238,9 @@ class _Run:
             deadline=self.deadline,
         )
         solver.timer.assembly += assembly
+        if problem.material.finite_strain and self.num.inversion_check == "halve":
+            # a step that would invert an element (a NaN residual) is halved instead
+            solver.limit_steps(problem.volume_ratio.positive)
         return solver
 
     # -- load program ----------------------------------------------------------------------
@@ -270,6 +273,7 @@ class _Run:
                         rec.cutbacks,
                         s.reason,
                         s.coarse_newton,
+                        s.halvings,
                         quantities,
                     )
                 )
