@@ -60,6 +60,13 @@ class _General:
         "the increment grows by 1.5, up to this load increment (0: at most 1 / steps)",
         nonnegative=True,
     )
+    inversion_check: str = param(
+        "halve",
+        "finite strain: halve a Newton step (up to 10 times) until no element inverts "
+        "(J = det F > 0 in every cell), or off (an inverting step gives a NaN residual, and "
+        "the load step is cut back)",
+        choices=("halve", "off"),
+    )
     solver: str = param(
         "lu",
         "linear solver: MUMPS LU, or GMRES + GAMG in an inexact Newton method (large 3D meshes)",

@@ -160,6 +160,7 @@ class StepLog:
     cutbacks: int
     reason: str
     coarse_newton: int  # nested iteration: Newton iterations on the coarser meshes
+    halvings: int  # Newton steps halved so that no element inverts (finite strain)
     quantities: Quantities
 
     def to_json(self) -> dict[str, Any]:
@@ -240,6 +241,10 @@ class RunSummary:
     @property
     def cutbacks(self) -> int:
         return sum(s.cutbacks for s in self.steps)
+
+    @property
+    def halvings(self) -> int:
+        return sum(s.halvings for s in self.steps)
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> RunSummary:

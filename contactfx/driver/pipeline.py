@@ -239,6 +239,9 @@ class _Run:
             roundoff_stop=problem.material.finite_strain,
         )
         solver.timer.assembly += assembly
+        if problem.material.finite_strain and self.num.inversion_check == "halve":
+            # a step that would invert an element (a NaN residual) is halved instead
+            solver.limit_steps(problem.volume_ratio.positive)
         return solver
 
     # -- load program ----------------------------------------------------------------------
@@ -271,6 +274,7 @@ class _Run:
                         rec.cutbacks,
                         s.reason,
                         s.coarse_newton,
+                        s.halvings,
                         quantities,
                     )
                 )

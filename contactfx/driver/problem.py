@@ -36,6 +36,7 @@ from contactfx.driver.fields import (
     surface_mask,
     vertex_rule,
 )
+from contactfx.driver.inversion import VolumeRatio
 from contactfx.mechanics.axisymmetric import hoop_strain, measure
 from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
@@ -239,26 +240,23 @@ class Problem:
         ``finish(quantities, out) -> dict``."""
         raise NotImplementedError(f"{type(self).__name__} has no post-processing")
 
+    @functools.cached_property
+    def volume_ratio(self) -> VolumeRatio:
+        """J = det F of the displacement at sample points of every cell (a finite-strain
+        material): what the solver's step halving and :meth:`diagnose` ask."""
+        return VolumeRatio(self.material.jacobian(self.U), self.state, self.num.degree)
+
     def diagnose(self) -> str:
         """What the state shows after a failed solve (collective): with a finite-strain
-        material the smallest volume ratio J = det F over the cells and where it is, when an
-        element has inverted (J <= 0); else ""."""
+        material the smallest volume ratio J = det F over the cells' sample points
+        (:attr:`volume_ratio`) and the midpoint of its cell, when an element has inverted
+        (J <= 0); else ""."""
         if not self.material.finite_strain:
             return ""
-        DG0 = _compat.function_space(self.mesh, "DG", 0)
-        J = dolfinx.fem.Function(DG0)
-        J.interpolate(_compat.expression(self.material.jacobian(self.U), DG0))
-        comm, n = self.mesh.comm, DG0.dofmap.index_map.size_local
-        values = np.nan_to_num(J.x.array[:n], nan=-np.inf)  # NaN: ln J of an inverted cell
-        local = float(values.min()) if n else np.inf
-        j_min, owner = comm.allreduce((local, comm.rank), op=MPI.MIN)
+        j_min, where = self.volume_ratio.smallest(_compat.petsc_vec(self.state))
         if not j_min <= 0.0:
             return ""
-        where = None
-        if comm.rank == owner:
-            where = _compat.dof_coordinates(DG0)[int(values.argmin())][: self.gdim]
-        where = comm.bcast(where, root=owner)
-        at = ", ".join(f"{x:.4g}" for x in where)
+        at = ", ".join(f"{x:.4g}" for x in where[: self.gdim])
         value = "not a number" if np.isinf(j_min) else f"= {j_min:.3g} <= 0"
         return f"an element inverted (J {value}) at ({at}) in the reference mesh"
 

@@ -34,6 +34,7 @@ class SolveStats:
     reason: str = ""
     outer: int = 1  # augmented Lagrangian (Uzawa) outer iterations
     coarse_newton: int = 0  # nested iteration: Newton iterations on the coarser meshes
+    halvings: int = 0  # Newton steps halved before the line search (ContactSNES.limit_steps)
 
 
 class ConvergenceError(RuntimeError):

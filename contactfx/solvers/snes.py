@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import dolfinx
@@ -239,6 +239,71 @@ class _RoundOffStop:
         return R.CONVERGED_ITERATING
 
 
+class _StepHalving:
+    """Newton's line-search pre-check (PETSc's SNESLineSearchSetPreCheck, called before every
+    line search with the iterate x and the Newton direction y; the line search then tries
+    x - lambda y): y is halved until ``admissible(x - y)`` holds, at most MAX_HALVINGS times.
+
+    It gives up on a step, which is then left as Newton gave it (the line search meets what it
+    would have met without the check: an inadmissible iterate, a NaN residual, a failed solve
+    and a cut-back), when even the last halving is not admissible, or when the steps of the
+    solve's last MAX_IN_A_ROW iterations were all halved: a Newton iteration that keeps
+    running into the boundary of the admissible set, from a start too far from the solution,
+    which the load step's cut-back leaves sooner. Measured on hertz2d (neo-Hookean, Nitsche,
+    eight meshes, depths and thetas; docs/verification.md section 15): without a limit the
+    solves that failed halved every step from their first iteration on, for 10 to 34
+    iterations; with a limit of 1, 2 or 5 the runs took 29, 29 and 28 load steps (37 without
+    halving) and 308, 327 and 381 Newton iterations, failed solves included (330). A halved
+    step is what the check is for: a step, often the first of a load increment, that
+    overshoots into an inverted element from an iterate that Newton then corrects.
+
+    ``admissible`` is collective and answers alike on every rank, so every rank scales y
+    alike. ``halvings`` (halvings applied) and ``given_up`` (steps left whole) count since the
+    solver was made; :meth:`start` begins a solve."""
+
+    #: halvings per Newton step at most (a step of 2^-10 of Newton's)
+    MAX_HALVINGS = 10
+    #: halved steps in a row at most
+    MAX_IN_A_ROW = 1
+
+    def __init__(self, snes: PETSc.SNES, admissible: Callable[[PETSc.Vec], bool]) -> None:
+        self.admissible = admissible
+        self.halvings = 0
+        self.given_up = 0
+        self.in_a_row = 0
+        self.trial: PETSc.Vec | None = None
+        snes.setLineSearchPreCheck(self._precheck)
+
+    def start(self) -> None:
+        """A new solve: no halved steps in a row."""
+        self.in_a_row = 0
+
+    def _precheck(self, x: PETSc.Vec, y: PETSc.Vec) -> bool:
+        if self.trial is None:
+            self.trial = x.duplicate()
+        scale = 1.0
+        for halvings in range(self.MAX_HALVINGS + 1):
+            x.copy(self.trial)
+            self.trial.axpy(-scale, y)
+            if self.admissible(self.trial):
+                if halvings == 0:
+                    self.in_a_row = 0
+                    return False
+                y.scale(scale)
+                self.halvings += halvings
+                self.in_a_row += 1
+                return True
+            if self.in_a_row >= self.MAX_IN_A_ROW:
+                break
+            scale *= 0.5
+        self.given_up += 1
+        return False
+
+    def destroy(self) -> None:
+        if self.trial is not None:
+            self.trial.destroy()
+
+
 class ContactSNES:
     """Newton (or SNES-VI) for F(u) = R(u) + F_c(u) = 0 with Dirichlet conditions.
 
@@ -354,6 +419,8 @@ class ContactSNES:
             self.roundoff = _RoundOffStop(self.snes, divergence)
         self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
+        self.halving: _StepHalving | None = None
+        self._full: PETSc.Vec | None = None
 
     # -- options -------------------------------------------------------------------------
     @property
@@ -413,6 +480,26 @@ class ContactSNES:
             self.J, self.nullspace, rebuild_it, coupled=self.coupling is not None
         )
         self.snes.setJacobian(self._jacobian, self.J, self.kept.P)
+
+    # -- step halving ------------------------------------------------------------------------
+    def limit_steps(self, admissible: Callable[[PETSc.Vec], bool]) -> None:
+        """Halve every Newton step until ``admissible`` accepts the iterate it leads to, at
+        most _StepHalving.MAX_HALVINGS times (e.g. until no element of a finite-strain body
+        inverts: :class:`contactfx.driver.inversion.VolumeRatio`). ``admissible`` is a
+        collective predicate of a vector of u's layout (its owned entries set). The halvings
+        are counted in the solves' :class:`SolveStats` and named in a failed solve's
+        message."""
+        check = admissible
+        if self.reduced is not None:  # SNES's vectors hold the kept dofs only
+            reduced = self.reduced
+            full = self._full = reduced.F.duplicate()
+            full.set(0.0)  # the confined entries stay zero
+
+            def check(x: PETSc.Vec) -> bool:
+                reduced.extend(x, full)
+                return admissible(full)
+
+        self.halving = _StepHalving(self.snes, check)
 
     def set_bounds(self, lower: PETSc.Vec, upper: PETSc.Vec) -> None:
         """Bound constraints lower <= u <= upper (requires -snes_type vinewtonrsls)."""
@@ -670,6 +757,11 @@ class ContactSNES:
         start = xs.copy()
         ksp = self.snes.getKSP()
         linear_failure = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+        halving = self.halving
+        halved = given_up = 0
+        if halving is not None:
+            halving.start()
+            halved, given_up = halving.halvings, halving.given_up
         try:
             for attempt in itertools.count():
                 self.snes.solve(None, xs)
@@ -690,15 +782,23 @@ class ContactSNES:
             raise TimeLimitExceeded()
         self._sync(x)
         reason = self.snes.getConvergedReason()
+        if halving is not None:
+            halved, given_up = halving.halvings - halved, halving.given_up - given_up
         stats = SolveStats(
             newton=before.newton + self.snes.getIterationNumber(),
             ksp=before.ksp + self.snes.getLinearSolveIterations(),
             reason=snes_reason_name(reason),
+            halvings=before.halvings + halved,
         )
         if reason <= 0:
             message = stats.reason
             if reason == linear_failure:
                 message += f" ({self.mumps.describe(ksp)})"
+            if halving is not None and (halved or given_up):  # what the step halving did
+                message += f" (step halvings: {halved}"
+                if given_up:
+                    message += f"; steps not admissible, taken whole: {given_up}"
+                message += ")"
             raise ConvergenceError(message, stats=stats)
         return stats
 
@@ -745,7 +845,17 @@ class ContactSNES:
         return {}
 
     def destroy(self) -> None:
-        for obj in (self.snes, self.bulk, self.J, self.kept, self.Jc, self.fc, self.residual_vec):
+        for obj in (
+            self.snes,
+            self.bulk,
+            self.J,
+            self.kept,
+            self.Jc,
+            self.fc,
+            self.residual_vec,
+            self.halving,
+            self._full,
+        ):
             if obj is not None:
                 obj.destroy()
         if self.reduced is not None:

@@ -89,6 +89,7 @@ class Uzawa(SolverWrapper):
                 raise ConvergenceError(f"{err.reason} (Uzawa iteration {k})") from None
             total.newton += stats.newton
             total.ksp += stats.ksp
+            total.halvings += stats.halvings
             total.reason = stats.reason
             self.update(self._next)
             new = np.where(mask, self._next.x.array, 0.0)

@@ -155,6 +155,48 @@ def test_root_and_newton_count(bulk):
     assert stats.newton == expected
 
 
+def owned_max_at_most(bound, entries=None):
+    """A collective predicate of a vector: its largest owned entry (of the local indices
+    ``entries``, or all) is <= bound on every rank."""
+
+    def admissible(x):
+        values = x.getArray() if entries is None else x.getArray()[entries]
+        return COMM.allreduce(bool(np.all(values <= bound)), op=MPI.LAND)
+
+    return admissible
+
+
+def test_step_halving():
+    """Newton's first step from 0 is the spring-free bar, u = 3 x - 1.5 x^2 (u_L = 1.5, its
+    largest value); with the steps limited to max u <= 1 it is halved once (u_L = 0.75), and
+    from there the iterates are scalar Newton's on g from 0.75 (the next linear solve restores
+    the bulk rows exactly): they fall onto the root 0.607 with max u <= 0.76 (at x = 0.7), so
+    no other step is halved. The root is the bar's."""
+    solver, u, _ = make_solver("cfx_unit_halving_")
+    solver.limit_steps(owned_max_at_most(1.0))
+    solver.assemble_load()
+    stats = solver.solve()
+    solver.destroy()
+    assert stats.halvings == 1
+    assert stats.newton == 1 + newton_count(0.75, 1.0, f0_from_zero(1.0))
+    assert nodal_error(u, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+
+
+def test_step_halving_gives_up():
+    """A bound that no step meets (max u <= -1, not even the start): every step is given up
+    after MAX_HALVINGS halvings and taken whole, so Newton's iterates and count are the bar's
+    own; none is counted as halved."""
+    solver, u, _ = make_solver("cfx_unit_halving_none_")
+    solver.limit_steps(owned_max_at_most(-1.0))
+    solver.assemble_load()
+    stats = solver.solve()
+    given_up = solver.halving.given_up
+    solver.destroy()
+    assert stats.halvings == 0
+    assert given_up == stats.newton == newton_count(0.0, 1.0, f0_from_zero(1.0))
+    assert nodal_error(u, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+
+
 def test_max_it_raises_with_reason():
     assert newton_count(0.0, 1.0, f0_from_zero(1.0)) > 1  # one step is not enough
     solver, _, _ = make_solver("cfx_unit_maxit_", options={"snes_max_it": 1})
@@ -267,13 +309,18 @@ def test_load_program_increment_floor():
     assert stub.t_done == 7 / 16
 
 
-def test_confined_field_leaves_the_system():
+@pytest.mark.parametrize("halving", [False, True])
+def test_confined_field_leaves_the_system(halving):
     """The spring force as a second field lam of a mixed space [P1] x P1, confined to the end
     node x = L (``confined``: zero at every other node): u-equation E u'v' - t F v + lam v at
     x = L, lam-equation (lam - K u^3) mu at x = L. Its root is the cubic-spring bar's with
     lam = K u_L^3, and Newton's iterates are the bar's (lam is eliminated exactly by each
     linear solve), so the root, the count and the system size are all predicted: SNES works on
-    the N + 1 displacement dofs and the one kept multiplier dof, not on 2 (N + 1)."""
+    the N + 1 displacement dofs and the one kept multiplier dof, not on 2 (N + 1).
+
+    ``halving``: the steps limited to max u <= 1 as in test_step_halving, the predicate asked
+    on the full layout (the kept dofs put back in place): the first step is halved, the rest
+    are the bar's from u_L = 0.75."""
     from contactfx.driver.fields import confine, surface_mask
 
     mesh = _compat.create_interval(COMM, N, L)
@@ -298,9 +345,13 @@ def test_confined_field_leaves_the_system():
         contact_residual=dolfinx.fem.form(Fc),
         contact_jacobian=dolfinx.fem.form(ufl.derivative(Fc, w, dw)),
         bcs=[bc, *confined],
-        prefix="cfx_unit_confined_",
+        prefix=f"cfx_unit_confined_{halving}_",
         confined=confined,
     )
+    if halving:
+        u_dofs = np.asarray(W.sub(0).collapse()[1])
+        n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
+        solver.limit_steps(owned_max_at_most(1.0, u_dofs[u_dofs < n_owned]))
     solver.assemble_load()
     stats = solver.solve()
     size = solver.J.getSize()[0]
@@ -317,7 +368,11 @@ def test_confined_field_leaves_the_system():
     err = np.abs(lam_h.x.array[:n][end] - K * root(1.0) ** 3).max(initial=0.0)
     assert COMM.allreduce(err, op=MPI.MAX) < 3 * K * tolerance(f0_from_zero(1.0)) + 1e-13
     assert COMM.allreduce(np.abs(lam_h.x.array[:n][~end]).max(initial=0.0), op=MPI.MAX) == 0.0
-    assert stats.newton == newton_count(0.0, 1.0, f0_from_zero(1.0))
+    if halving:
+        assert stats.halvings == 1
+        assert stats.newton == 1 + newton_count(0.75, 1.0, f0_from_zero(1.0))
+    else:
+        assert stats.newton == newton_count(0.0, 1.0, f0_from_zero(1.0))
 
 
 @pytest.mark.parametrize("gdim", [2, 3])

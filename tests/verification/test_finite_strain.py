@@ -22,12 +22,23 @@ Measured (h = 0.1, two load steps):
                                        this block: +0.19 %)
     compliance                         peak +1.6 % (small strain: +1.0 %), likewise
     mixed u-p P2/P1, nu = 0.4999       grad u error 9e-15
+
+Newton when a step inverts an element: a finite-strain energy is undefined at J = det F <= 0
+(the neo-Hookean ln J), so such a step gives a NaN residual, SNES stops with
+DIVERGED_FNORM_NAN and the load step is cut back; ``--inversion-check halve`` (the default at
+finite strain) halves the step until no element inverts
+(:class:`contactfx.driver.inversion.VolumeRatio`, ``ContactSNES.limit_steps``). Tested: the
+sampled J of homogeneous stretches (P1, P2, mixed, axisymmetric), a first Newton step that
+inverts elements at the contact edge of hertz2d (halved: one load step instead of a cut-back,
+the same solution as eight load steps), and the diagnosis of an inversion that halving cannot
+avoid.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
+import re
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +47,8 @@ import ufl
 from mpi4py import MPI
 
 from conftest import grad_error, psi
+from contactfx import _compat
+from contactfx.driver import setup as build_problem
 from contactfx.io.vtk import read_vtu
 from contactfx.meshes import RectangleFacets
 from contactfx.scenes import Numerics
@@ -278,10 +291,13 @@ def test_serial_and_parallel_agree():
         assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
 
 
-def test_inverted_element_is_named():
+@pytest.mark.parametrize("check", ["halve", "off"])
+def test_inverted_element_is_named(check):
     # a cylinder (R = 1) pressed 0.9 deep into a unit-high neo-Hookean block: the elements at
     # the contact edge invert near a load factor of 0.89 whatever the step (measured: the
-    # stepper cuts back to 1/64 increments, then gives up with J = -0.24 at (-0.21, -0.05))
+    # stepper cuts back to 1/64 increments, then gives up at load factor 0.892 with J = -0.24
+    # at (-0.21, -0.05), or with the steps halved J = -2.4 at (-0.23, -0.07)). Halving cannot
+    # avoid it: the message says how many halvings it made and that it took one step whole
     params = dataclasses.replace(
         Hertz2D.Params(),
         E=1.0,
@@ -291,10 +307,97 @@ def test_inverted_element_is_named():
         h_far=0.2,
         refine_half_width=0.5,
     )
-    num = Numerics(material="neo-hookean", steps=1)
+    num = Numerics(material="neo-hookean", steps=1, inversion_check=check)
     with pytest.raises(ConvergenceError, match=r"an element inverted \(J .*\) at \(") as err:
         Hertz2D(params).run(num, verbose=False)
     assert 0.8 < err.value.load < 0.95
+    assert err.value.reason.startswith("DIVERGED_FNORM_NAN")
+    halved = re.search(
+        r"step halvings: (\d+); steps not admissible, taken whole: 1\)", str(err.value)
+    )
+    assert (halved is not None and int(halved[1]) > 0) == (check == "halve")
+
+
+#: a homogeneous stretch F = diag(L1, L2) (in plane)
+L1, L2 = 1.1, 0.8
+
+
+@pytest.mark.parametrize(
+    "scene, options",
+    [
+        (UniaxialBlock, {}),
+        (UniaxialBlock, {"degree": 2}),
+        (UniaxialBlock, {"degree": 2, "formulation": "mixed-up"}),
+        (UniaxialCylinder, {}),
+    ],
+)
+def test_volume_ratio_of_a_homogeneous_stretch(scene, options):
+    num = Numerics(friction="none", mu=0.0, material="neo-hookean", **options)
+    problem = build_problem(scene(PARAMS), num)
+    u = problem.state.sub(0) if problem.split else problem.state
+    ratio = problem.volume_ratio
+    x = _compat.petsc_vec(problem.state)
+    hoop = L1 if scene.axisymmetric else 1.0  # 1 + u_r / r
+    for l2 in (L2, -L2):
+        u.interpolate(lambda X, l2=l2: np.vstack([(L1 - 1.0) * X[0], (l2 - 1.0) * X[1]]))
+        problem.state.x.scatter_forward()
+        # P1 and P2 interpolate the linear displacement exactly: J = l1 l2 (times the hoop
+        # stretch l1) at every sample point of every cell, to round-off
+        np.testing.assert_allclose(ratio.values(x), L1 * l2 * hoop, rtol=1e-12)
+        assert ratio.positive(x) == (l2 > 0.0)
+        j_min, where = ratio.smallest(x)
+        assert j_min == pytest.approx(L1 * l2 * hoop, rel=1e-12)
+        assert len(where) >= 2
+
+
+def indentation(check: str, steps: int, comm=MPI.COMM_WORLD):
+    """hertz2d in neo-Hookean material (E = 1000, nu = 0.3): a true circle R = 1 pressed
+    0.006 deep (a / R = 0.06), h = 0.003 at the contact, Nitsche theta = 1."""
+    params = dataclasses.replace(
+        Hertz2D.Params(), profile="circle", depth=0.006, h_contact=0.003, refine_half_width=0.15
+    )
+    num = Numerics(
+        material="neo-hookean", method="nitsche", theta=1, steps=steps, inversion_check=check
+    )
+    return Hertz2D(params).run(num, comm=comm, verbose=False)
+
+
+def test_inverting_first_step_is_halved():
+    # the indentation in one load step: Newton's first step from the unloaded block inverts
+    # elements at the contact edge (with theta != 0 the tangent's term
+    # p theta / gamma d(sigma_n(v))/du, p / gamma the penetration, is large while the
+    # penetration is two elements deep; docs/verification.md section 15)
+    unchecked = indentation("off", 1)
+    checked = indentation("halve", 1)
+    reference = indentation("off", 8)
+    # without the check the first solve fails (measured: DIVERGED_FNORM_NAN at Newton's first
+    # step) and the step is cut back to load 1/2: two load steps
+    assert unchecked.cutbacks >= 1 and unchecked.halvings == 0
+    # with it: the inverting step halved, no cut-back, one load step, fewer Newton iterations
+    assert checked.halvings >= 1
+    assert checked.cutbacks == 0 and len(checked.steps) == 1
+    assert checked.newton_iterations < unchecked.newton_iterations
+    assert reference.cutbacks == 0  # eight steps: no inversion on the way
+    # halving shortens steps and leaves the discrete problem alone: the solution of eight
+    # load steps (frictionless and hyperelastic: no path dependence), to Newton's tolerance
+    # (rtol 1e-10 on the residual; measured 5e-13 on the force and the peak pressure, the
+    # same contact size; bound 1e-8, well above round-off and Newton's stopping error)
+    for key in ("force", "contact_size", "peak_pressure"):
+        assert getattr(checked, key) == pytest.approx(getattr(reference, key), rel=1e-8), key
+        assert getattr(unchecked, key) == pytest.approx(getattr(reference, key), rel=1e-8), key
+
+
+def test_inverting_first_step_serial_and_parallel_agree():
+    serial = indentation("halve", 1, MPI.COMM_SELF)
+    parallel = indentation("halve", 1, MPI.COMM_WORLD)
+    # the same steps halved (the check's answer is collective: every rank scales alike) and
+    # the same Newton path up to round-off
+    assert [(s.newton, s.halvings, s.cutbacks) for s in parallel.steps] == [
+        (s.newton, s.halvings, s.cutbacks) for s in serial.steps
+    ]
+    # same mesh, same discrete problem, Newton converged to 1e-10: round-off only
+    for key in ("force", "contact_size", "peak_pressure"):
+        assert getattr(parallel, key) == pytest.approx(getattr(serial, key), rel=1e-8), key
 
 
 @pytest.mark.parametrize(
