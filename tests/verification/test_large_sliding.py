@@ -82,8 +82,10 @@ class SlidingPatch(PatchTest):
                 V.sub(0), 1, facet_tags.indices[facet_tags.values == f.UPPER_TOP]
             )
         else:  # at the top's left corner only: the top expands freely (uniaxial stress)
+            mesh = V.mesh
+            mesh.topology.create_connectivity(0, mesh.topology.dim)  # (dolfinx 0.9 needs it)
             corner = dolfinx.mesh.locate_entities(
-                V.mesh, 0, lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], self.p.height)
+                mesh, 0, lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], self.p.height)
             )
             dragged = _compat.locate_dofs_topological(V.sub(0), 0, corner)
         return [
