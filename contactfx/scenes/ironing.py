@@ -46,7 +46,6 @@ published plateaus.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -136,24 +135,8 @@ class ShallowIroning(PressThenDrag):
         super().configure(numerics)
         self.friction, self.mu = numerics.friction, float(numerics.mu)
 
-    def mesh_builder(self):
-        p = self.p
-        builder = functools.partial(
-            die_on_block,
-            radius=p.radius,
-            half_width=p.half_width,
-            height=p.height,
-            left=p.left,
-            right=p.right,
-            depth=p.depth,
-            track=p.slide,
-            h_contact=p.h_contact,
-            h_far=p.h_far,
-            refine=p.refine,
-            ratio=p.ratio,
-            offset=p.offset,
-        )
-        return builder, 2
+    builder = staticmethod(die_on_block)
+    body_params = ("radius", "half_width", "height")
 
     #: the block's clamped bottom and the die's driven top: (facet tag, group)
     clamped = (DieOnBlockFacets.BLOCK_BOTTOM, "block_bottom")

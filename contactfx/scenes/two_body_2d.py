@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import dolfinx
 import numpy as np
@@ -254,6 +254,27 @@ class PressThenDrag(TwoBodyScene):
 
     clamped: ClassVar[tuple[int, str]]
     driven: ClassVar[tuple[int, str]]
+    #: the gmsh builder of the body on the block (its block and track keywords as
+    #: rounded_on_block's) and the names of the body's own parameters it takes
+    builder: ClassVar[Any]
+    body_params: ClassVar[tuple[str, ...]]
+
+    def mesh_builder(self):
+        p = self.p
+        builder = functools.partial(
+            type(self).builder,
+            **{name: getattr(p, name) for name in self.body_params},
+            left=p.left,
+            right=p.right,
+            depth=p.depth,
+            track=p.slide,
+            h_contact=p.h_contact,
+            h_far=p.h_far,
+            refine=p.refine,
+            ratio=p.ratio,
+            offset=p.offset,
+        )
+        return builder, 2
 
     def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
@@ -300,23 +321,8 @@ class SlidingContact(PressThenDrag):
     }
     numerics_defaults = {"steps": 50}
 
-    def mesh_builder(self):
-        p = self.p
-        builder = functools.partial(
-            rounded_on_block,
-            radius=p.radius,
-            height=p.height,
-            left=p.left,
-            right=p.right,
-            depth=p.depth,
-            track=p.slide,
-            h_contact=p.h_contact,
-            h_far=p.h_far,
-            refine=p.refine,
-            ratio=p.ratio,
-            offset=p.offset,
-        )
-        return builder, 2
+    builder = staticmethod(rounded_on_block)
+    body_params = ("radius", "height")
 
     #: the block's clamped bottom and the rounded body's driven top: (facet tag, group)
     clamped = (RoundedOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
