@@ -52,7 +52,7 @@ __all__ = [
 ]
 
 
-#: Newton with a backtracking line search, MUMPS LU.
+#: Newton (full steps: ``-snes_linesearch_type bt`` for a backtracking line search), MUMPS LU.
 DEFAULT_OPTIONS: dict[str, object] = {
     "snes_type": "newtonls",
     "snes_linesearch_type": "basic",
@@ -753,7 +753,9 @@ class ContactSNES:
         limit = self.snes.getTolerances()[3]
         if max_it is not None and max_it < limit:
             self.snes.setTolerances(max_it=max_it)
-        xs = x if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
+        # SNES iterates on its own vector: the callbacks copy their argument into u, and a line
+        # search evaluates F at trial points W = X - lambda Y while it still needs X
+        xs = x.copy() if self.reduced is None else self.reduced.restrict(x, self.reduced.x)
         start = xs.copy()
         ksp = self.snes.getKSP()
         linear_failure = PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
@@ -776,8 +778,9 @@ class ContactSNES:
         finally:
             start.destroy()
             self.snes.setTolerances(max_it=limit)
-            if self.reduced is not None:
-                self._sync(xs)  # into x = u
+            self._sync(xs)  # into x = u
+            if self.reduced is None:
+                xs.destroy()
         if self._late:
             raise TimeLimitExceeded()
         self._sync(x)

@@ -155,6 +155,20 @@ def test_root_and_newton_count(bulk):
     assert stats.newton == expected
 
 
+def test_backtracking_line_search_finds_the_root():
+    """With ``-snes_linesearch_type bt`` the full first step from 0 (u_L = 1.5, |g| = 13.5
+    against 1.5 at 0) is backtracked, and the line search's trial points are X - lambda Y
+    from the iterate X it started at: the solve reaches the same root as full Newton steps.
+    (When the residual callback wrote its trial point into u, which was also SNES's iterate,
+    every later trial started from the rejected full step, and the line search failed.)"""
+    solver, u, _ = make_solver("cfx_unit_bt_", user_options={"snes_linesearch_type": "bt"})
+    solver.assemble_load()
+    stats = solver.solve()
+    solver.destroy()
+    assert stats.reason.startswith("CONVERGED_FNORM")
+    assert nodal_error(u, 1.0) < tolerance(f0_from_zero(1.0))  # see tolerance()
+
+
 def owned_max_at_most(bound, entries=None):
     """A collective predicate of a vector: its largest owned entry (of the local indices
     ``entries``, or all) is <= bound on every rank."""
