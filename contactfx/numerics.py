@@ -60,6 +60,20 @@ class _General:
         "the increment grows by 1.5, up to this load increment (0: at most 1 / steps)",
         nonnegative=True,
     )
+    predictor: str = param(
+        "secant",
+        "start of each load step: secant (the extrapolation of the last two converged steps), "
+        "or previous (the last converged state: for a body dragged over many elements, where "
+        "the secant lifts the contact off the surface it has moved on)",
+        choices=("secant", "previous"),
+    )
+    line_search: str = param(
+        "basic",
+        "Newton's line search: basic (full steps), bt (backtracking on the residual norm) or "
+        "cp (the step length where the residual is orthogonal to the step: a minimum of the "
+        "energy along it; the penalty and hyperelastic problems are energy minimisations)",
+        choices=("basic", "bt", "cp"),
+    )
     inversion_check: str = param(
         "halve",
         "finite strain: halve a Newton step (up to 10 times) until no element inverts "

@@ -218,6 +218,7 @@ class _Run:
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem: Problem, forms: Forms) -> ContactSNES:
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
+        options["snes_linesearch_type"] = self.num.line_search
         options.update(self.method.snes_options())
         t0 = time.perf_counter()
         bulk = forms.bulk()
@@ -287,7 +288,11 @@ class _Run:
 
             t0 = time.perf_counter()
             a0 = solver.timer.assembly
-            stepper = QuasiStatic(self.num.steps, max_increment=self.num.max_increment or None)
+            stepper = QuasiStatic(
+                self.num.steps,
+                max_increment=self.num.max_increment or None,
+                predictor=self.num.predictor,
+            )
             march(stepper, solver, problem.apply_load, on_step=on_step, diagnose=problem.diagnose)
             total = time.perf_counter() - t0
         self.timings["assembly"] = solver.timer.assembly + self.timings.pop("chain_assembly", 0.0)

@@ -6,8 +6,8 @@ step (its history moves on), on failure let it cut the step back (it restores ev
 owns) or give up. What a step's history is belongs to the stepper:
 
 * :class:`QuasiStatic`: the load factors t = 1/steps, ..., 1 (a quasi-static run's time is its
-  load factor), a secant predictor through the last two converged states, cut-back by
-  halving;
+  load factor), a secant predictor through the last two converged states (or the last
+  converged state), cut-back by halving;
 * a dynamic stepper (Newmark, HHT-alpha, generalised-alpha) holds (u, v, a), predicts from
   them, restores all three on a cut-back, and asks the solver's bulk to assemble again when
   its step size changes (the effective stiffness K + c M depends on it).
@@ -119,7 +119,16 @@ class QuasiStatic:
     Each step but the first starts from the secant extrapolation of the last two converged
     states, the unloaded state u = 0 at t = 0 being the first of them (not the starting
     iterate: that is a guess of the first step's solution, and a secant through it can carry a
-    stiffly enforced contact off its obstacle everywhere, where the Jacobian is singular). A
+    stiffly enforced contact off its obstacle everywhere, where the Jacobian is singular).
+    With ``predictor="previous"`` each step starts from the last converged state (Abaqus's
+    ``EXTRAPOLATION=NO``): where a contact moves over the mesh (a body dragged over several
+    elements a step) the displacement of a surface node is a wave passing it, which the secant
+    extrapolates wrongly to second order; the extrapolated start lifts most of the contact
+    zone off the surface by more than the penalty's penetration, Newton's first step from
+    there, without the stiffness of the open points, releases the dent, and the residual jumps
+    by two orders of magnitude (the sliding-contact scene at finite strain: 35 load steps and
+    240 Newton iterations for 20 asked with the secant, 24 and 194 without; docs/verification.md
+    section 15). A
     failed step is retried with half the increment, up to ``max_cutbacks`` halvings in a row,
     and never below 1 / (steps 4^max_cutbacks) (the increment grows back only after a step
     that needed no cut-back, so without a floor steps that each fail once would shrink it
@@ -142,6 +151,7 @@ class QuasiStatic:
         max_increment: float | None = None,
         easy_newton: int = 5,
         growth: float = 1.5,
+        predictor: str = "secant",
     ) -> None:
         if steps < 1:
             raise ValueError(f"load steps must be >= 1, got {steps}")
@@ -150,6 +160,9 @@ class QuasiStatic:
         self.steps, self.max_cutbacks, self.fields = steps, max_cutbacks, list(fields)
         self.max_increment = max_increment
         self.easy_newton, self.growth = easy_newton, growth
+        if predictor not in ("secant", "previous"):
+            raise ValueError(f"the predictor must be secant or previous, got {predictor!r}")
+        self.secant = predictor == "secant"
         self.step = 0
 
     def start(self, x: PETSc.Vec) -> None:
@@ -173,9 +186,10 @@ class QuasiStatic:
     def predict(self) -> None:
         """x = previous + factor (previous - older): the secant extrapolation of the last two
         converged states (previous alone, factor 0, in the first step: before it, previous
-        is the starting iterate); the other fields at their last converged values."""
+        is the starting iterate; and at every step with the predictor "previous"); the other
+        fields at their last converged values."""
         t, t_prev = self.t, self.t_prev
-        factor = (t - t_prev) / (t_prev - self.t_older) if self.step > 0 else 0.0
+        factor = (t - t_prev) / (t_prev - self.t_older) if self.step > 0 and self.secant else 0.0
         self.previous.restore()
         if factor != 0.0:
             self.x.axpy(factor, self.previous.copies[0])

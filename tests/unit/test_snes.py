@@ -31,7 +31,7 @@ from petsc4py import PETSc
 from contactfx import _compat
 from contactfx.solvers.bulk import LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import DEFAULT_OPTIONS, ContactSNES, ConvergenceError
-from contactfx.solvers.stepper import run_load_program
+from contactfx.solvers.stepper import QuasiStatic, march, run_load_program
 
 COMM = MPI.COMM_WORLD
 L, N, E, F, K = 1.0, 4, 1.0, 3.0, 4.0
@@ -257,6 +257,29 @@ def test_load_program_steps():
     counts = [newton_count(u0, s, f0) for s, (u0, f0) in zip(loads, starts, strict=True)]
     assert [r.stats.newton for r in records] == counts
     assert counts[2] < counts[0]  # the predictor pays off
+
+
+def test_load_program_previous_predictor():
+    """With the predictor "previous" each step starts from the last converged state: 0, u(1/3)
+    and u(2/3). The bulk is linear and u(s) is the root at load s, so the residual at the start
+    of a step to load s + 1/3 is the load increment alone (the residual of 0 at load 1/3): the
+    same norm at every step (the secant's starts have other norms). Newton's iterates are scalar
+    Newton's on g from the start's end value (module docstring)."""
+    solver, u, t = make_solver("cfx_unit_previous_")
+    first = []  # the residual norm each solve starts from
+    solver.snes.setMonitor(lambda snes, its, norm: first.append(norm) if its == 0 else None)
+    records = march(QuasiStatic(3, predictor="previous"), solver, lambda s: setattr(t, "value", s))
+    error = nodal_error(u, 1.0)
+    solver.destroy()
+    loads, f0 = [1 / 3, 2 / 3, 1.0], f0_from_zero(1 / 3)
+    assert error < tolerance(f0)  # see tolerance()
+    # the converged roots differ from the bisection's by the SNES tolerance (< 1e-10)
+    np.testing.assert_allclose(first, [f0] * 3, rtol=1e-9)
+    starts = [0.0, root(1 / 3), root(2 / 3)]
+    counts = [newton_count(u0, s, f0) for s, u0 in zip(loads, starts, strict=True)]
+    assert [r.stats.newton for r in records] == counts
+    with pytest.raises(ValueError, match="secant or previous"):
+        QuasiStatic(3, predictor="linear")
 
 
 def test_load_program_cutback():
