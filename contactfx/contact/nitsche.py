@@ -65,10 +65,7 @@ class Nitsche(TrialFriction, MethodBase):
         nodal_quadrature=True,
         interfaces=True,
         two_body=True,
-        why_not={
-            "two_body_finite_strain": "its consistency term between two bodies is the slave "
-            "body's small-strain stress"
-        },
+        two_body_finite_strain=True,
     )
 
     def __post_init__(self) -> None:

@@ -236,6 +236,10 @@ class ContactPair:
     #: (m, 3) E, lambda, mu of the cell of each slave / master facet (set by the problem)
     slave_lame: np.ndarray | None = None
     master_lame: np.ndarray | None = None
+    #: (m,) the stress model of the cell of each slave / master facet (finite-strain Nitsche:
+    #: ``point_coupling.LINEAR``, ``NEO_HOOKEAN``, ``SVK``; None: linear), set by the problem
+    slave_model: np.ndarray | None = None
+    master_model: np.ndarray | None = None
     #: Coulomb friction coefficient (None: frictionless or Tresca) and the last converged
     #: displacement (a Function: the history of the slip increments), set by the problem
     mu: float | None = None

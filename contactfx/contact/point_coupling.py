@@ -31,7 +31,8 @@ radius, or the closest point on an edge of the master surface that no other mast
 shares) are not in contact.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
-the penalty only, and always searched at every Newton iteration): everything above is already
+penalty, and frictionless Nitsche as below; always searched at every Newton iteration):
+everything above is already
 in the current configuration, x = X + u on both sides: the slave Gauss points, the master facets,
 their normal n_m and the closest point y. The weights are the Gauss weights of the REFERENCE
 slave facet, so P = kappa [-g]_+ is a nominal pressure (force per unit reference area of the
@@ -49,6 +50,15 @@ normal, both functions of u: computed by complex-step differentiation of the vec
 residual (Squire and Trapp 1998, doi:10.1137/S003614459631241X), exact to round-off, which
 gives Newton's quadratic convergence without writing Wriggers' geometric terms by hand.
 Points at a vertex of the master surface keep the Jacobian above.
+
+Nitsche between finite-strain bodies (frictionless): sigma_n(u) becomes the slave's first
+Piola traction on its reference facet along the current normal, T_n(u) = n . P(F) N (N the
+reference facet's outward unit normal, F constant in the P1 slave cell), a nominal pressure as
+the penalty's, and sigma_n(v) its derivative with n held, T_n(v) = n . (dP/dF : grad v) N
+(the large-deformation Nitsche of Mlika, Renard and Chouly 2017,
+doi:10.1016/j.cma.2017.01.003); :func:`first_piola` gives P and dP/dF of neo-Hookean, Saint
+Venant-Kirchhoff and linear slave cells in closed form. Residual and Jacobian come from
+:meth:`PointCoupling._point_terms` by complex steps, as for penalty friction below.
 
 Penalty friction (Coulomb |t| <= mu P, or Tresca |t| <= s where closed), small or finite
 strain: a return map at every Gauss point, t = proj_{B(0, bound)}(t_trial), with the trial
@@ -117,12 +127,117 @@ def _cell_gradients(X: np.ndarray) -> np.ndarray:
     return np.concatenate([-Jinv.sum(axis=1, keepdims=True), Jinv], axis=1)
 
 
+def _outward_normals(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """(m, gdim) unit normals of the facets (m, d, gdim) pointing away from their cells
+    (m, d + 1, gdim) (2D: segments, 3D: triangles)."""
+    e = facets[:, 1:] - facets[:, :1]
+    if facets.shape[2] == 2:
+        n = np.stack([e[:, 0, 1], -e[:, 0, 0]], axis=1)
+    else:
+        n = np.cross(e[:, 0], e[:, 1])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    out = np.einsum("mg,mg->m", n, facets[:, 0] - cells.mean(axis=1))
+    return np.where(out[:, None] < 0.0, -n, n)
+
+
+#: the stress models of finite-strain Nitsche's consistency term (:func:`first_piola`)
+LINEAR, NEO_HOOKEAN, SVK = 0, 1, 2
+#: by material name
+STRESS_MODELS = {"linear": LINEAR, "neo-hookean": NEO_HOOKEAN, "svk": SVK}
+
+
+def nitsche_finite_strain_refusal(friction: str, materials: list[str]) -> str | None:
+    """Why finite-strain Nitsche between two bodies refuses the friction law and the bodies'
+    materials (their names), or None: it is frictionless, and its consistency term evaluates
+    the stress of the STRESS_MODELS only."""
+    if friction != "none":
+        return (
+            "nitsche between two finite-strain bodies is frictionless for now: use "
+            "--method penalty for friction between finite-strain bodies"
+        )
+    for name in materials:
+        if name not in STRESS_MODELS:
+            return (
+                "nitsche between two finite-strain bodies evaluates the stress of "
+                f"{', '.join(STRESS_MODELS)} bodies, not {name}: use --method penalty"
+            )
+    return None
+
+
+def first_piola(
+    F: np.ndarray, model: np.ndarray, lmbda: np.ndarray, mu: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The first Piola stress P (n, g, g) and its derivative A = dP/dF (n, g, g, g, g),
+    A[i, J, k, L] = dP_iJ / dF_kL, of the deformation gradients F (n, g, g) (a 2D F is the
+    in-plane block of a plane-strain F3 with F33 = 1; real or complex, analytic in F so that
+    complex steps pass through), by model (Holzapfel 2000, Nonlinear Solid Mechanics, 6.5;
+    Bonet and Wood 2008, 6.4.3):
+
+    * LINEAR: sigma(eps), eps = sym(F - I): P = lambda tr(eps) I + 2 mu eps,
+      A = lambda I x I + mu (d_ik d_JL + d_iL d_Jk);
+    * NEO_HOOKEAN (psi = mu/2 (I1 - 3 - 2 ln J) + lambda/2 (ln J)^2): P = mu (F - F^-T) +
+      lambda ln J F^-T, A = mu d_ik d_JL + (mu - lambda ln J) Fi_Li Fi_Jk + lambda Fi_Ji Fi_Lk
+      with Fi = F^-1;
+    * SVK (psi = lambda/2 (tr E)^2 + mu E : E): P = F S, S = lambda tr(E) I + 2 mu E,
+      A = d_ik S_JL + lambda F_iJ F_kL + mu (F_iL F_kJ + (F F^T)_ik d_JL)."""
+    g = F.shape[1]
+    eye = np.eye(g)
+    dd = np.einsum("ik,JL->iJkL", eye, eye)[None]  # d_ik d_JL
+    lm, m = lmbda[:, None, None], mu[:, None, None]
+    lm4, m4 = lm[..., None, None], m[..., None, None]
+    P = np.zeros(F.shape, dtype=F.dtype)
+    A = np.zeros((*F.shape, g, g), dtype=F.dtype)
+    lin = model == LINEAR
+    if np.any(lin):
+        eps = 0.5 * (F[lin] + np.swapaxes(F[lin], 1, 2)) - eye
+        tr = np.trace(eps, axis1=1, axis2=2)[:, None, None]
+        P[lin] = lm[lin] * tr * eye + 2.0 * m[lin] * eps
+        A[lin] = lm4[lin] * np.einsum("iJ,kL->iJkL", eye, eye)[None] + m4[lin] * (
+            dd + np.einsum("iL,Jk->iJkL", eye, eye)[None]
+        )
+    nh = model == NEO_HOOKEAN
+    if np.any(nh):
+        Fn = F[nh]
+        Fi = np.linalg.inv(Fn)
+        FiT = np.swapaxes(Fi, 1, 2)
+        lnJ = np.log(np.linalg.det(Fn))[:, None, None]
+        P[nh] = m[nh] * (Fn - FiT) + lm[nh] * lnJ * FiT
+        A[nh] = (
+            m4[nh] * dd
+            + (m4[nh] - lm4[nh] * lnJ[..., None, None]) * np.einsum("nLi,nJk->niJkL", Fi, Fi)
+            + lm4[nh] * np.einsum("nJi,nLk->niJkL", Fi, Fi)
+        )
+    sv = model == SVK
+    if np.any(sv):
+        Fs = F[sv]
+        E = 0.5 * (np.einsum("nki,nkj->nij", Fs, Fs) - eye)
+        S = lm[sv] * np.trace(E, axis1=1, axis2=2)[:, None, None] * eye + 2.0 * m[sv] * E
+        P[sv] = np.einsum("nim,nmj->nij", Fs, S)
+        FFt = np.einsum("nim,nkm->nik", Fs, Fs)
+        A[sv] = (
+            np.einsum("ik,nJL->niJkL", eye, S)
+            + lm4[sv] * np.einsum("niJ,nkL->niJkL", Fs, Fs)
+            + m4[sv] * (np.einsum("niL,nkJ->niJkL", Fs, Fs) + np.einsum("nik,JL->niJkL", FFt, eye))
+        )
+    return P, A
+
+
 class _Directed:
     """One direction of the pair (slave -> master) with its weight and Gauss points."""
 
-    def __init__(self, slave: Side, master: Side, weight: float, lame: np.ndarray) -> None:
+    def __init__(
+        self,
+        slave: Side,
+        master: Side,
+        weight: float,
+        lame: np.ndarray,
+        model: np.ndarray | None = None,
+    ) -> None:
         self.slave, self.master, self.weight = slave, master, weight
         self.lame = lame  # (m, 3): E, lambda, mu of each slave facet's cell
+        #: (m,) the stress model of each slave facet's cell (finite-strain Nitsche,
+        #: :func:`first_piola`): LINEAR, NEO_HOOKEAN or SVK
+        self.model = np.full(len(lame), LINEAR, dtype=np.int64) if model is None else model
         d = slave.local.shape[1]
         gdim = slave.cell_X.shape[-1] if slave.cell_X.ndim == 3 else d
         # (a rank without facets of this side: empty arrays, the collectives still run)
@@ -138,6 +253,8 @@ class _Directed:
         X = slave.cell_X
         edges = [np.linalg.norm(X[:, i] - X[:, j], axis=-1) for i in range(d + 1) for j in range(i)]
         self.h = np.max(edges, axis=0) if len(slave) else np.zeros(0)
+        #: (m, gdim) the outward unit normal of each slave facet in the reference configuration
+        self.N_ref = _outward_normals(slave.X, X) if len(slave) else np.zeros((0, gdim))
         if d == 2:
             q, w = gauss_segment(2)
             self.qbary = np.stack([1.0 - q, q], axis=1)
@@ -194,15 +311,18 @@ class PointCoupling:
         self.comm = self.layout.comm
         self.search_each_newton = pair.search_each_newton
         assert pair.slave_lame is not None  # set by the problem, as master_lame
-        dirs = [_Directed(pair.slave, pair.master, 0.5 if unbiased else 1.0, pair.slave_lame)]
+        weight = 0.5 if unbiased else 1.0
+        dirs = [_Directed(pair.slave, pair.master, weight, pair.slave_lame, pair.slave_model)]
         if unbiased:
             assert pair.master_lame is not None
-            dirs.append(_Directed(pair.master, pair.slave, 0.5, pair.master_lame))
+            dirs.append(
+                _Directed(pair.master, pair.slave, 0.5, pair.master_lame, pair.master_model)
+            )
         self.dirs = dirs
         self.scatter: PETSc.Scatter | None = None
-        #: finite strain (penalty): the Jacobian with the variation of the master normal and
-        #: of the projection (module docstring)
-        self.geometric = pair.finite_strain and law.kind == "penalty"
+        #: finite strain: the Jacobian with the variation of the master normal and of the
+        #: projection (module docstring)
+        self.geometric = pair.finite_strain
         #: Coulomb coefficient (None: frictionless or Tresca), Tresca's threshold (None:
         #: frictionless or Coulomb) and the last converged state (history)
         self.mu, self.threshold = pair.mu, pair.threshold
@@ -211,6 +331,9 @@ class PointCoupling:
         #: penalty friction: the tangential traction by a return map with a per-point history
         #: (module docstring), residual and Jacobian from :meth:`_point_terms`
         self.penalty_friction = self.frictional and law.kind == "penalty"
+        #: residual and Jacobian from :meth:`_point_terms` (penalty friction, finite-strain
+        #: Nitsche), else from :meth:`_law`
+        self.pointwise = self.penalty_friction or (pair.finite_strain and law.kind == "nitsche")
         #: the frame-indifferent slip (False: the jump's increment alone, which reads the
         #: rotation of the penetration vector g n as slip: the objectivity test's contrast)
         self.objective = True
@@ -323,6 +446,16 @@ class PointCoupling:
             ST = np.einsum("pacg,phg->pach", traction, P_T).reshape(len(xq), (d + 1) * gdim, gdim)
             ST = np.concatenate([ST, np.zeros((len(xq), d * gdim, gdim))], axis=1)
             extra = dict(Jvec=Jvec, ST=ST, P_T=P_T, bary=Nm, **dr.history(len(xq), gdim))
+        if self.pair.finite_strain and self.law.kind == "nitsche":
+            # the slave cell's stress (finite-strain Nitsche, :meth:`_nitsche_stress`)
+            extra.update(
+                bary=Nm,
+                G=grads,
+                N_ref=dr.N_ref[facet],
+                model=dr.model[facet],
+                lmbda=lmbda,
+                mu=mu,
+            )
         # a tie (the law's argument at round-off, as on coinciding flat surfaces at the start)
         # takes the active branch of the derivative: the branch of a gap within 1e-12 h of 0
         tie = 1e-12 * scale * dr.h[facet]
@@ -504,8 +637,8 @@ class PointCoupling:
         vals = self._gather(x)
         add = PETSc.InsertMode.ADD_VALUES
         self.state = []
-        if self.penalty_friction:
-            self._penalty_friction_residual(vals, F)
+        if self.pointwise:
+            self._pointwise_residual(vals, F)
             return
         for p in self.points:
             P, dP, g, sn = self._law(p, vals)
@@ -537,7 +670,7 @@ class PointCoupling:
         add = PETSc.InsertMode.ADD_VALUES
         theta = self.law.theta
         for p in self.points:
-            if self.penalty_friction:  # the whole law by complex steps (module docstring)
+            if self.pointwise:  # the whole law by complex steps (module docstring)
                 A = self._tangent(p, vals, np.ones(len(p["w"]), dtype=bool), geometric=False)
             else:
                 A = self._law_jacobian(p, vals, theta)
@@ -605,6 +738,10 @@ class PointCoupling:
         g = np.einsum("pg,pg->p", gap, nm)
         scale = p["scale"][sel]
         arg = -scale * g
+        nitsche = self.law.kind == "nitsche"
+        if nitsche:
+            Tn, S = self._nitsche_stress(p, x[:, : d + 1], sel, -nm)
+            arg = arg - Tn
         active = p["paired"][sel] & (arg.real > -p["tie"][sel])
         P = np.where(active, arg, 0.0)
         tau = P[:, None] * nm  # -P n with n = -n_m
@@ -635,8 +772,31 @@ class PointCoupling:
             tau = tau + t
             out.update(t=t, stick=stick, slip=slip)
         r = -np.concatenate([N[:, :, None] * tau[:, None, :], -bary[:, :, None] * tau[:, None]], 1)
-        out["r"] = (p["w"][sel])[:, None] * r.reshape(len(N), x.shape[1] * x.shape[2])
+        r = r.reshape(len(N), x.shape[1] * x.shape[2])
+        if nitsche and self.law.theta != 0:
+            # - theta / gamma (P + T_n(u)) T_n(v) on the slave cell's dofs
+            cell = S.shape[1]
+            r[:, :cell] -= (self.law.theta / scale * (P + Tn))[:, None] * S
+        out["r"] = (p["w"][sel])[:, None] * r
         return out
+
+    @staticmethod
+    def _nitsche_stress(
+        p: _Points, xc: np.ndarray, sel: np.ndarray, n: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Finite-strain Nitsche: T_n(u) = n . P(F) N, the normal component (along the
+        current slave normal n = -n_m) of the first Piola traction on the reference slave
+        facet (unit normal N: force per unit reference area, as the penalty's P), and its
+        derivative in the slave cell's dofs with n held, T_n(v) = n . (dP/dF : grad v) N
+        (P, (d + 1) gdim); F = sum_a x_a grad N_a of the P1 cell's current node positions xc
+        (P, d + 1, gdim), the model of the cell's body (:func:`first_piola`)."""
+        G = p["G"][sel]  # (P, d + 1, gdim) reference gradients of the cell's basis
+        F = np.einsum("pag,pah->pgh", xc, G)
+        stress, A = first_piola(F, p["model"][sel], p["lmbda"][sel], p["mu"][sel])
+        N = p["N_ref"][sel]
+        Tn = np.einsum("pi,piJ,pJ->p", n, stress, N)
+        S = np.einsum("pi,piJkL,pJ,paL->pak", n, A, N, G)
+        return Tn, S.reshape(len(F), S.shape[1] * S.shape[2])
 
     def _tangent(
         self, p: _Points, vals: np.ndarray, sel: np.ndarray, geometric: bool
@@ -656,9 +816,9 @@ class PointCoupling:
             A[:, :, j] = self._point_terms(p, xj.reshape(x.shape), sel, geometric)["r"].imag / step
         return A
 
-    def _penalty_friction_residual(self, vals: np.ndarray, F: PETSc.Vec) -> None:
-        """The penalty residual with friction (:meth:`_point_terms` at the search's
-        projection), and the state the post-processing and the history read."""
+    def _pointwise_residual(self, vals: np.ndarray, F: PETSc.Vec) -> None:
+        """The residual of :meth:`_point_terms` at the search's projection (penalty friction,
+        finite-strain Nitsche), and the state the post-processing and the history read."""
         gdim = self.layout.gdim
         self.state, self._last = [], []
         for p in self.points:
@@ -668,11 +828,11 @@ class PointCoupling:
             o = self._point_terms(p, x, every, geometric=False)
             F.setValues(p["rows"].ravel(), o["r"].ravel(), addv=PETSc.InsertMode.ADD_VALUES)
             g = np.where(p["paired"], o["g"], np.inf)
-            self.state.append((o["P"], g, o["t"], o["stick"], o["slip"]))
+            self.state.append((o["P"], g, o.get("t"), o.get("stick"), o.get("slip")))
             # the gap vector's normal part g n_m: with the projection of the step's search
             # (small strain) x_s - y also holds the step's sliding, which is the slip
             gap = np.where(p["paired"], o["g"], 0.0)[:, None] * o["nm"]
-            self._last.append((o["t"], gap, o["nm"]))
+            self._last.append((o.get("t"), gap, o["nm"]))
         F.assemblyBegin()
         F.assemblyEnd()
 
@@ -682,6 +842,7 @@ class PointCoupling:
         if not self.penalty_friction:
             return
         for dr, (t, gap, nm) in zip(self.dirs, self._last, strict=True):
+            assert t is not None  # penalty friction
             h = dr.history(len(t), self.layout.gdim)
             h["t_old"][:], h["d_old"][:], h["n_old"][:] = t, gap, nm
 

@@ -10,9 +10,11 @@ body's own model and parameters (``scene.materials()``). The internal work is th
 sum_i int_{body i} S_i(u) : grad v dX over the cell tags (a nonlinear bulk, assembled at every
 Newton iteration), S_i the body's weak stress (a hyperelastic body's first Piola stress).
 Finite strain searches the pair at every Newton iteration (the contact in the deformed
-configuration, :mod:`contactfx.contact.point_coupling`) and is offered with the penalty
-method for now; the contact's parameters scale with the small-strain E, lambda, mu of each
-facet's body (a hyperelastic model's linearisation at F = I).
+configuration, :mod:`contactfx.contact.point_coupling`) and is offered with penalty (with
+or without friction) and frictionless Nitsche (the slave body's first Piola traction in its
+consistency term: a neo-Hookean, Saint Venant-Kirchhoff or linear slave body); the contact's
+parameters scale with the small-strain E, lambda, mu of each facet's body (a hyperelastic
+model's linearisation at F = I).
 
 A linear body among finite-strain ones (a problem file's stiff steel part on a rubber one)
 keeps its small-strain stress, S = sigma(u), its term sigma(u) : eps(v): the model the file
@@ -51,6 +53,11 @@ from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
 from contactfx.contact.laws import Coulomb, Tresca
 from contactfx.contact.pair import ContactPair, Side, side_of
+from contactfx.contact.point_coupling import (
+    LINEAR,
+    STRESS_MODELS,
+    nitsche_finite_strain_refusal,
+)
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
@@ -122,8 +129,7 @@ class TwoBodyProblem(Problem):
                     method,
                     "two_body_finite_strain",
                     f"is not offered between two finite-strain bodies (--material "
-                    f"{numerics.material}): finite strain between two meshed bodies is offered "
-                    "with penalty for now",
+                    f"{numerics.material})",
                     lambda c: c.two_body and c.two_body_finite_strain,
                 )
 
@@ -150,10 +156,14 @@ class TwoBodyProblem(Problem):
             raise _not_offered(
                 method,
                 "two_body_finite_strain",
-                "is not offered between two bodies when one is finite-strain: finite strain "
-                "between two meshed bodies is offered with penalty for now",
+                "is not offered between two bodies when one is finite-strain",
                 lambda c: c.two_body and c.two_body_finite_strain,
             )
+        if self.finite_strain and method.name == "nitsche":
+            names = [m.name if m.finite_strain else "linear" for m in materials.values()]
+            refusal = nitsche_finite_strain_refusal(numerics.friction, names)
+            if refusal is not None:
+                raise ValueError(refusal)
         super().__init__(scene, numerics, method, mesh, facet_tags)
         # penalty friction's history is the coupling's (per Gauss point of the slave surface)
         self.t_prev = None
@@ -213,6 +223,9 @@ class TwoBodyProblem(Problem):
         self.pair.previous = self.prev
         self.pair.slave_lame = self._lame(self.pair.slave)
         self.pair.master_lame = self._lame(self.pair.master)
+        if self.finite_strain:
+            self.pair.slave_model = self._model(self.pair.slave)
+            self.pair.master_model = self._model(self.pair.master)
         return SurfaceSetup(None, self.ds, self.v_load)
 
     def _lame(self, side: Side) -> NDArray[np.float64]:
@@ -233,6 +246,16 @@ class TwoBodyProblem(Problem):
         )
         E, nu = (f.x.array[dofs] for f in fields)
         return np.stack([E, *lame(E, nu)], axis=1)
+
+    def _model(self, side: Side) -> NDArray[np.int64]:
+        """(m,) the stress model of the cell of each facet of ``side`` (finite-strain Nitsche's
+        consistency term, :func:`contactfx.contact.point_coupling.first_piola`)."""
+        tags = self._cell_body(side.cell)
+        out = np.full(len(side.cell), LINEAR, dtype=np.int64)
+        for tag, m in self.body_materials.items():
+            # (a model Nitsche does not evaluate is refused before; penalty reads none)
+            out[tags == tag] = STRESS_MODELS.get(m.name, LINEAR) if m.finite_strain else LINEAR
+        return out
 
     def coupling(self) -> Any:
         if not hasattr(self, "_coupling"):

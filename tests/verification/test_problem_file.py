@@ -980,8 +980,8 @@ def test_two_body_hyperelastic_ranks_agree(shared_tmp):
         (
             lambda t: t,
             ["numerics.method=nitsche"],
-            "numerics.method: nitsche is not offered between two bodies when one is "
-            "finite-strain (bodies.0.material = 'mooney-rivlin'",
+            "numerics.method: nitsche between two finite-strain bodies evaluates the stress of "
+            "linear, neo-hookean, svk bodies, not mooney-rivlin: use --method penalty",
         ),
     ],
 )
@@ -1016,9 +1016,9 @@ def test_finite_strain_material_per_body_refusals(tmp_path, capsys):
     )
     scene, _, _ = load_problem(_stacked(tmp_path, linear))
     with pytest.raises(ValueError) as err:
-        scene.run(Numerics(method="nitsche"), verbose=False)
+        scene.run(Numerics(method="mortar"), verbose=False)
     assert str(err.value).startswith(
-        "method nitsche is not offered between two bodies when one is finite-strain"
+        "method mortar is not offered between two bodies when one is finite-strain"
     )
     assert "\n" not in str(err.value)
     demo = str(DEMOS / "indenter-on-rubber.toml")

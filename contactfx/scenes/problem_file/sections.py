@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from contactfx.contact.interface import BartonBandis
+from contactfx.contact.point_coupling import nitsche_finite_strain_refusal
 from contactfx.contact.registry import method_class, methods_supporting
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.mechanics.hyperelastic import (
@@ -543,6 +544,11 @@ def check_materials(problem: ProblemFile, numerics: Numerics) -> None:
             f"{supports.why_not.get('two_body_finite_strain', 'not implemented')}); use "
             + ", ".join(offered),
         )
+    if problem.pair is not None and numerics.method == "nitsche":
+        names = [b.material.name if b.material.finite_strain else "linear" for b in problem.bodies]
+        refusal = nitsche_finite_strain_refusal(numerics.friction, names)
+        if refusal is not None:
+            r.fail("numerics.method", refusal)
 
 
 def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
