@@ -9,15 +9,22 @@ the first ``press_fraction`` of the load program, then along +x by ``slide`` at 
 a symmetry plane of both bodies (u_y = 0). Both bodies neo-Hookean, the sphere 10 times stiffer
 than the block by default; penalty method (the contact searched in the deformed configuration
 at every Newton iteration), Coulomb friction mu = 0.3 by default
-(:mod:`contactfx.contact.point_coupling`).
+(:mod:`contactfx.contact.point_coupling`). The block's top is the slave surface by default: with
+the sphere's as the slave the default run needs 49 load steps (20 asked: Newton's first
+iterations of one sliding step in three raise the residual until an element inverts, a NaN
+residual, and the step is cut back) and 277 Newton iterations, against 20 and 94 with the
+block's (docs/verification.md section 15).
 
 No closed form: the scores are checks of the discrete solution.
 
 - ``P`` and ``Q``: the pair's force on the sphere (full model, ``pair_forces.csv``) at the last
   step: P its z component (the block pushes the sphere up), Q minus its x component (the force
   that drags the sphere along +x); ``Q_over_P`` and, with Coulomb friction, ``Q_over_P_over_mu``
-  (1 up to the tilt of the contact surface: the friction traction lies in the curved, deformed
-  contact surface, the normal pressure is tilted too).
+  (not 1 at gross slip: the friction traction lies in the curved, deformed contact surface, the
+  pressure acts along its normal); ``curvature_factor`` = sum P sqrt(1 - n_x^2) / sum P |n_z|
+  over the slave points, what Q / (mu P) would be at gross slip under a pressure symmetric in
+  x; ``tangential_over_bound`` (the kind's) the contact-frame ratio of |t_T| to mu P, 1 at
+  gross slip.
 - Equilibrium (at every converged step, the largest over the steps): the reactions of the
   supports, from the residual R(u) + F_c(u) summed over the supported rows of a group
   (:func:`contactfx.scenes._common.reaction_forces`), against the pair's force. The driven top
@@ -50,6 +57,12 @@ __all__ = ["SphereSlide"]
 class SphereSlideParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the sphere
     E_upper: float = param(1e4, "Young's modulus of the upper body (the sphere)", positive=True)
+    slave: str = param(
+        "lower",
+        "the slave surface of the contact pair (the block: with the sphere as the slave, "
+        "Newton diverges in one step of three and the load steps are cut back)",
+        choices=("upper", "lower"),
+    )
     radius: float = param(1.0, "radius R of the sphere", positive=True)
     height: float = param(
         1.0, "height of the sphere cap's flat top above its lowest point, <= R", positive=True
@@ -98,6 +111,8 @@ class SphereSlide(PressThenDrag):
         "upper": SphereOnBlockFacets.SPHERE_CONTACT,
     }
     symmetry = 2.0
+    # the radius of a disc of the closed nodes' area
+    size_rule = "disc-radius"
     numerics_defaults = {
         "method": "penalty",
         "material": "neo-hookean",
@@ -174,7 +189,30 @@ class SphereSlide(PressThenDrag):
         r.destroy()
         sign = 1.0 if self.slave_is_upper else -1.0
         pair = sign * self.symmetry * problem.coupling().slave_force()
-        self.records.append({"load": load, "pair": pair, **reactions})
+        rec = {"load": load, "pair": pair, "curvature": self.curvature(problem), **reactions}
+        if problem.friction is not None:
+            comm = problem.mesh.comm
+            sums = problem.coupling().friction_state()
+            total = {k: comm.allreduce(v) for k, v in sums.items()}
+            # the contact-frame ratio of |t_T| to the bound mu P: 1 at gross slip
+            rec["tangential_over_bound"] = (
+                total["tangential"] / total["bound"] if total["bound"] > 0.0 else 0.0
+            )
+        self.records.append(rec)
+
+    @staticmethod
+    def curvature(problem) -> float:
+        """sum w P sqrt(1 - n_x^2) / sum w P |n_z| over the slave points (n the contact
+        normal): Q / (mu P) at gross slip for a pressure symmetric about the contact's centre
+        in x (the friction traction mu P along the projection of -x on the contact's tangent
+        plane, whose x part is sqrt(1 - n_x^2), against the normal force's z part |n_z|); above
+        1 on a curved contact. Collective."""
+        coupling = problem.coupling()
+        w, n, P = coupling.points[0]["w"], coupling.points[0]["n"], coupling.state[0][0]
+        num = float(np.sum(w * P * np.sqrt(np.clip(1.0 - n[:, 0] ** 2, 0.0, None))))
+        den = float(np.sum(w * P * np.abs(n[:, 2])))
+        num, den = (problem.mesh.comm.allreduce(v) for v in (num, den))
+        return num / den if den > 0.0 else 1.0
 
     def equilibrium(self) -> dict[str, float]:
         """The largest relative imbalances over the converged steps (x and z components):
@@ -203,5 +241,7 @@ class SphereSlide(PressThenDrag):
             scores["max_Q_over_P_sliding"] = float(np.max(ratio))
         if self.friction == "coulomb" and self.mu > 0.0:
             scores["Q_over_P_over_mu"] = float(Q[-1] / P[-1] / self.mu)
+            if self.records:
+                scores["curvature_factor"] = self.records[-1]["curvature"]
         scores.update(self.equilibrium())
         return scores
