@@ -48,11 +48,13 @@ def test_sphere_slide_equilibrium(run):
     for rec in scene.records:
         pair = rec["pair"][[0, 2]]
         scale = np.linalg.norm(pair)
-        # the sphere's internal forces sum to zero, so the top's reaction balances the pair's
-        # force on the sphere, and the bottom's the pair's force on the block, up to the sum
-        # of the residual's free rows: Newton stops at 1e-10 of the step's first residual
-        # (1e1 to 3e3 against forces of 1e1 to 3e2; the round-off stop of a stalled residual
-        # 1e-8 below it), over ~1e3 rows: 1e-8 relative bounds it (measured 2e-16 to 7e-12)
+        # each body's internal forces sum to zero, and the pair's force is the sum of the
+        # contact terms over the body's rows (measured to 2e-16 on the default mesh), so the
+        # top's reaction balances the pair's force on the sphere, the bottom's the pair's
+        # force on the block, up to the sum of the residual over the body's free rows:
+        # Newton's tolerance, 1e-10 of the step's first residual (1e1 to 3e3, against forces
+        # of 1e1 to 3e2) over ~1e3 rows; 1e-8 relative bounds it (measured 2e-16 to 7e-12;
+        # 5.7e-9 at the first step of the default mesh)
         assert np.linalg.norm(rec["top"][[0, 2]] + pair) < 1e-8 * scale
         assert np.linalg.norm(rec["bottom"][[0, 2]] - pair) < 1e-8 * scale
     scores = res.scores
