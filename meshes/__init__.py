@@ -19,7 +19,8 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
 
 Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.two_body`: the
 bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
-:func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`, :func:`die_on_block`.
+:func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`, :func:`die_on_block`;
+:mod:`contactfx.meshes.sphere_on_block`: :func:`sphere_on_block`.
 
 Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,penny-block,joint-column,
 stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block} ...
@@ -50,6 +51,11 @@ from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.penny_block import PennyBlockCells, PennyBlockFacets, penny_block
 from contactfx.meshes.rectangle import RectangleCells, RectangleFacets, rectangle
+from contactfx.meshes.sphere_on_block import (
+    SphereOnBlockCells,
+    SphereOnBlockFacets,
+    sphere_on_block,
+)
 from contactfx.meshes.two_body import (
     CylindersCells,
     CylindersFacets,
@@ -90,6 +96,7 @@ BUILDERS = {
     "punch-foundation": (punch_foundation, 2),
     "rounded-on-block": (rounded_on_block, 2),
     "die-on-block": (die_on_block, 2),
+    "sphere-on-block": (sphere_on_block, 3),
 }
 
 __all__ = [
@@ -118,6 +125,8 @@ __all__ = [
     "RectangleFacets",
     "RoundedOnBlockCells",
     "RoundedOnBlockFacets",
+    "SphereOnBlockCells",
+    "SphereOnBlockFacets",
     "SpheresCells",
     "SpheresFacets",
     "StackedBlocksCells",
@@ -141,6 +150,7 @@ __all__ = [
     "punch_foundation",
     "rectangle",
     "rounded_on_block",
+    "sphere_on_block",
     "spheres",
     "stacked_blocks",
     "stacked_boxes",

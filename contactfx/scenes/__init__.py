@@ -12,6 +12,7 @@ from contactfx.scenes.ironing import ShallowIroning
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
+from contactfx.scenes.sphere_slide import SphereSlide
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
 from contactfx.scenes.westergaard import Westergaard
@@ -44,6 +45,7 @@ SCENES: dict[str, type[Scene]] = {
         SlidingContact,
         CattaneoCylinders,
         ShallowIroning,
+        SphereSlide,
     )
 }
 

@@ -5,11 +5,12 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.meshes import build
 
-__all__ = ["gmsh_mesh", "fix", "fix_component", "prescribe_component"]
+__all__ = ["gmsh_mesh", "fix", "fix_component", "prescribe_component", "reaction_forces"]
 
 
 def gmsh_mesh(comm, builder, gdim: int, name: str, **kwargs):
@@ -46,3 +47,26 @@ def prescribe_component(V, facet_tags, tag: int, component: int, value):
     sub = V.sub(component)
     dofs = _compat.locate_dofs_topological(sub, V.mesh.topology.dim - 1, _facets(facet_tags, tag))
     return _compat.dirichletbc(value, dofs, sub)
+
+
+def reaction_forces(V, facet_tags, tags: dict, reactions, scale: float = 1.0) -> dict:
+    """The force the supports exert on the body on each group of facets: ``tags`` maps a name
+    to a facet tag, ``reactions`` is ``solver.reactions()`` (R(u) + F_c(u), nonzero on the
+    supported rows at a solution); each group's reaction is the sum of its owned rows, per
+    component, times ``scale`` (the model's symmetry multiplicity, the axisymmetric 2 pi).
+    Collective; returns {name: array (components,)}. A node shared by two groups counts in both."""
+    values = reactions.getArray()
+    n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
+    fdim = V.mesh.topology.dim - 1
+    components = max(V.num_sub_spaces, 1)
+    comm = V.mesh.comm
+    out = {}
+    for name, tag in tags.items():
+        facets = _facets(facet_tags, tag)
+        total = np.zeros(components)
+        for c in range(components):
+            sub = V.sub(c) if V.num_sub_spaces else V
+            dofs = np.asarray(_compat.locate_dofs_topological(sub, fdim, facets))
+            total[c] = float(np.sum(values[dofs[dofs < n_owned]])) * scale
+        out[name] = comm.allreduce(total, op=MPI.SUM)
+    return out

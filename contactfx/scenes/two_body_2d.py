@@ -81,10 +81,13 @@ from contactfx.scenes.two_body_base import TwoBodyScene, two_elastic
 __all__ = ["PunchFoundation", "SlidingContact", "CattaneoCylinders"]
 
 
-def press_then_drag(group: str, drag: float, push: float, fraction: float) -> list[dict]:
-    """The ``[[boundary]]`` tables of a face moved by ``push`` along y during the first
-    ``fraction`` of the load program, then along x by ``drag`` at that vertical displacement:
-    one table per component, each with its piecewise-linear amplitude."""
+def press_then_drag(
+    group: str, drag: float, push: float, fraction: float, axis: str = "y"
+) -> list[dict]:
+    """The ``[[boundary]]`` tables of a face moved by ``push`` along ``axis`` (the vertical,
+    y in 2D, z in 3D) during the first ``fraction`` of the load program, then along x by
+    ``drag`` at that vertical displacement: one table per component, each with its
+    piecewise-linear amplitude."""
     return [
         {
             "group": group,
@@ -93,7 +96,7 @@ def press_then_drag(group: str, drag: float, push: float, fraction: float) -> li
         },
         {
             "group": group,
-            "displacement": {"y": float(push)},
+            "displacement": {axis: float(push)},
             "amplitude": [[0.0, 0.0], [float(fraction), 1.0], [1.0, 1.0]],
         },
     ]

@@ -187,6 +187,17 @@ CASES: dict[str, BenchCase] = {
         numerics={"friction": "coulomb", "mu": 0.3},
         beside="shallow-ironing",
     ),
+    # 3D, two finite-strain bodies, Coulomb friction: no closed form; the columns to read are
+    # the load steps, Newton iterations, times, memory and the equilibrium of the reactions
+    # with the contact force. Level 1 is the scene's default mesh (penalty only)
+    "sphere-slide": BenchCase(
+        "sphere-slide",
+        {},
+        2.0,
+        "neo-Hookean sphere pressed 0.3 R into a block and slid 1 R, Coulomb mu 0.3 (3D)",
+        p2_levels=0,
+        levels=3,
+    ),
 }
 
 #: relative errors below this are round-off (e.g. the force under force control): no rate
@@ -313,8 +324,11 @@ def run_case(
     for key in ("Q_over_bound", "c_over_a_computed"):  # partial slip: values, not errors
         if key in res.reference:
             row[key] = float(res.reference[key])
-    # force plateaus against published curves (shallow ironing): signed errors and values
-    for key in ("P_plateau_error", "Q_plateau_error", "Q_over_P", "P_jump", "Q_jump"):
+    # force plateaus against published curves (shallow ironing): signed errors and values;
+    # the sliding sphere's Q / (mu P) and equilibrium of the reactions with the contact force
+    values = ("P_plateau_error", "Q_plateau_error", "Q_over_P", "P_jump", "Q_jump")
+    values += ("Q_over_P_over_mu", "equilibrium_top", "equilibrium_bottom")
+    for key in values:
         if key in res.scores:
             row[key] = float(res.scores[key])
     return row, scene, num

@@ -107,6 +107,9 @@ def _has(rows: list[dict], column: str, floor: float = 0.0) -> bool:
 VALUE_COLUMNS = (
     ("Q_over_bound", "Q / (mu P)"),
     ("c_over_a_computed", "stick c / a"),
+    ("Q_over_P_over_mu", "Q / (mu P) global"),
+    ("equilibrium_top", "equilibrium top"),
+    ("equilibrium_bottom", "equilibrium bottom"),
     ("t_contact", "t contact"),
     ("contact_over_bulk", "contact over bulk"),
     ("contact_over_linear", "contact over linear"),

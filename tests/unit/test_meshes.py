@@ -39,6 +39,8 @@ from contactfx.meshes import (
     RectangleFacets,
     RoundedOnBlockCells,
     RoundedOnBlockFacets,
+    SphereOnBlockCells,
+    SphereOnBlockFacets,
     SpheresCells,
     SpheresFacets,
     StackedBlocksCells,
@@ -53,6 +55,7 @@ from contactfx.meshes import (
     punch_foundation,
     rectangle,
     rounded_on_block,
+    sphere_on_block,
     spheres,
     stacked_blocks,
     stacked_boxes,
@@ -144,6 +147,20 @@ SPHERES = dict(
     refine=0.1,
     ratio=0.7,
     offset=0.3,
+    grading=1.0,
+)
+SPHERE_ON_BLOCK = dict(
+    radius=1.0,
+    height=0.8,
+    left=1.5,
+    right=2.5,
+    width=1.5,
+    depth=1.0,
+    track=0.5,
+    h_contact=0.2,
+    h_far=0.5,
+    refine=0.3,
+    ratio=0.8,
     grading=1.0,
 )
 
@@ -943,6 +960,65 @@ def test_spheres(spheres_mesh: MeshData) -> None:
     _check_separate_bodies(data, cells.LOWER, cells.UPPER)
     # The spheres only touch at the origin.
     _check_non_matching(data, facets.LOWER_CONTACT, facets.UPPER_CONTACT, max_coincident=1)
+
+
+def test_sphere_on_block() -> None:
+    """The block (a box) tiles exactly; every node of the sphere's contact face is on the
+    sphere, its volume within the chord bound of :func:`test_spheres` below the half cap's;
+    the flat top is the half disk of radius sqrt(height (2 R - height)) (its polygon inscribed);
+    the bodies are separate; the block is refined along the track, the sphere at its pole."""
+    p = SPHERE_ON_BLOCK
+    data = build(MPI.COMM_WORLD, partial(sphere_on_block, **p), gdim=3, name="sphere")
+    r, hc = p["radius"], p["height"]
+    length, width, depth = p["left"] + p["right"], p["width"], p["depth"]
+    cells, facets = SphereOnBlockCells, SphereOnBlockFacets
+    comm = data.mesh.comm
+    _check_boundary_tagged_once(data)
+    assert _measure(data, cells.BLOCK, "dx") == pytest.approx(length * width * depth, rel=1e-12)
+    areas = {
+        facets.BLOCK_TOP: length * width,
+        facets.BLOCK_BOTTOM: length * width,
+        facets.BLOCK_Y0: length * depth,
+        facets.BLOCK_SIDES: 2 * width * depth + length * depth,
+    }
+    for tag, area in areas.items():
+        assert _measure(data, tag) == pytest.approx(area, rel=1e-12), tag.name
+    mesh = data.mesh
+    mesh.topology.create_connectivity(2, 0)
+    face_vertices = mesh.topology.connectivity(2, 0).array.reshape(-1, 3)
+    triangles = _vertex_coordinates(mesh)[
+        face_vertices[data.facet_tags.find(facets.SPHERE_CONTACT)]
+    ]
+    distance = np.linalg.norm(triangles - np.array([0.0, 0.0, r]), axis=2)
+    assert np.all(np.abs(distance - r) <= 1e-12 * r)
+    a, b, c = (
+        np.linalg.norm(triangles[:, i] - triangles[:, j], axis=1)
+        for i, j in ((0, 1), (1, 2), (2, 0))
+    )
+    doubled_area = np.linalg.norm(
+        np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
+    )
+    rho = comm.allreduce((a * b * c / (2 * doubled_area)).max(initial=0.0), op=MPI.MAX)
+    delta = r - math.sqrt(r**2 - rho**2)
+    cap = math.pi * hc**2 * (3 * r - hc) / 3 / 2  # the half cap below z = height
+    assert cap * (1 - 3 * delta / r) <= _measure(data, cells.SPHERE, "dx") <= cap
+    top = hc * (2 * r - hc)  # the top's radius squared
+    low, high = _arc_bounds(0.5 * math.pi * top, math.sqrt(top), p["h_far"], 6)
+    assert low <= _measure(data, facets.SPHERE_TOP) <= high
+    _check_separate_bodies(data, cells.BLOCK, cells.SPHERE)
+    # the surfaces only touch at the origin (the sphere's pole, generally no node of the block)
+    nodes = _tagged_vertices(data, facets.SPHERE_CONTACT)
+    assert _coincident(nodes, _tagged_vertices(data, facets.BLOCK_TOP)).sum() <= 1
+    for body, h in ((cells.BLOCK, p["h_contact"]), (cells.SPHERE, p["ratio"] * p["h_contact"])):
+        sizes, midpoints = _cell_sizes(data, body)
+        x, y, z = midpoints.T
+        if body == cells.BLOCK:
+            along = np.maximum(np.maximum(-x, x - p["track"]), 0.0)
+            distance = np.sqrt(along**2 + y**2 + z**2)
+        else:
+            distance = np.linalg.norm(midpoints, axis=1)
+        graded = p["refine"] + (p["h_far"] - h) / p["grading"]
+        _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
 
 
 @pytest.mark.parametrize(

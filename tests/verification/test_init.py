@@ -76,6 +76,11 @@ TWO_BODY_CASES = [
         {"h_contact": 0.3, "h_far": 1.5, "press": 0.2, "slide": 0.6, "right": 3.0},
         {"steps": 4},
     ),
+    (
+        "sphere-slide",
+        {"h_contact": 0.3, "h_far": 0.8, "refine": 0.5, "slide": 0.25, "press": 0.15},
+        {"steps": 4},
+    ),
 ]
 CASES = OBSTACLE_CASES + INTERFACE_CASES + TWO_BODY_CASES
 

@@ -25,7 +25,7 @@ from contactfx.contact.obstacles import (
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import BUILDERS, build_file, build_grouped, builder_groups
 from contactfx.params import Params, param
-from contactfx.scenes._common import fix, fix_component, prescribe_component
+from contactfx.scenes._common import fix, fix_component, prescribe_component, reaction_forces
 from contactfx.scenes.base import ObstacleScene
 from contactfx.scenes.interface_base import InterfaceScene
 from contactfx.scenes.problem_file.expressions import DistanceObstacle
@@ -324,21 +324,15 @@ class _FileMesh:
             self.reaction_rows.append(row)
             return
         r = solver.reactions()
-        values = r.getArray()
         # axisymmetric: the residual is per radian; report the total over the circumference
         # (Abaqus's convention for CAX elements: the radial one is the sum of the radial
         # forces all around, whose vector sum vanishes)
         turn = 2.0 * np.pi if self.axisymmetric else 1.0
-        n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
-        for g in self.spec.output.reactions:
-            facets = self._facet_tags.indices[self._facet_tags.values == self.groups[g].tag]
+        tags = {g: self.groups[g].tag for g in self.spec.output.reactions}
+        forces = reaction_forces(problem.V, self._facet_tags, tags, r, turn)
+        for g, force in forces.items():
             for c in range(self.gdim):
-                dofs = np.asarray(
-                    _compat.locate_dofs_topological(problem.V.sub(c), self.gdim - 1, facets)
-                )
-                owned = dofs[dofs < n_owned]
-                total = float(np.sum(values[owned])) * turn
-                row[f"{g}_{AXES[c]}"] = problem.mesh.comm.allreduce(total, op=MPI.SUM)
+                row[f"{g}_{AXES[c]}"] = float(force[c])
         r.destroy()
         self.reaction_rows.append(row)
 
