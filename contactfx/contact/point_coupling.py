@@ -837,14 +837,41 @@ class PointCoupling:
         F.assemblyEnd()
 
     def converged(self) -> None:
-        """A step converged: its tangential traction, gap vector and master normal at every
-        point are the history of the next (penalty friction)."""
+        """A step converged: the number of closed points (:meth:`lost`) and, with penalty
+        friction, the tangential traction, gap vector and master normal at every point are the
+        history of the next. Collective."""
+        from mpi4py import MPI
+
+        closed = int(np.sum(self.state[0][0] > 0.0))
+        self.closed_before = self.comm.allreduce(closed, op=MPI.SUM)
         if not self.penalty_friction:
             return
         for dr, (t, gap, nm) in zip(self.dirs, self._last, strict=True):
             assert t is not None  # penalty friction
             h = dr.history(len(t), self.layout.gdim)
             h["t_old"][:], h["d_old"][:], h["n_old"][:] = t, gap, nm
+
+    #: the slave points closed at the last converged step (all ranks)
+    closed_before = 0
+
+    def lost(self) -> str | None:
+        """After a converged solve: why it is no solution of the contact problem, or None. A
+        solve whose last search paired no slave point with the master surface, while points
+        were closed at the last converged step, has lost the contact: a Newton iterate carried
+        one body into the other deeper than the search reaches (a master facet's size), and
+        the solve converged with the bodies overlapping and no contact force (seen with the
+        critical-point line search, whose step length may exceed 1, on shallow-ironing).
+        Collective."""
+        from mpi4py import MPI
+
+        paired = self.comm.allreduce(int(np.sum(self.points[0]["paired"])), op=MPI.SUM)
+        if self.closed_before > 0 and paired == 0:
+            return (
+                f"the contact was lost ({self.closed_before} slave points closed at the last "
+                "step, none near the master surface now: a Newton iterate carried one body "
+                "through the other)"
+            )
+        return None
 
     def search_gaps(self) -> np.ndarray:
         """The gaps of this rank's paired Gauss points at the last search."""

@@ -692,8 +692,14 @@ class ContactSNES:
         if self.coupling is None or self.coupling.search_each_newton:
             if self.coupling is not None:
                 self._timed_search()
-            return self._newton(x, stats)
-        return self._search_rounds(x, stats)
+            stats = self._newton(x, stats)
+        else:
+            stats = self._search_rounds(x, stats)
+        lost = getattr(self.coupling, "lost", None)  # a coupling's check of the solution
+        why = None if lost is None else lost()
+        if why is not None:
+            raise ConvergenceError(why, stats=stats)
+        return stats
 
     def _search_rounds(self, x: PETSc.Vec, stats: SolveStats) -> SolveStats:
         """Newton with a search at the step's start and again at each solution (solve())."""
