@@ -901,6 +901,20 @@ def test_rounded_on_block_sizes(rounded_on_block_mesh: MeshData) -> None:
         _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
 
 
+def _sagitta(triangles: np.ndarray, radius: float, comm) -> float:
+    """The largest gap between a sphere of ``radius`` and the inscribed triangles (n, 3, 3)
+    whose vertices lie on it: the sagitta of the largest circumradius (all ranks)."""
+    a, b, c = (
+        np.linalg.norm(triangles[:, i] - triangles[:, j], axis=1)
+        for i, j in ((0, 1), (1, 2), (2, 0))
+    )
+    doubled_area = np.linalg.norm(
+        np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
+    )
+    rho = comm.allreduce((a * b * c / (2 * doubled_area)).max(initial=0.0), op=MPI.MAX)
+    return radius - math.sqrt(radius**2 - rho**2)
+
+
 def test_spheres(spheres_mesh: MeshData) -> None:
     """Eighth balls. Bound: a chord triangle with circumradius rho lies in a plane at the
     distance sqrt(R^2 - rho^2) from the centre, inside its circumdisk, so within the shell
@@ -940,15 +954,7 @@ def test_spheres(spheres_mesh: MeshData) -> None:
         # every contact node is on the sphere
         distance = np.linalg.norm(triangles - np.asarray(centre), axis=2)
         assert np.all(np.abs(distance - radius) <= 1e-12 * radius)
-        a, b, c = (
-            np.linalg.norm(triangles[:, i] - triangles[:, j], axis=1)
-            for i, j in ((0, 1), (1, 2), (2, 0))
-        )
-        doubled_area = np.linalg.norm(
-            np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
-        )
-        rho = comm.allreduce((a * b * c / (2 * doubled_area)).max(initial=0.0), op=MPI.MAX)
-        delta = radius - math.sqrt(radius**2 - rho**2)
+        delta = _sagitta(triangles, radius, comm)
         volume, exact_volume = _measure(data, body, "dx"), math.pi * radius**3 / 6
         assert exact_volume * (1 - 3 * delta / radius) <= volume <= exact_volume, body.name
         area, exact_area = _measure(data, contact), math.pi * radius**2 / 2
@@ -991,15 +997,7 @@ def test_sphere_on_block() -> None:
     ]
     distance = np.linalg.norm(triangles - np.array([0.0, 0.0, r]), axis=2)
     assert np.all(np.abs(distance - r) <= 1e-12 * r)
-    a, b, c = (
-        np.linalg.norm(triangles[:, i] - triangles[:, j], axis=1)
-        for i, j in ((0, 1), (1, 2), (2, 0))
-    )
-    doubled_area = np.linalg.norm(
-        np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
-    )
-    rho = comm.allreduce((a * b * c / (2 * doubled_area)).max(initial=0.0), op=MPI.MAX)
-    delta = r - math.sqrt(r**2 - rho**2)
+    delta = _sagitta(triangles, r, comm)
     cap = math.pi * hc**2 * (3 * r - hc) / 3 / 2  # the half cap below z = height
     assert cap * (1 - 3 * delta / r) <= _measure(data, cells.SPHERE, "dx") <= cap
     top = hc * (2 * r - hc)  # the top's radius squared

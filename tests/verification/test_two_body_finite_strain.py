@@ -144,6 +144,17 @@ def solve(
     return scene, res
 
 
+def _as_small_strain(scene, res, small, small_res):
+    """The nodal pressure deviation, grad u error and Gauss-point deviation of the finite-strain
+    run against the small-strain run's on the same mesh: within 2.5 times the 10 % strain."""
+    for ours, theirs in (
+        (res.scores["pressure_deviation"], small_res.scores["pressure_deviation"]),
+        (scene.grad_error, small.grad_error),
+        (scene.gauss_deviation, small.gauss_deviation),
+    ):
+        assert ours == pytest.approx(theirs, rel=0.25)
+
+
 def test_exact_stretches_small_load_limit():
     # the reference itself: at a small load (q / E = 1e-4) the stretches are the small-strain
     # plane-strain uniaxial strains -(1 - nu^2) q / E and nu (1 + nu) q / E to O((q / E)^2)
@@ -175,13 +186,8 @@ def test_finite_strain_patch_test(penalty):
     # the nominal pressure's uniformity and grad u against the exact homogeneous state: the
     # Gauss-point rule's error of the small-strain run on the same mesh, relative, changed by
     # O(strain) (module docstring): measured within 10 % (nodal 1.4 %, 6.5 %; grad u 3.4 %,
-    # 9.4 % at penalty 10, 1000); bound 2.5 times the 10 % strain
-    for ours, theirs in (
-        (res.scores["pressure_deviation"], small_res.scores["pressure_deviation"]),
-        (scene.grad_error, small.grad_error),
-        (scene.gauss_deviation, small.gauss_deviation),
-    ):
-        assert ours == pytest.approx(theirs, rel=0.25)
+    # 9.4 % at penalty 10, 1000)
+    _as_small_strain(scene, res, small, small_res)
     # the small-strain run's own size (test_two_body.py reports this 2D patch at 1.1-1.3 % at
     # penalty 10; measured 1.3 % and 0.13 % at penalty 10 and 1000): 2 %
     assert small_res.scores["pressure_deviation"] < 0.02
@@ -204,13 +210,8 @@ def test_finite_strain_nitsche_patch_test(theta, sides):
     assert abs(res.scores["force_x"]) < 1e-3 * Q * scene.p.width
     assert scene.closed_points == scene.points
     # the Gauss-point rule's error of the small-strain run, changed by O(strain): measured
-    # within 8 % (module docstring table); bound 2.5 times the 10 % strain
-    for ours, theirs in (
-        (res.scores["pressure_deviation"], small_res.scores["pressure_deviation"]),
-        (scene.grad_error, small.grad_error),
-        (scene.gauss_deviation, small.gauss_deviation),
-    ):
-        assert ours == pytest.approx(theirs, rel=0.25)
+    # within 8 % (module docstring table)
+    _as_small_strain(scene, res, small, small_res)
     # quadratic convergence: measured 7 iterations for the two load steps
     assert res.newton_iterations <= 10
 
