@@ -16,11 +16,11 @@ from contactfx.meshes._build import (
     matheval_number,
 )
 from contactfx.meshes.two_body import (
-    _add_body_groups,
-    _check_graded,
-    _faces_by_plane,
-    _generate,
-    _set_body_sizes,
+    add_body_groups,
+    check_graded,
+    faces_by_plane,
+    generate_mesh,
+    set_body_sizes,
 )
 
 if TYPE_CHECKING:
@@ -107,7 +107,7 @@ def sphere_on_block(
     check_less_equal("height", height, "radius", radius)
     if not track >= 0.0:
         raise ValueError(f"track must be >= 0, got {track}")
-    _check_graded(h_contact, h_far, refine, grading, ratio, 0.0)
+    check_graded(h_contact, h_far, refine, grading, ratio, 0.0)
     r = radius
     top = math.sqrt(height * (2.0 * r - height))  # the radius of the cap's flat top
     check_less("the top's radius", top, "left", left)
@@ -124,7 +124,7 @@ def sphere_on_block(
     occ.synchronize()
 
     f = SphereOnBlockFacets
-    block_faces = _faces_by_plane(
+    block_faces = faces_by_plane(
         model,
         3,
         block,
@@ -135,14 +135,14 @@ def sphere_on_block(
         },
         rest=f.BLOCK_SIDES,
     )
-    sphere_faces = _faces_by_plane(
+    sphere_faces = faces_by_plane(
         model,
         3,
         sphere,
         {f.SPHERE_TOP: (2, height), f.SPHERE_Y0: (1, 0.0)},
         rest=f.SPHERE_CONTACT,
     )
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             SphereOnBlockCells.BLOCK: (block, block_faces),
@@ -151,7 +151,7 @@ def sphere_on_block(
     )
     end = matheval_number(track)
     along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
-    _set_body_sizes(
+    set_body_sizes(
         model,
         3,
         [(block, h_contact, h_far), (sphere, ratio * h_contact, h_far)],
@@ -159,4 +159,4 @@ def sphere_on_block(
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 3)
+    generate_mesh(model, 3)

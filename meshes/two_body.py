@@ -252,7 +252,7 @@ def _closure(model: type[gmsh.model], dim: int, tag: int) -> dict[int, list[int]
     return closure
 
 
-def _add_body_groups(
+def add_body_groups(
     model: type[gmsh.model],
     bodies: Mapping[IntEnum, tuple[int, Mapping[IntEnum, Sequence[int]]]],
 ) -> None:
@@ -288,7 +288,7 @@ def _add_body_groups(
             model.setPhysicalName(dim - 1, group.value, group.name.lower())
 
 
-def _faces_by_plane(
+def faces_by_plane(
     model: type[gmsh.model],
     dim: int,
     entity: int,
@@ -346,7 +346,7 @@ def _split_at_points(
     return entity
 
 
-def _set_body_sizes(
+def set_body_sizes(
     model: type[gmsh.model],
     dim: int,
     bodies: Sequence[tuple[int, float, float]],
@@ -382,7 +382,7 @@ def _set_body_sizes(
     field.setAsBackgroundMesh(minimum)
 
 
-def _generate(model: type[gmsh.model], dim: int) -> None:
+def generate_mesh(model: type[gmsh.model], dim: int) -> None:
     import gmsh
 
     gmsh.option.setNumber("Mesh.Algorithm", 6)
@@ -455,7 +455,7 @@ def stacked_blocks(
         model.mesh.setTransfiniteCurve(upper_bottom[0], 2)
 
     f = StackedBlocksFacets
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             StackedBlocksCells.LOWER: (
@@ -479,8 +479,8 @@ def stacked_blocks(
         },
     )
     # Uniform sizes: size_min == size_max makes the distance irrelevant.
-    _set_body_sizes(model, 2, [(lower, h1, h1), (upper, h2, h2)], "0", dist_min=0.0, grading=1.0)
-    _generate(model, 2)
+    set_body_sizes(model, 2, [(lower, h1, h1), (upper, h2, h2)], "0", dist_min=0.0, grading=1.0)
+    generate_mesh(model, 2)
 
 
 def stacked_boxes(
@@ -528,7 +528,7 @@ def stacked_boxes(
     model.occ.synchronize()
 
     f = StackedBoxesFacets
-    lower_faces = _faces_by_plane(
+    lower_faces = faces_by_plane(
         model,
         3,
         lower,
@@ -541,7 +541,7 @@ def stacked_boxes(
             f.LOWER_TOP: (2, 0.0),
         },
     )
-    upper_faces = _faces_by_plane(
+    upper_faces = faces_by_plane(
         model,
         3,
         upper,
@@ -554,18 +554,18 @@ def stacked_boxes(
             f.UPPER_TOP: (2, h_upper),
         },
     )
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             StackedBoxesCells.LOWER: (lower, lower_faces),
             StackedBoxesCells.UPPER: (upper, upper_faces),
         },
     )
-    _set_body_sizes(model, 3, [(lower, h1, h1), (upper, h2, h2)], "0", dist_min=0.0, grading=1.0)
-    _generate(model, 3)
+    set_body_sizes(model, 3, [(lower, h1, h1), (upper, h2, h2)], "0", dist_min=0.0, grading=1.0)
+    generate_mesh(model, 3)
 
 
-def _check_graded(
+def check_graded(
     h_contact: float, h_far: float, refine: float, grading: float, ratio: float, offset: float
 ) -> None:
     """Validate the size parameters shared by the graded builders."""
@@ -624,7 +624,7 @@ def cylinders(
         return
     check_finite(radius_lower=radius_lower, radius_upper=radius_upper)
     check_positive(radius_lower=radius_lower, radius_upper=radius_upper)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     r1, r2 = radius_upper, radius_lower
     l0 = offset_length(offset, ratio * h_contact)
     if offset > 0:
@@ -654,7 +654,7 @@ def cylinders(
         model.mesh.setTransfiniteCurve(upper_arc[0], 2)
 
     f = CylindersFacets
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             CylindersCells.LOWER: (
@@ -675,7 +675,7 @@ def cylinders(
             ),
         },
     )
-    _set_body_sizes(
+    set_body_sizes(
         model,
         2,
         [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
@@ -683,7 +683,7 @@ def cylinders(
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 2)
+    generate_mesh(model, 2)
 
 
 def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grading) -> None:
@@ -691,7 +691,7 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
     y = -R2 (lower)."""
     check_finite(radius_lower=r2, radius_upper=r1)
     check_positive(radius_lower=r2, radius_upper=r1)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     l0 = offset_length(offset, ratio * h_contact)
     if offset > 0:
         _check_first_element(l0, "the upper contact arc", 0.5 * math.pi * r1)
@@ -721,7 +721,7 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
     if offset > 0:
         model.mesh.setTransfiniteCurve(upper_arc[1], 2)
     f = CylindersFacets
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             CylindersCells.LOWER: (
@@ -731,7 +731,7 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
             CylindersCells.UPPER: (upper, {f.UPPER_CONTACT: upper_arc, f.UPPER_TOP: [upper_top]}),
         },
     )
-    _set_body_sizes(
+    set_body_sizes(
         model,
         2,
         [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
@@ -739,7 +739,7 @@ def _full_cylinders(model, r2, r1, h_contact, h_far, refine, ratio, offset, grad
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 2)
+    generate_mesh(model, 2)
 
 
 def punch_foundation(
@@ -788,7 +788,7 @@ def punch_foundation(
     check_less("rho", rho, "b", b)
     check_less("rho", rho, "h_punch", h_punch)
     check_less("b", b, "width", width)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     l0 = offset_length(offset, ratio * h_contact)
     if offset > 0:
         _check_first_element(l0, "the punch's flat face", b - rho)
@@ -819,7 +819,7 @@ def punch_foundation(
         model.mesh.setTransfiniteCurve(flat[0], 2)
 
     f = PunchFoundationFacets
-    _add_body_groups(
+    add_body_groups(
         model,
         {
             PunchFoundationCells.BLOCK: (
@@ -845,7 +845,7 @@ def punch_foundation(
     # Distance to the segment [0, b] x {0}, as in rectangle().
     zone = matheval_number(b)
     along = f"(Fabs(x)+Fabs(x-{zone})-{zone})/2"
-    _set_body_sizes(
+    set_body_sizes(
         model,
         2,
         [(block, h_contact, h_far), (punch, ratio * h_contact, h_far)],
@@ -853,7 +853,7 @@ def punch_foundation(
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 2)
+    generate_mesh(model, 2)
 
 
 def rounded_on_block(
@@ -905,7 +905,7 @@ def rounded_on_block(
     if not track >= 0.0:
         raise ValueError(f"track must be >= 0, got {track}")
     check_less("track", track, "right", right)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     r = radius
     half = math.acos((r - height) / r)  # half the arc's angle
     w = r * math.sin(half)
@@ -993,10 +993,10 @@ def _mesh_body_on_block(
     model.occ.synchronize()
     if split_arcs is not None:
         model.mesh.setTransfiniteCurve(split_arcs[1], 2)
-    _add_body_groups(model, {block[0]: block[1:], body[0]: body[1:]})
+    add_body_groups(model, {block[0]: block[1:], body[0]: body[1:]})
     end = matheval_number(track)
     along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
-    _set_body_sizes(
+    set_body_sizes(
         model,
         2,
         [(block[1], h_contact, h_far), (body[1], ratio * h_contact, h_far)],
@@ -1004,7 +1004,7 @@ def _mesh_body_on_block(
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 2)
+    generate_mesh(model, 2)
 
 
 def spheres(
@@ -1044,7 +1044,7 @@ def spheres(
     """
     check_finite(radius_lower=radius_lower, radius_upper=radius_upper)
     check_positive(radius_lower=radius_lower, radius_upper=radius_upper)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     r1, r2 = radius_upper, radius_lower
     l0 = offset_length(offset, ratio * h_contact)
     if offset > 0:
@@ -1061,25 +1061,25 @@ def spheres(
     model.occ.synchronize()
 
     f = SpheresFacets
-    lower_faces = _faces_by_plane(
+    lower_faces = faces_by_plane(
         model,
         3,
         lower,
         {f.LOWER_BOTTOM: (2, -r2), f.LOWER_X0: (0, 0.0), f.LOWER_Y0: (1, 0.0)},
         rest=f.LOWER_CONTACT,
     )
-    upper_faces = _faces_by_plane(
+    upper_faces = faces_by_plane(
         model,
         3,
         upper,
         {f.UPPER_TOP: (2, r1), f.UPPER_X0: (0, 0.0), f.UPPER_Y0: (1, 0.0)},
         rest=f.UPPER_CONTACT,
     )
-    _add_body_groups(
+    add_body_groups(
         model,
         {SpheresCells.LOWER: (lower, lower_faces), SpheresCells.UPPER: (upper, upper_faces)},
     )
-    _set_body_sizes(
+    set_body_sizes(
         model,
         3,
         [(lower, h_contact, h_far), (upper, ratio * h_contact, h_far)],
@@ -1087,7 +1087,7 @@ def spheres(
         dist_min=refine,
         grading=grading,
     )
-    _generate(model, 3)
+    generate_mesh(model, 3)
 
 
 class DieOnBlockCells(IntEnum):
@@ -1176,7 +1176,7 @@ def die_on_block(
         raise ValueError(f"track must be >= 0, got {track}")
     check_less("half_width", half_width, "left", left)
     check_less("track + half_width", track + half_width, "right", right)
-    _check_graded(h_contact, h_far, refine, grading, ratio, offset)
+    check_graded(h_contact, h_far, refine, grading, ratio, offset)
     r, w = radius, half_width
     half = math.asin(w / r)  # half the arc's angle
     e = r * (1.0 - math.cos(half))
