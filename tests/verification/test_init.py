@@ -164,6 +164,11 @@ def test_init_round_trip(tmp_path, name, params, numerics):
             )
             floor = 1e-12 * (h if length else scale)
             assert abs(va - vb) <= 1e-10 * max(abs(va), abs(vb)) + floor, (key, va, vb)
+        elif key.endswith(".reason"):
+            # which of SNES's tests stopped a converged step (the absolute or the relative
+            # one) can differ by the round-off of another partition when the last residual
+            # meets both (seen at 2 ranks on Debian 13); the numbers are compared above
+            assert va.startswith("CONVERGED") == vb.startswith("CONVERGED"), (key, va, vb)
         else:
             assert va == vb, (key, va, vb)
 
