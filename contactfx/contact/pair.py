@@ -237,7 +237,7 @@ class ContactPair:
     slave_lame: np.ndarray | None = None
     master_lame: np.ndarray | None = None
     #: (m,) the stress model of the cell of each slave / master facet (finite-strain Nitsche:
-    #: ``point_coupling.LINEAR``, ``NEO_HOOKEAN``, ``SVK``; None: linear), set by the problem
+    #: ``mechanics.piola.LINEAR``, ``NEO_HOOKEAN``, ``SVK``; None: linear), set by the problem
     slave_model: np.ndarray | None = None
     master_model: np.ndarray | None = None
     #: Coulomb friction coefficient (None: frictionless or Tresca) and the last converged

@@ -53,16 +53,13 @@ from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
 from contactfx.contact.laws import Coulomb, Tresca
 from contactfx.contact.pair import ContactPair, Side, side_of
-from contactfx.contact.point_coupling import (
-    LINEAR,
-    STRESS_MODELS,
-    nitsche_finite_strain_refusal,
-)
+from contactfx.contact.point_coupling import nitsche_finite_strain_refusal
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
 from contactfx.driver.problem import Method, Numerics, Problem, Scene, Solver, SurfaceSetup
 from contactfx.mechanics.elasticity import lame
+from contactfx.mechanics.piola import LINEAR, STRESS_MODELS
 from contactfx.results import Friction, Quantities
 
 __all__ = ["TwoBodyProblem", "TwoBodyPost", "plot_pressure"]
@@ -249,7 +246,7 @@ class TwoBodyProblem(Problem):
 
     def _model(self, side: Side) -> NDArray[np.int64]:
         """(m,) the stress model of the cell of each facet of ``side`` (finite-strain Nitsche's
-        consistency term, :func:`contactfx.contact.point_coupling.first_piola`)."""
+        consistency term, :func:`contactfx.mechanics.piola.first_piola`)."""
         tags = self._cell_body(side.cell)
         out = np.full(len(side.cell), LINEAR, dtype=np.int64)
         for tag, m in self.body_materials.items():

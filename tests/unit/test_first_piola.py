@@ -1,4 +1,4 @@
-"""Unit test of :func:`contactfx.contact.point_coupling.first_piola` (finite-strain Nitsche's
+"""Unit test of :func:`contactfx.mechanics.piola.first_piola` (finite-strain Nitsche's
 stress between two bodies): P against the complex-step derivative of each model's strain
 energy written here in NumPy (independently of the function's closed forms), and A = dP/dF
 against the complex-step derivative of P, in 2D (plane strain, F33 = 1) and 3D, at a
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from contactfx.contact.point_coupling import LINEAR, NEO_HOOKEAN, SVK, first_piola
+from contactfx.mechanics.piola import LINEAR, NEO_HOOKEAN, SVK, first_piola
 
 LMBDA, MU = 577.0, 385.0
 
