@@ -89,6 +89,7 @@ from contactfx.contact.projection import (
     gauss_segment,
     gauss_triangle,
     segment_overlaps,
+    transport,
     triangle_overlaps,
 )
 from contactfx.params import param, validate
@@ -123,6 +124,7 @@ class Mortar(MethodBase):
         obstacles=False,
         interfaces=False,
         two_body=True,
+        two_body_finite_strain=True,
         dim1=False,
         iterative=False,
         why_not={
@@ -294,6 +296,16 @@ class MortarCoupling:
         self._reference: tuple[np.ndarray, np.ndarray] | None = None
         #: Coulomb coefficient (None: frictionless) and the last converged displacement
         self.mu, self.previous = pair.mu, pair.previous
+        #: finite strain: the frame-indifferent slip (:meth:`_objective_slip`), with the
+        #: weighted gap vectors b_j and nodal normals of the owned slave nodes closed at the
+        #: last converged step (sorted global nodes, (m, gdim) vectors, (m, gdim) normals)
+        self.objective = pair.finite_strain and self.mu is not None
+        empty = np.zeros((0, self.layout.gdim))
+        self._b_old: tuple[np.ndarray, np.ndarray, np.ndarray] = (
+            np.zeros(0, dtype=np.int64),
+            empty,
+            empty,
+        )
 
     # -- search and mortar integrals -------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -313,6 +325,8 @@ class MortarCoupling:
         j_nodes, (j_data,) = _to_owners(comm, self.ranges, nodes, [node_data])
         m_rows, (m_cols, m_vals) = _to_owners(comm, self.ranges, rows, [cols, vals])
         self._assemble(j_nodes, j_data, m_rows, m_cols, m_vals)
+        if self.objective:
+            self._objective_slip(u)
 
     def _node_sums(self, nodes: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(sorted owned nodes, sums): the per-facet-node ``values`` (same shape as the facets'
@@ -625,8 +639,57 @@ class MortarCoupling:
         return A, B
 
     # -- what the post-processing reads ----------------------------------------------------
+    def _gap_vectors(self, u: np.ndarray) -> np.ndarray:
+        """(m, gdim) the weighted gap vectors b_j = sum_k (M_jk / D_j) x_k - x_j of the
+        contact nodes at x = X + u (``u`` the local array) under the last search's weights:
+        b_j . n_j = g_j from the gap rows, t_jc . b_j = -(the slip rows' t_jc . (x_j - sum_k
+        (M_jk / D_j) x_k)) on the free tangents."""
+        assert self.G is not None  # made by the search
+        lay = self.layout
+        n = lay.n_owned * lay.bs
+        x = self.G.createVecRight()
+        x.getArray()[:] = lay.X.getArray()[:n] + u[:n]
+        y = self.G.createVecLeft()
+        self.G.mult(x, y)
+        gy = y.getArray()
+        g = gy[self.normal_rows]
+        t_part = np.where(self.tmask, gy[self.tangent_rows()], 0.0)
+        x.destroy()
+        y.destroy()
+        return g[:, None] * self.normal - np.einsum("jc,jci->ji", t_part, self.tangents)
+
+    def _objective_slip(self, u: np.ndarray) -> None:
+        """Make the slip rows frame-indifferent: v_j = t_jc . (du_j - sum_k (M_jk / D_j) du_k)
+        + t_jc . (R_j b_j,old - b_j,old), b_j the weighted gap vector at the last converged
+        step and R_j the least rotation of the nodal normal since then (the mortar
+        counterpart of the correction g (n - n_old) of Mlika, Renard and Chouly 2017,
+        doi:10.1016/j.cma.2017.01.003). Under a rigid rotation R of both bodies the weights do
+        not change and the jump's increment is t_jc . (b_j,old - R b_j,old): v_j = 0 whatever
+        the gap and the tangential part of b (the dual weights' normal is the nodal average,
+        so b is not along n_j on a curved or kinked interface). The correction is held at the
+        search's normal, as the rest of the rows. A node closed at the last step only."""
+        assert self.g0 is not None
+        nodes_old, b_kept, n_kept = self._b_old
+        if len(nodes_old) == 0:
+            return
+        pos = np.minimum(np.searchsorted(nodes_old, self.nodes), len(nodes_old) - 1)
+        has = nodes_old[pos] == self.nodes
+        b_old, n_old = b_kept[pos[has]], n_kept[pos[has]]
+        change = transport(n_old, self.normal[has], b_old) - b_old
+        correction = np.zeros((len(self.nodes), self.layout.gdim))
+        correction[has] = np.einsum("jci,ji->jc", self.tangents[has], change)
+        rows = self.tangent_rows()[self.tmask]
+        self.g0.getArray()[rows] += correction[self.tmask]
+
     def converged(self) -> None:
-        """Nothing to move on: the slip history is the problem's last converged state."""
+        """The slip history is the problem's last converged state; with the frame-indifferent
+        slip also the weighted gap vectors of the closed nodes (:meth:`_objective_slip`)."""
+        if not self.objective:
+            return
+        assert self.previous is not None  # set with mu
+        b = self._gap_vectors(self.previous.x.array)
+        closed = self.lam - self.c * self.gap > 0.0
+        self._b_old = (self.nodes[closed], b[closed], self.normal[closed])
 
     def force(self) -> float:
         """The normal contact force sum_j D_j lambda_j of the pair."""

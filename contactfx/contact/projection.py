@@ -64,6 +64,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 __all__ = [
+    "transport",
     "FacetProjection",
     "Pick",
     "SegmentOverlaps",
@@ -757,6 +758,20 @@ def triangle_overlaps(
 
 
 # --- quadrature ----------------------------------------------------------------------------
+
+
+def transport(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """v (P, gdim) rotated by the rotation about a x b taking the unit vectors a to b (the
+    least rotation; analytic, so that complex steps pass through): in 2D by the angle from a to
+    b, in 3D R = I + [w]x + [w]x^2 / (1 + a . b), w = a x b. a = 0 (no history): v in 3D, 0 in
+    2D (v is 0 there)."""
+    c = np.einsum("pg,pg->p", a, b)
+    if v.shape[1] == 2:
+        w = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+        return c[:, None] * v + w[:, None] * np.stack([-v[:, 1], v[:, 0]], axis=1)
+    w = np.cross(a, b)
+    wv = np.cross(w, v)
+    return v + wv + np.cross(w, wv) / (1.0 + c)[:, None]
 
 
 def gauss_segment(n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1010,17 +1010,6 @@ def test_finite_strain_material_per_body_refusals(tmp_path, capsys):
     scene, _, _ = load_problem(_stacked(tmp_path))
     with pytest.raises(ValueError, match=r"^--material svk: the body's material is neo-hookean"):
         scene.run(Numerics(method="penalty", material="svk"), verbose=False)
-    # a linear slave on a finite-strain master: the problem kind refuses the method itself
-    linear = STACKED.replace(
-        'material = "neo-hookean"\nmu = 600.0\nkappa = 2000.0', "E = 2000.0\nnu = 0.3"
-    )
-    scene, _, _ = load_problem(_stacked(tmp_path, linear))
-    with pytest.raises(ValueError) as err:
-        scene.run(Numerics(method="mortar"), verbose=False)
-    assert str(err.value).startswith(
-        "method mortar is not offered between two bodies when one is finite-strain"
-    )
-    assert "\n" not in str(err.value)
     demo = str(DEMOS / "indenter-on-rubber.toml")
     assert main(["check", demo]) == 0
     out = capsys.readouterr().out

@@ -319,11 +319,6 @@ def test_finite_strain_serial_and_parallel_agree(method):
 
 def test_finite_strain_two_body_refused():
     scene = PatchTest(PatchTest.Params())
-    num = Numerics(method="mortar", material="neo-hookean")
-    with pytest.raises(ValueError, match="method mortar is not offered between two finite-"):
-        scene.run(num, verbose=False)
-    with pytest.raises(ValueError, match=r"\); use nitsche, penalty$"):
-        scene.run(num, verbose=False)
     # finite-strain Nitsche: frictionless, and the stress of the models it evaluates
     num = Numerics(method="nitsche", material="neo-hookean", friction="coulomb", mu=0.3)
     with pytest.raises(ValueError, match="frictionless for now: use --method penalty"):
