@@ -158,7 +158,7 @@ class TwoBodyProblem(Problem):
             )
         if self.finite_strain and method.name == "nitsche":
             names = [m.name if m.finite_strain else "linear" for m in materials.values()]
-            refusal = nitsche_finite_strain_refusal(numerics.friction, names)
+            refusal = nitsche_finite_strain_refusal(names)
             if refusal is not None:
                 raise ValueError(refusal)
         super().__init__(scene, numerics, method, mesh, facet_tags)
