@@ -31,7 +31,8 @@ radius, or the closest point on an edge of the master surface that no other mast
 shares) are not in contact.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
-penalty, and frictionless Nitsche as below; always searched at every Newton iteration):
+penalty, and Nitsche as below, each with or without friction; always searched at every Newton
+iteration):
 everything above is already
 in the current configuration, x = X + u on both sides: the slave Gauss points, the master facets,
 their normal n_m and the closest point y. The weights are the Gauss weights of the REFERENCE
@@ -51,7 +52,7 @@ residual (Squire and Trapp 1998, doi:10.1137/S003614459631241X), exact to round-
 gives Newton's quadratic convergence without writing Wriggers' geometric terms by hand.
 Points at a vertex of the master surface keep the Jacobian above.
 
-Nitsche between finite-strain bodies (frictionless): sigma_n(u) becomes the slave's first
+Nitsche between finite-strain bodies: sigma_n(u) becomes the slave's first
 Piola traction on its reference facet along the current normal, T_n(u) = n . P(F) N (N the
 reference facet's outward unit normal, F constant in the P1 slave cell), a nominal pressure as
 the penalty's, and sigma_n(v) its derivative with n held, T_n(v) = n . (dP/dF : grad v) N
@@ -59,6 +60,23 @@ the penalty's, and sigma_n(v) its derivative with n held, T_n(v) = n . (dP/dF : 
 doi:10.1016/j.cma.2017.01.003); :func:`first_piola` gives P and dP/dF of neo-Hookean, Saint
 Venant-Kirchhoff and linear slave cells in closed form. Residual and Jacobian come from
 :meth:`PointCoupling._point_terms` by complex steps, as for penalty friction below.
+
+Nitsche friction between finite-strain bodies (Coulomb; the same paper's large-deformation
+Nitsche friction): sigma_T(u) of the small-strain law becomes the tangential part of the same
+traction, T_T(u) = (I - n n) P(F) N, and
+
+    t = proj_{B(0, bound)}(T_T(u) - gamma slip),   bound = mu P (Coulomb; Tresca's threshold
+    where closed in the point law, not offered between two bodies),
+
+with the penalty friction's frame-indifferent slip below (no traction history: the trial is
+the stress's); residual, over the reference slave surface,
+int P ([v].n - theta / gamma T_n(v)) - theta / gamma int T_n(u) T_n(v)
+- int t . ([v] - theta / gamma T_T(v)) - theta / gamma int T_T(u) . T_T(v),
+T_T(v) = (I - n n)(dP/dF : grad v) N with n held. Its stick is regularised by the step's slip,
+t = T_T(u) - gamma slip: an interface at rest keeps relaxing by (T_T(u) - t) / gamma a step.
+The frame-indifferent slip projects the last step's offset on the current tangent plane, so a
+step rotating the contact by dtheta shortens a nonzero slip by 1 - cos(dtheta): objective to
+O(dtheta^2) |slip| (tests/verification/test_large_sliding.py).
 
 Penalty friction (Coulomb |t| <= mu P, or Tresca |t| <= s where closed), small or finite
 strain: a return map at every Gauss point, t = proj_{B(0, bound)}(t_trial), with the trial
@@ -71,12 +89,13 @@ rotations whose axis lies in the tangent plane), and the slip increment made fra
 the increment of the jump less that of the gap vector g n_m, whose rotation with the bodies
 is no slip (Mlika, Renard and Chouly 2017, doi:10.1016/j.cma.2017.01.003, the correction
 g (n - n_old) of GetFEM's ``frame_indifferent`` option). The history (t_old, g_old n_m,old,
-n_old) is kept per Gauss point of the slave surface (the same points at every search) and
-moved on at each converged step (``converged``). Residual and Jacobian come from one function
-of the nodal positions (:meth:`PointCoupling._point_terms`), differentiated by complex steps:
-with the projection frozen (small strain, and points at a master vertex) or recomputed
-(finite strain, inside a facet). A tie (the law's argument, or the trial against the bound,
-at round-off) takes the closed and sticking branch on every partition.
+n_old; Nitsche reads g_old n_m,old only) is kept per Gauss point of the slave surface (the
+same points at every search) and moved on at each converged step (``converged``). Residual
+and Jacobian come from one function of the nodal positions (:meth:`PointCoupling._point_terms`),
+differentiated by complex steps: with the projection frozen (small strain, and points at a
+master vertex) or recomputed (finite strain, inside a facet). A tie (the law's argument, or
+the trial against the bound, at round-off) takes the closed and sticking branch on every
+partition.
 
 Finite strain keeps each point's master facet of the last search while the point stays on it
 or within 0.1 of its size past its edge (:meth:`PointCoupling._keep_facets`): the facet
@@ -144,7 +163,7 @@ def _outward_normals(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
 def nitsche_finite_strain_refusal(materials: list[str]) -> str | None:
     """Why finite-strain Nitsche between two bodies refuses the bodies' materials (their
     names), or None: its consistency term evaluates the stress of the STRESS_MODELS only
-    (frictionless or with Coulomb or Tresca friction)."""
+    (frictionless or with Coulomb friction)."""
     for name in materials:
         if name not in STRESS_MODELS:
             return (

@@ -1,4 +1,4 @@
-"""Large sliding between two finite-strain bodies (the penalty method, the contact searched
+"""Large sliding between two finite-strain bodies (penalty and Nitsche, the contact searched
 in the deformed configuration at every Newton iteration), with and without Coulomb friction,
 and the objectivity of the frictional slip under a finite rigid rotation.
 
