@@ -31,7 +31,8 @@ radius, or the closest point on an edge of the master surface that no other mast
 shares) are not in contact.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
-penalty, and frictionless Nitsche as below; always searched at every Newton iteration):
+penalty, and Nitsche as below, each with or without friction; always searched at every Newton
+iteration):
 everything above is already
 in the current configuration, x = X + u on both sides: the slave Gauss points, the master facets,
 their normal n_m and the closest point y. The weights are the Gauss weights of the REFERENCE
@@ -51,7 +52,7 @@ residual (Squire and Trapp 1998, doi:10.1137/S003614459631241X), exact to round-
 gives Newton's quadratic convergence without writing Wriggers' geometric terms by hand.
 Points at a vertex of the master surface keep the Jacobian above.
 
-Nitsche between finite-strain bodies (frictionless): sigma_n(u) becomes the slave's first
+Nitsche between finite-strain bodies: sigma_n(u) becomes the slave's first
 Piola traction on its reference facet along the current normal, T_n(u) = n . P(F) N (N the
 reference facet's outward unit normal, F constant in the P1 slave cell), a nominal pressure as
 the penalty's, and sigma_n(v) its derivative with n held, T_n(v) = n . (dP/dF : grad v) N
@@ -59,6 +60,23 @@ the penalty's, and sigma_n(v) its derivative with n held, T_n(v) = n . (dP/dF : 
 doi:10.1016/j.cma.2017.01.003); :func:`first_piola` gives P and dP/dF of neo-Hookean, Saint
 Venant-Kirchhoff and linear slave cells in closed form. Residual and Jacobian come from
 :meth:`PointCoupling._point_terms` by complex steps, as for penalty friction below.
+
+Nitsche friction between finite-strain bodies (Coulomb; the same paper's large-deformation
+Nitsche friction): sigma_T(u) of the small-strain law becomes the tangential part of the same
+traction, T_T(u) = (I - n n) P(F) N, and
+
+    t = proj_{B(0, bound)}(T_T(u) - gamma slip),   bound = mu P (Coulomb; Tresca's threshold
+    where closed in the point law, not offered between two bodies),
+
+with the penalty friction's frame-indifferent slip below (no traction history: the trial is
+the stress's); residual, over the reference slave surface,
+int P ([v].n - theta / gamma T_n(v)) - theta / gamma int T_n(u) T_n(v)
+- int t . ([v] - theta / gamma T_T(v)) - theta / gamma int T_T(u) . T_T(v),
+T_T(v) = (I - n n)(dP/dF : grad v) N with n held. Its stick is regularised by the step's slip,
+t = T_T(u) - gamma slip: an interface at rest keeps relaxing by (T_T(u) - t) / gamma a step.
+The frame-indifferent slip projects the last step's offset on the current tangent plane, so a
+step rotating the contact by dtheta shortens a nonzero slip by 1 - cos(dtheta): objective to
+O(dtheta^2) |slip| (tests/verification/test_large_sliding.py).
 
 Penalty friction (Coulomb |t| <= mu P, or Tresca |t| <= s where closed), small or finite
 strain: a return map at every Gauss point, t = proj_{B(0, bound)}(t_trial), with the trial
@@ -71,12 +89,13 @@ rotations whose axis lies in the tangent plane), and the slip increment made fra
 the increment of the jump less that of the gap vector g n_m, whose rotation with the bodies
 is no slip (Mlika, Renard and Chouly 2017, doi:10.1016/j.cma.2017.01.003, the correction
 g (n - n_old) of GetFEM's ``frame_indifferent`` option). The history (t_old, g_old n_m,old,
-n_old) is kept per Gauss point of the slave surface (the same points at every search) and
-moved on at each converged step (``converged``). Residual and Jacobian come from one function
-of the nodal positions (:meth:`PointCoupling._point_terms`), differentiated by complex steps:
-with the projection frozen (small strain, and points at a master vertex) or recomputed
-(finite strain, inside a facet). A tie (the law's argument, or the trial against the bound,
-at round-off) takes the closed and sticking branch on every partition.
+n_old; Nitsche reads g_old n_m,old only) is kept per Gauss point of the slave surface (the
+same points at every search) and moved on at each converged step (``converged``). Residual
+and Jacobian come from one function of the nodal positions (:meth:`PointCoupling._point_terms`),
+differentiated by complex steps: with the projection frozen (small strain, and points at a
+master vertex) or recomputed (finite strain, inside a facet). A tie (the law's argument, or
+the trial against the bound, at round-off) takes the closed and sticking branch on every
+partition.
 
 Finite strain keeps each point's master facet of the last search while the point stays on it
 or within 0.1 of its size past its edge (:meth:`PointCoupling._keep_facets`): the facet
@@ -141,15 +160,10 @@ def _outward_normals(facets: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return np.where(out[:, None] < 0.0, -n, n)
 
 
-def nitsche_finite_strain_refusal(friction: str, materials: list[str]) -> str | None:
-    """Why finite-strain Nitsche between two bodies refuses the friction law and the bodies'
-    materials (their names), or None: it is frictionless, and its consistency term evaluates
-    the stress of the STRESS_MODELS only."""
-    if friction != "none":
-        return (
-            "nitsche between two finite-strain bodies is frictionless for now: use "
-            "--method penalty for friction between finite-strain bodies"
-        )
+def nitsche_finite_strain_refusal(materials: list[str]) -> str | None:
+    """Why finite-strain Nitsche between two bodies refuses the bodies' materials (their
+    names), or None: its consistency term evaluates the stress of the STRESS_MODELS only
+    (frictionless or with Coulomb friction)."""
     for name in materials:
         if name not in STRESS_MODELS:
             return (
@@ -268,9 +282,16 @@ class PointCoupling:
         #: penalty friction: the tangential traction by a return map with a per-point history
         #: (module docstring), residual and Jacobian from :meth:`_point_terms`
         self.penalty_friction = self.frictional and law.kind == "penalty"
+        #: finite-strain Nitsche (frictionless or with friction): the slave's first Piola
+        #: traction in the consistency term, from :meth:`_point_terms`
+        self.nitsche_finite_strain = pair.finite_strain and law.kind == "nitsche"
         #: residual and Jacobian from :meth:`_point_terms` (penalty friction, finite-strain
         #: Nitsche), else from :meth:`_law`
-        self.pointwise = self.penalty_friction or (pair.finite_strain and law.kind == "nitsche")
+        self.pointwise = self.penalty_friction or self.nitsche_finite_strain
+        #: a per-point history moved on at each converged step (:meth:`converged`): penalty
+        #: friction and finite-strain Nitsche friction (small-strain Nitsche friction reads
+        #: the last step's displacement only)
+        self.keeps_history = self.frictional and self.pointwise
         #: the frame-indifferent slip (False: the jump's increment alone, which reads the
         #: rotation of the penetration vector g n as slip: the objectivity test's contrast)
         self.objective = True
@@ -677,7 +698,11 @@ class PointCoupling:
         arg = -scale * g
         nitsche = self.law.kind == "nitsche"
         if nitsche:
-            Tn, S = self._nitsche_stress(p, x[:, : d + 1], sel, -nm)
+            # the slave's first Piola traction P(F) N and its derivative (dP/dF : grad v) N;
+            # their normal parts along n = -n_m (held in the derivative)
+            T, dT = self._nitsche_stress(p, x[:, : d + 1], sel)
+            Tn = -np.einsum("pg,pg->p", T, nm)
+            S = -np.einsum("pig,pg->pi", dT, nm)
             arg = arg - Tn
         active = p["paired"][sel] & (arg.real > -p["tie"][sel])
         P = np.where(active, arg, 0.0)
@@ -692,7 +717,14 @@ class PointCoupling:
             # vector, P_T([u] - [u_old] - (g n_m - g_old n_m_old)) with P_T g n_m = 0
             slip = jump + p["d_old"][sel] if self.objective else jump
             slip = slip - np.einsum("pg,pg->p", slip, nm)[:, None] * nm
-            trial = _transport(p["n_old"][sel], nm, p["t_old"][sel]) - scale[:, None] * slip
+            if nitsche:
+                # Nitsche's trial: the slave's tangential traction T_T(u) = (I - n n) P(F) N
+                # (a point off the master surface has no tangent plane: 0, as its T_n)
+                paired = p["paired"][sel][:, None]
+                TT = np.where(paired, T + Tn[:, None] * nm, 0.0)
+                trial = TT - scale[:, None] * slip
+            else:
+                trial = _transport(p["n_old"][sel], nm, p["t_old"][sel]) - scale[:, None] * slip
             if self.mu is not None:
                 bound = self.mu * P
             else:
@@ -714,26 +746,35 @@ class PointCoupling:
             # - theta / gamma (P + T_n(u)) T_n(v) on the slave cell's dofs
             cell = S.shape[1]
             r[:, :cell] -= (self.law.theta / scale * (P + Tn))[:, None] * S
+            if self.frictional:
+                # + theta / gamma (t - T_T(u)) . T_T(v), T_T(v) = (I - n n)(dP/dF : grad v) N
+                # (n held): the small-strain residual's friction terms with sigma_T -> T_T
+                ST = dT - np.einsum("pig,pg->pi", dT, nm)[:, :, None] * nm[:, None, :]
+                ST = np.where(paired[:, :, None], ST, 0.0)
+                r[:, :cell] += (self.law.theta / scale)[:, None] * np.einsum(
+                    "pig,pg->pi", ST, t - TT
+                )
         out["r"] = (p["w"][sel])[:, None] * r
         return out
 
     @staticmethod
     def _nitsche_stress(
-        p: _Points, xc: np.ndarray, sel: np.ndarray, n: np.ndarray
+        p: _Points, xc: np.ndarray, sel: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Finite-strain Nitsche: T_n(u) = n . P(F) N, the normal component (along the
-        current slave normal n = -n_m) of the first Piola traction on the reference slave
-        facet (unit normal N: force per unit reference area, as the penalty's P), and its
-        derivative in the slave cell's dofs with n held, T_n(v) = n . (dP/dF : grad v) N
-        (P, (d + 1) gdim); F = sum_a x_a grad N_a of the P1 cell's current node positions xc
-        (P, d + 1, gdim), the model of the cell's body (:func:`first_piola`)."""
+        """Finite-strain Nitsche: the first Piola traction of the slave on its reference facet
+        T(u) = P(F) N (P, gdim) (unit normal N: force per unit reference area, as the
+        penalty's P), and its derivative in the slave cell's dofs, T(v) = (dP/dF : grad v) N
+        (P, (d + 1) gdim, gdim); F = sum_a x_a grad N_a of the P1 cell's current node positions
+        xc (P, d + 1, gdim), the model of the cell's body (:func:`first_piola`). The normal
+        part along the current slave normal n = -n_m is T_n(u) = n . T(u), T_n(v) = n . T(v)
+        with n held, the tangential part T_T = (I - n n) T."""
         G = p["G"][sel]  # (P, d + 1, gdim) reference gradients of the cell's basis
         F = np.einsum("pag,pah->pgh", xc, G)
         stress, A = first_piola(F, p["model"][sel], p["lmbda"][sel], p["mu"][sel])
         N = p["N_ref"][sel]
-        Tn = np.einsum("pi,piJ,pJ->p", n, stress, N)
-        S = np.einsum("pi,piJkL,pJ,paL->pak", n, A, N, G)
-        return Tn, S.reshape(len(F), S.shape[1] * S.shape[2])
+        T = np.einsum("piJ,pJ->pi", stress, N)
+        dT = np.einsum("piJkL,pJ,paL->paki", A, N, G)
+        return T, dT.reshape(len(F), dT.shape[1] * dT.shape[2], dT.shape[3])
 
     def _tangent(
         self, p: _Points, vals: np.ndarray, sel: np.ndarray, geometric: bool
@@ -775,16 +816,17 @@ class PointCoupling:
 
     def converged(self) -> None:
         """A step converged: the number of closed points (:meth:`lost`) and, with penalty
-        friction, the tangential traction, gap vector and master normal at every point are the
-        history of the next. Collective."""
+        friction or finite-strain Nitsche friction, the tangential traction, gap vector and
+        master normal at every point are the history of the next (Nitsche's trial reads the gap
+        vector only: its traction is the stress's). Collective."""
         from mpi4py import MPI
 
         closed = int(np.sum(self.state[0][0] > 0.0))
         self.closed_before = self.comm.allreduce(closed, op=MPI.SUM)
-        if not self.penalty_friction:
+        if not self.keeps_history:
             return
         for dr, (t, gap, nm) in zip(self.dirs, self._last, strict=True):
-            assert t is not None  # penalty friction
+            assert t is not None  # with friction
             h = dr.history(len(t), self.layout.gdim)
             h["t_old"][:], h["d_old"][:], h["n_old"][:] = t, gap, nm
 

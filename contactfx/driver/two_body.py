@@ -10,9 +10,9 @@ body's own model and parameters (``scene.materials()``). The internal work is th
 sum_i int_{body i} S_i(u) : grad v dX over the cell tags (a nonlinear bulk, assembled at every
 Newton iteration), S_i the body's weak stress (a hyperelastic body's first Piola stress).
 Finite strain searches the pair at every Newton iteration (the contact in the deformed
-configuration, :mod:`contactfx.contact.point_coupling`) and is offered with penalty (with
-or without friction) and frictionless Nitsche (the slave body's first Piola traction in its
-consistency term: a neo-Hookean, Saint Venant-Kirchhoff or linear slave body); the contact's
+configuration, :mod:`contactfx.contact.point_coupling`) and is offered with penalty and
+Nitsche, with or without Coulomb friction (Nitsche: the slave body's first Piola traction in
+its consistency term, a neo-Hookean, Saint Venant-Kirchhoff or linear slave body); the contact's
 parameters scale with the small-strain E, lambda, mu of each facet's body (a hyperelastic
 model's linearisation at F = I).
 
@@ -158,7 +158,7 @@ class TwoBodyProblem(Problem):
             )
         if self.finite_strain and method.name == "nitsche":
             names = [m.name if m.finite_strain else "linear" for m in materials.values()]
-            refusal = nitsche_finite_strain_refusal(numerics.friction, names)
+            refusal = nitsche_finite_strain_refusal(names)
             if refusal is not None:
                 raise ValueError(refusal)
         super().__init__(scene, numerics, method, mesh, facet_tags)

@@ -546,7 +546,7 @@ def check_materials(problem: ProblemFile, numerics: Numerics) -> None:
         )
     if problem.pair is not None and numerics.method == "nitsche":
         names = [b.material.name if b.material.finite_strain else "linear" for b in problem.bodies]
-        refusal = nitsche_finite_strain_refusal(numerics.friction, names)
+        refusal = nitsche_finite_strain_refusal(names)
         if refusal is not None:
             r.fail("numerics.method", refusal)
 
