@@ -113,7 +113,13 @@ from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
-from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
+from contactfx.contact.projection import (
+    Pick,
+    gauss_segment,
+    gauss_triangle,
+    pick_closest,
+    transport,
+)
 from contactfx.mechanics.elasticity import basis_tractions
 from contactfx.mechanics.piola import LINEAR, STRESS_MODELS, first_piola
 
@@ -168,7 +174,7 @@ def nitsche_finite_strain_refusal(materials: list[str]) -> str | None:
         if name not in STRESS_MODELS:
             return (
                 "nitsche between two finite-strain bodies evaluates the stress of "
-                f"{', '.join(STRESS_MODELS)} bodies, not {name}: use --method penalty"
+                f"{', '.join(STRESS_MODELS)} bodies, not {name}: use --method penalty or mortar"
             )
     return None
 
@@ -231,20 +237,6 @@ class _Directed:
 #: how far past its edge (a fraction of its size) a point keeps its facet within a Newton
 #: solve (:meth:`PointCoupling._keep_facets`)
 KEEP_BEYOND = 0.1
-
-
-def _transport(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """v (P, gdim) rotated by the rotation about a x b taking the unit vectors a to b (the
-    least rotation; analytic, so that complex steps pass through): in 2D by the angle from a to
-    b, in 3D R = I + [w]x + [w]x^2 / (1 + a . b), w = a x b. a = 0 (no history): v in 3D, 0 in
-    2D (v is 0 there)."""
-    c = np.einsum("pg,pg->p", a, b)
-    if v.shape[1] == 2:
-        w = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-        return c[:, None] * v + w[:, None] * np.stack([-v[:, 1], v[:, 0]], axis=1)
-    w = np.cross(a, b)
-    wv = np.cross(w, v)
-    return v + wv + np.cross(w, wv) / (1.0 + c)[:, None]
 
 
 class PointCoupling:
@@ -716,6 +708,16 @@ class PointCoupling:
             # the frame-indifferent slip: the increment of the jump less that of the gap
             # vector, P_T([u] - [u_old] - (g n_m - g_old n_m_old)) with P_T g n_m = 0
             slip = jump + p["d_old"][sel] if self.objective else jump
+            if self.objective and self.geometric:
+                # finite strain: that vector, jump + g_old n_m_old - g n_m, is the step's slide
+                # in the last converged configuration (the offset of the point's master point
+                # then): carried into the current one by the rotation of the normal, so that a
+                # step that turns the bodies by dtheta does not shorten it by 1 - cos(dtheta)
+                # (a point without history keeps it)
+                n_old = p["n_old"][sel]
+                offset = slip - g[:, None] * nm
+                has = (np.einsum("pg,pg->p", n_old, n_old) > 0.0)[:, None]
+                slip = np.where(has, transport(n_old, nm, offset), offset)
             slip = slip - np.einsum("pg,pg->p", slip, nm)[:, None] * nm
             if nitsche:
                 # Nitsche's trial: the slave's tangential traction T_T(u) = (I - n n) P(F) N
@@ -724,7 +726,7 @@ class PointCoupling:
                 TT = np.where(paired, T + Tn[:, None] * nm, 0.0)
                 trial = TT - scale[:, None] * slip
             else:
-                trial = _transport(p["n_old"][sel], nm, p["t_old"][sel]) - scale[:, None] * slip
+                trial = transport(p["n_old"][sel], nm, p["t_old"][sel]) - scale[:, None] * slip
             if self.mu is not None:
                 bound = self.mu * P
             else:

@@ -203,13 +203,16 @@ class _RoundOffStop:
     configuration is the difference of current positions, x_s - y, of size |x| where the
     penalty kappa multiplies it: a floor of kappa eps |x| w, 2e-11 on a block pressed to
     1e-10 of a small load increment's residual), which the relative tolerance of a step
-    whose predictor was already close does not reach."""
+    whose predictor was already close does not reach. The depth is measured against the
+    largest first residual of the run's solves too: a step that changes nothing (a hold in
+    the load program) starts at the round-off level, where the residual cannot fall."""
 
     #: how far below the first residual the last must be before a stall counts as round-off
     DEPTH = 1e-8
 
     def __init__(self, snes: PETSc.SNES, divergence: float) -> None:
         self.first = self.last = 0.0
+        self.peak = 0.0  # the largest first residual of the solves so far
         self.divergence = divergence
         self.stalled = 0  # solves stopped at the round-off level (a statistic)
         snes.setConvergenceTest(self)
@@ -221,6 +224,8 @@ class _RoundOffStop:
         last, self.last = self.last, fnorm
         if it == 0:
             self.first = fnorm
+            if np.isfinite(fnorm):
+                self.peak = max(self.peak, fnorm)
         if not np.isfinite(fnorm):
             return R.DIVERGED_FNORM_NAN
         if fnorm < atol:
@@ -233,7 +238,7 @@ class _RoundOffStop:
             return R.CONVERGED_SNORM_RELATIVE
         if self.divergence > 0 and fnorm > self.divergence * self.first:
             return R.DIVERGED_DTOL
-        if it >= 2 and last <= self.DEPTH * self.first and fnorm > 0.1 * last:
+        if it >= 2 and last <= self.DEPTH * max(self.first, self.peak) and fnorm > 0.1 * last:
             self.stalled += 1
             return R.CONVERGED_FNORM_RELATIVE
         return R.CONVERGED_ITERATING

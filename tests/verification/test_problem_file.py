@@ -981,7 +981,7 @@ def test_two_body_hyperelastic_ranks_agree(shared_tmp):
             lambda t: t,
             ["numerics.method=nitsche"],
             "numerics.method: nitsche between two finite-strain bodies evaluates the stress of "
-            "linear, neo-hookean, svk bodies, not mooney-rivlin: use --method penalty",
+            "linear, neo-hookean, svk bodies, not mooney-rivlin: use --method penalty or mortar",
         ),
     ],
 )
