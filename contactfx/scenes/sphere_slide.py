@@ -47,14 +47,14 @@ from contactfx.meshes import SphereOnBlockCells, SphereOnBlockFacets, sphere_on_
 from contactfx.params import param
 from contactfx.scenes import export
 from contactfx.scenes._common import fix, fix_component, prescribe_component, reaction_forces
-from contactfx.scenes.two_body_2d import PressThenDrag, press_then_drag
+from contactfx.scenes.two_body_2d import PressThenDrag, press_drag, press_then_drag
 from contactfx.scenes.two_body_base import two_elastic
 
 __all__ = ["SphereSlide"]
 
 
 @dataclass(frozen=True)
-class SphereSlideParams(two_elastic(1000.0, 0.3)):
+class _SphereParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the sphere
     E_upper: float = param(1e4, "Young's modulus of the upper body (the sphere)", positive=True)
     slave: str = param(
@@ -67,13 +67,18 @@ class SphereSlideParams(two_elastic(1000.0, 0.3)):
     height: float = param(
         1.0, "height of the sphere cap's flat top above its lowest point, <= R", positive=True
     )
-    press: float = param(0.3, "downward displacement of the sphere's top", positive=True)
-    slide: float = param(
-        1.0, "displacement of the sphere's top along +x after pressing", nonnegative=True
+
+
+@dataclass(frozen=True)
+class SphereSlideParams(
+    press_drag(
+        _SphereParams,
+        press=(0.3, "downward displacement of the sphere's top"),
+        slide=(1.0, "displacement of the sphere's top along +x after pressing"),
+        press_fraction=0.3,
+        slide_may_be_zero=True,
     )
-    press_fraction: float = param(
-        0.3, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+):
     left: float = param(2.5, "extent of the block behind the sphere's lowest point", positive=True)
     right: float = param(
         4.0, "extent of the block ahead of the sphere's lowest point (along +x)", positive=True
@@ -91,11 +96,6 @@ class SphereSlideParams(two_elastic(1000.0, 0.3)):
     grading: float = param(
         0.3, "element size growth per unit distance from the refined zones", positive=True
     )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
 
 
 class SphereSlide(PressThenDrag):

@@ -102,6 +102,51 @@ def press_then_drag(
     ]
 
 
+def press_fraction_param(default: float):
+    """The parameter ``press_fraction`` of a scene pressed, then dragged (with
+    :class:`PressFraction`, which checks it is < 1)."""
+    return param(default, "fraction of the load program spent pressing, in (0, 1)", positive=True)
+
+
+class PressFraction:
+    """Mixin of the parameter dataclasses with a ``press_fraction``
+    (:func:`press_fraction_param`): after the fields' rules, press_fraction < 1."""
+
+    press_fraction: float
+
+    def __post_init__(self) -> None:
+        super().__post_init__()  # type: ignore[misc]
+        if not self.press_fraction < 1.0:
+            raise ValueError(f"--press-fraction must be < 1, got {self.press_fraction}")
+
+
+def press_drag(
+    base: type,
+    press: tuple[float, str],
+    slide: tuple[float, str],
+    press_fraction: float,
+    *,
+    slide_may_be_zero: bool = False,
+) -> type:
+    """Base of the parameters of a :class:`PressThenDrag` scene: the fields of ``base`` (the
+    bodies'), then ``press`` and ``slide`` (each (default, help); press > 0, slide > 0 or,
+    with ``slide_may_be_zero``, >= 0) and ``press_fraction`` (default ``press_fraction``,
+    checked in (0, 1)). The scene's own fields (the block, the mesh sizes) follow."""
+    fields = {
+        "press": param(*press, positive=True),
+        "slide": param(*slide, positive=not slide_may_be_zero, nonnegative=slide_may_be_zero),
+        "press_fraction": press_fraction_param(press_fraction),
+    }
+
+    @dataclass(frozen=True)
+    class PressDragParams(PressFraction, base):  # type: ignore[valid-type, misc]
+        press: float = fields["press"]
+        slide: float = fields["slide"]
+        press_fraction: float = fields["press_fraction"]
+
+    return PressDragParams
+
+
 @dataclass(frozen=True)
 class PunchFoundationParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the punch (stiff by default)
@@ -212,20 +257,22 @@ class PunchFoundation(TwoBodyScene):
 
 
 @dataclass(frozen=True)
-class SlidingContactParams(two_elastic(1000.0, 0.3)):
+class _RoundedBodyParams(two_elastic(1000.0, 0.3)):
     radius: float = param(1.0, "radius R of the rounded body", positive=True)
     height: float = param(
         0.15, "height of the rounded body (the disk cut at y = height <= R)", positive=True
     )
-    press: float = param(
-        2e-3, "prescribed downward displacement of the rounded body's top", positive=True
+
+
+@dataclass(frozen=True)
+class SlidingContactParams(
+    press_drag(
+        _RoundedBodyParams,
+        press=(2e-3, "prescribed downward displacement of the rounded body's top"),
+        slide=(0.2, "tangential displacement of the top (along +x) after pressing"),
+        press_fraction=0.1,
     )
-    slide: float = param(
-        0.2, "tangential displacement of the top (along +x) after pressing", positive=True
-    )
-    press_fraction: float = param(
-        0.1, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+):
     left: float = param(0.8, "extent of the block left of the first contact point", positive=True)
     right: float = param(
         1.2, "extent of the block right of the first contact point (> slide)", positive=True
@@ -243,17 +290,12 @@ class SlidingContactParams(two_elastic(1000.0, 0.3)):
         nonnegative=True,
     )
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
-
 
 class PressThenDrag(TwoBodyScene):
     """A body's top pressed down by ``press`` on [0, press_fraction] of the load program, then
     dragged along +x by ``slide`` at that depth, the other body's bottom clamped: ``clamped``
     and ``driven`` are (facet tag, problem-file group) of the two; the scene's parameters
-    ``press``, ``slide`` and ``press_fraction``."""
+    (:func:`press_drag`) ``press``, ``slide`` and ``press_fraction``."""
 
     clamped: ClassVar[tuple[int, str]]
     driven: ClassVar[tuple[int, str]]
@@ -350,7 +392,7 @@ class SlidingContact(PressThenDrag):
 
 
 @dataclass(frozen=True)
-class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
+class CattaneoCylindersParams(PressFraction, two_elastic(1000.0, 0.3)):
     R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
     R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
     depth: float = param(
@@ -359,9 +401,7 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
     shift: float = param(
         1.5e-3, "displacement of the top along +x after pressing", nonnegative=True
     )
-    press_fraction: float = param(
-        0.5, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+    press_fraction: float = press_fraction_param(0.5)
     h_contact: float = param(
         1e-3, "element size of the lower body in the contact zone", positive=True
     )
@@ -375,11 +415,6 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
         "shift of the upper body's contact nodes (fraction of an element, in [0, 1))",
         nonnegative=True,
     )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
 
 
 class CattaneoCylinders(HertzCylinders):
