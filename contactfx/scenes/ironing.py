@@ -191,13 +191,6 @@ class ShallowIroning(PressThenDrag):
         "line_search": "cp",
     }
 
-    friction = "none"
-    mu = 0.0
-
-    def configure(self, numerics) -> None:
-        super().configure(numerics)
-        self.friction, self.mu = numerics.friction, float(numerics.mu)
-
     def materials(self) -> dict[str, Elastic]:
         """The bodies' constants, plane-stress-equivalent with ``section`` plane-stress."""
         mats = super().materials()
@@ -229,16 +222,16 @@ class ShallowIroning(PressThenDrag):
     def plateau(self, loads: np.ndarray) -> np.ndarray:
         """The indices of the steps on the plateau (slide within [plateau_from, plateau_to] of
         ``slide``)."""
-        slide = np.array([self.top_displacement(t)[0] for t in loads]) / self.p.slide
-        f = self.p.press_fraction
-        on = (loads > f * (1.0 + 1e-9)) & (slide >= self.p.plateau_from - 1e-9)
-        return np.flatnonzero(on & (slide <= self.p.plateau_to + 1e-9))
+        drag = self.drag_steps(loads)
+        slide = np.array([self.top_displacement(t)[0] for t in loads[drag]]) / self.p.slide
+        on = (slide >= self.p.plateau_from - 1e-9) & (slide <= self.p.plateau_to + 1e-9)
+        return drag[on]
 
     def force_scores(self, loads, forces):
         """P at the end of the pressing and its error against the published value, the plateau
         means of P and Q, their errors against the published plateaus, Q / P, and the largest
         step-to-step jumps of P and Q on the plateau (over P_plateau)."""
-        P, Q = forces[:, 1], -forces[:, 0]
+        P, Q = self.forces_PQ(forces)
         scores = {"P": float(P[-1]), "Q": float(Q[-1])}
         f = self.p.press_fraction
         if loads[0] <= f <= loads[-1]:
@@ -263,7 +256,7 @@ class ShallowIroning(PressThenDrag):
         published = self.published_Q()
         if published is not None:
             scores["Q_plateau_error"] = (Qm - published) / published
-        if self.friction == "coulomb" and self.mu > 0.0:
+        if self.coulomb:
             scores["Q_over_P_over_mu"] = Qm / Pm / self.mu
         return scores
 
