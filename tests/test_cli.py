@@ -58,6 +58,9 @@ BAD = [
         ["run", "cattaneo-cylinders", "--friction", "tresca", "--mu=0", "--threshold=0.3"],
         "method nitsche has no Tresca friction between two meshed bodies",
     ),
+    # the press-then-drag scenes' press_fraction, checked once (contactfx/scenes/two_body_2d.py)
+    (["run", "shallow-ironing", "--press-fraction", "1"], "--press-fraction must be < 1"),
+    (["run", "cattaneo-cylinders", "--press-fraction", "1.5"], "--press-fraction must be < 1"),
     (["run", "hertz2d", "--method", "al-ssn", "--solver", "gamg"], "use --solver lu"),
     (["run", "hertz2d", "--method", "al-ssn", "--ncp", "newton"], "--ncp must be one of"),
     (["run", "hertz2d", "--quadrature", "nodal", "--degree", "2"], "--quadrature nodal needs"),

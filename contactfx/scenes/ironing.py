@@ -79,7 +79,7 @@ from mpi4py import MPI
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import DieOnBlockCells, DieOnBlockFacets, die_on_block
 from contactfx.params import param
-from contactfx.scenes.two_body_2d import PressThenDrag
+from contactfx.scenes.two_body_2d import PressThenDrag, press_drag
 from contactfx.scenes.two_body_base import two_elastic
 
 __all__ = [
@@ -112,7 +112,7 @@ def plane_stress_equivalent(material: Elastic) -> Elastic:
 
 
 @dataclass(frozen=True)
-class ShallowIroningParams(two_elastic(68.96e7, 0.32)):
+class _DieParams(two_elastic(68.96e7, 0.32)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the die
     E_upper: float = param(68.96e8, "Young's modulus of the upper body (the die)", positive=True)
     slave: str = param(
@@ -130,13 +130,17 @@ class ShallowIroningParams(two_elastic(68.96e7, 0.32)):
     radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
     half_width: float = param(0.6, "half-width of the die", positive=True)
     height: float = param(1.2, "height of the die (its top above its lowest point)", positive=True)
-    press: float = param(0.8, "downward displacement of the die's top", positive=True)
-    slide: float = param(
-        10.0, "displacement of the die's top along +x after pressing", positive=True
+
+
+@dataclass(frozen=True)
+class ShallowIroningParams(
+    press_drag(
+        _DieParams,
+        press=(0.8, "downward displacement of the die's top"),
+        slide=(10.0, "displacement of the die's top along +x after pressing"),
+        press_fraction=0.1,
     )
-    press_fraction: float = param(
-        0.1, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+):
     left: float = param(0.8, "extent of the block left of the die's lowest point", positive=True)
     right: float = param(11.2, "extent of the block right of the die's lowest point", positive=True)
     depth: float = param(4.0, "depth of the block", positive=True)
@@ -158,8 +162,6 @@ class ShallowIroningParams(two_elastic(68.96e7, 0.32)):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
         if not self.plateau_from < self.plateau_to <= 1.0:
             raise ValueError(
                 "need plateau_from < plateau_to <= 1, got "
@@ -188,13 +190,6 @@ class ShallowIroning(PressThenDrag):
         "predictor": "previous",
         "line_search": "cp",
     }
-
-    friction = "none"
-    mu = 0.0
-
-    def configure(self, numerics) -> None:
-        super().configure(numerics)
-        self.friction, self.mu = numerics.friction, float(numerics.mu)
 
     def materials(self) -> dict[str, Elastic]:
         """The bodies' constants, plane-stress-equivalent with ``section`` plane-stress."""
@@ -227,16 +222,16 @@ class ShallowIroning(PressThenDrag):
     def plateau(self, loads: np.ndarray) -> np.ndarray:
         """The indices of the steps on the plateau (slide within [plateau_from, plateau_to] of
         ``slide``)."""
-        slide = np.array([self.top_displacement(t)[0] for t in loads]) / self.p.slide
-        f = self.p.press_fraction
-        on = (loads > f * (1.0 + 1e-9)) & (slide >= self.p.plateau_from - 1e-9)
-        return np.flatnonzero(on & (slide <= self.p.plateau_to + 1e-9))
+        drag = self.drag_steps(loads)
+        slide = np.array([self.top_displacement(t)[0] for t in loads[drag]]) / self.p.slide
+        on = (slide >= self.p.plateau_from - 1e-9) & (slide <= self.p.plateau_to + 1e-9)
+        return drag[on]
 
     def force_scores(self, loads, forces):
         """P at the end of the pressing and its error against the published value, the plateau
         means of P and Q, their errors against the published plateaus, Q / P, and the largest
         step-to-step jumps of P and Q on the plateau (over P_plateau)."""
-        P, Q = forces[:, 1], -forces[:, 0]
+        P, Q = self.forces_PQ(forces)
         scores = {"P": float(P[-1]), "Q": float(Q[-1])}
         f = self.p.press_fraction
         if loads[0] <= f <= loads[-1]:
@@ -261,7 +256,7 @@ class ShallowIroning(PressThenDrag):
         published = self.published_Q()
         if published is not None:
             scores["Q_plateau_error"] = (Qm - published) / published
-        if self.friction == "coulomb" and self.mu > 0.0:
+        if self.coulomb:
             scores["Q_over_P_over_mu"] = Qm / Pm / self.mu
         return scores
 

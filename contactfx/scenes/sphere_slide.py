@@ -38,7 +38,6 @@ No closed form: the scores are checks of the discrete solution.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,14 +46,14 @@ from contactfx.meshes import SphereOnBlockCells, SphereOnBlockFacets, sphere_on_
 from contactfx.params import param
 from contactfx.scenes import export
 from contactfx.scenes._common import fix, fix_component, prescribe_component, reaction_forces
-from contactfx.scenes.two_body_2d import PressThenDrag, press_then_drag
+from contactfx.scenes.two_body_2d import PressThenDrag, press_drag, press_then_drag
 from contactfx.scenes.two_body_base import two_elastic
 
 __all__ = ["SphereSlide"]
 
 
 @dataclass(frozen=True)
-class SphereSlideParams(two_elastic(1000.0, 0.3)):
+class _SphereParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the sphere
     E_upper: float = param(1e4, "Young's modulus of the upper body (the sphere)", positive=True)
     slave: str = param(
@@ -67,13 +66,18 @@ class SphereSlideParams(two_elastic(1000.0, 0.3)):
     height: float = param(
         1.0, "height of the sphere cap's flat top above its lowest point, <= R", positive=True
     )
-    press: float = param(0.3, "downward displacement of the sphere's top", positive=True)
-    slide: float = param(
-        1.0, "displacement of the sphere's top along +x after pressing", nonnegative=True
+
+
+@dataclass(frozen=True)
+class SphereSlideParams(
+    press_drag(
+        _SphereParams,
+        press=(0.3, "downward displacement of the sphere's top"),
+        slide=(1.0, "displacement of the sphere's top along +x after pressing"),
+        press_fraction=0.3,
+        slide_may_be_zero=True,
     )
-    press_fraction: float = param(
-        0.3, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+):
     left: float = param(2.5, "extent of the block behind the sphere's lowest point", positive=True)
     right: float = param(
         4.0, "extent of the block ahead of the sphere's lowest point (along +x)", positive=True
@@ -91,11 +95,6 @@ class SphereSlideParams(two_elastic(1000.0, 0.3)):
     grading: float = param(
         0.3, "element size growth per unit distance from the refined zones", positive=True
     )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
 
 
 class SphereSlide(PressThenDrag):
@@ -125,31 +124,20 @@ class SphereSlide(PressThenDrag):
     clamped = (SphereOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
     driven = (SphereOnBlockFacets.SPHERE_TOP, "sphere_top")
 
-    friction = "none"
-    mu = 0.0
-
-    def configure(self, numerics) -> None:
-        super().configure(numerics)
-        self.friction, self.mu = numerics.friction, float(numerics.mu)
-
-    def mesh_builder(self):
-        p = self.p
-        builder = functools.partial(
-            sphere_on_block,
-            radius=p.radius,
-            height=p.height,
-            left=p.left,
-            right=p.right,
-            width=p.width,
-            depth=p.depth,
-            track=p.slide,
-            h_contact=p.h_contact,
-            h_far=p.h_far,
-            refine=p.refine,
-            ratio=p.ratio,
-            grading=p.grading,
-        )
-        return builder, 3
+    builder = staticmethod(sphere_on_block)
+    body_params = ("radius", "height")
+    block_params = (
+        "left",
+        "right",
+        "width",
+        "depth",
+        "h_contact",
+        "h_far",
+        "refine",
+        "ratio",
+        "grading",
+    )
+    dim = 3
 
     def make_constants(self, mesh) -> None:
         super().make_constants(mesh)
@@ -232,14 +220,14 @@ class SphereSlide(PressThenDrag):
         """P, Q and Q / P at the last step (with Coulomb friction Q / (mu P)), the largest
         |Q / P| over the slide's steps and the equilibrium of the reactions and the pair's
         force over the steps."""
-        P, Q = forces[:, 2], -forces[:, 0]
-        scores = {"P": float(P[-1]), "Q": float(Q[-1]), "Q_over_P": float(Q[-1] / P[-1])}
-        sliding = np.flatnonzero(loads > self.p.press_fraction * (1.0 + 1e-9))
+        P, Q = self.forces_PQ(forces)
+        scores = self.last_step(P, Q)
+        sliding = self.drag_steps(loads)
         if len(sliding):
             ratio = Q[sliding] / P[sliding]
             scores["min_Q_over_P_sliding"] = float(np.min(ratio))
             scores["max_Q_over_P_sliding"] = float(np.max(ratio))
-        if self.friction == "coulomb" and self.mu > 0.0:
+        if self.coulomb:
             scores["Q_over_P_over_mu"] = float(Q[-1] / P[-1] / self.mu)
             if self.records:
                 scores["curvature_factor"] = self.records[-1]["curvature"]

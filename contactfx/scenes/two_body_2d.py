@@ -102,6 +102,57 @@ def press_then_drag(
     ]
 
 
+def press_drag_factors(t: float, fraction: float) -> tuple[float, float]:
+    """(dragged, pressed) at load factor t: the fractions of the drag and of the pressing done
+    when the pressing takes the first ``fraction`` of the load program and the drag the rest."""
+    return max(t - fraction, 0.0) / (1.0 - fraction), min(t / fraction, 1.0)
+
+
+def press_fraction_param(default: float):
+    """The parameter ``press_fraction`` of a scene pressed, then dragged (with
+    :class:`PressFraction`, which checks it is < 1)."""
+    return param(default, "fraction of the load program spent pressing, in (0, 1)", positive=True)
+
+
+class PressFraction:
+    """Mixin of the parameter dataclasses with a ``press_fraction``
+    (:func:`press_fraction_param`): after the fields' rules, press_fraction < 1."""
+
+    press_fraction: float
+
+    def __post_init__(self) -> None:
+        super().__post_init__()  # type: ignore[misc]
+        if not self.press_fraction < 1.0:
+            raise ValueError(f"--press-fraction must be < 1, got {self.press_fraction}")
+
+
+def press_drag(
+    base: type,
+    press: tuple[float, str],
+    slide: tuple[float, str],
+    press_fraction: float,
+    *,
+    slide_may_be_zero: bool = False,
+) -> type:
+    """Base of the parameters of a :class:`PressThenDrag` scene: the fields of ``base`` (the
+    bodies'), then ``press`` and ``slide`` (each (default, help); press > 0, slide > 0 or,
+    with ``slide_may_be_zero``, >= 0) and ``press_fraction`` (default ``press_fraction``,
+    checked in (0, 1)). The scene's own fields (the block, the mesh sizes) follow."""
+    fields = {
+        "press": param(*press, positive=True),
+        "slide": param(*slide, positive=not slide_may_be_zero, nonnegative=slide_may_be_zero),
+        "press_fraction": press_fraction_param(press_fraction),
+    }
+
+    @dataclass(frozen=True)
+    class PressDragParams(PressFraction, base):  # type: ignore[valid-type, misc]
+        press: float = fields["press"]
+        slide: float = fields["slide"]
+        press_fraction: float = fields["press_fraction"]
+
+    return PressDragParams
+
+
 @dataclass(frozen=True)
 class PunchFoundationParams(two_elastic(1000.0, 0.3)):
     # E_lower / nu_lower: the block; E_upper / nu_upper: the punch (stiff by default)
@@ -212,20 +263,22 @@ class PunchFoundation(TwoBodyScene):
 
 
 @dataclass(frozen=True)
-class SlidingContactParams(two_elastic(1000.0, 0.3)):
+class _RoundedBodyParams(two_elastic(1000.0, 0.3)):
     radius: float = param(1.0, "radius R of the rounded body", positive=True)
     height: float = param(
         0.15, "height of the rounded body (the disk cut at y = height <= R)", positive=True
     )
-    press: float = param(
-        2e-3, "prescribed downward displacement of the rounded body's top", positive=True
+
+
+@dataclass(frozen=True)
+class SlidingContactParams(
+    press_drag(
+        _RoundedBodyParams,
+        press=(2e-3, "prescribed downward displacement of the rounded body's top"),
+        slide=(0.2, "tangential displacement of the top (along +x) after pressing"),
+        press_fraction=0.1,
     )
-    slide: float = param(
-        0.2, "tangential displacement of the top (along +x) after pressing", positive=True
-    )
-    press_fraction: float = param(
-        0.1, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+):
     left: float = param(0.8, "extent of the block left of the first contact point", positive=True)
     right: float = param(
         1.2, "extent of the block right of the first contact point (> slide)", positive=True
@@ -243,41 +296,56 @@ class SlidingContactParams(two_elastic(1000.0, 0.3)):
         nonnegative=True,
     )
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
-
 
 class PressThenDrag(TwoBodyScene):
     """A body's top pressed down by ``press`` on [0, press_fraction] of the load program, then
     dragged along +x by ``slide`` at that depth, the other body's bottom clamped: ``clamped``
     and ``driven`` are (facet tag, problem-file group) of the two; the scene's parameters
-    ``press``, ``slide`` and ``press_fraction``."""
+    (:func:`press_drag`) ``press``, ``slide`` and ``press_fraction``. The run's friction law
+    and coefficient are kept (``friction``, ``mu``) for the scores."""
 
     clamped: ClassVar[tuple[int, str]]
     driven: ClassVar[tuple[int, str]]
-    #: the gmsh builder of the body on the block (its block and track keywords as
-    #: rounded_on_block's) and the names of the body's own parameters it takes
+    #: the gmsh builder of the body on the block (the track's length is its keyword
+    #: ``track``), the names of the body's own parameters it takes and of the block's and the
+    #: mesh sizes' (the keywords of rounded_on_block by default), and the dimension
     builder: ClassVar[Any]
     body_params: ClassVar[tuple[str, ...]]
+    block_params: ClassVar[tuple[str, ...]] = (
+        "left",
+        "right",
+        "depth",
+        "h_contact",
+        "h_far",
+        "refine",
+        "ratio",
+        "offset",
+    )
+    dim: ClassVar[int] = 2
+    #: Q = q_sign times the x component of the pair's force on the driven body: -1 the force
+    #: that drags the body along +x, +1 the force along +x
+    q_sign: ClassVar[float] = -1.0
+
+    friction = "none"
+    mu = 0.0
+
+    def configure(self, numerics) -> None:
+        super().configure(numerics)
+        self.friction, self.mu = numerics.friction, float(numerics.mu)
+
+    @property
+    def coulomb(self) -> bool:
+        """Coulomb friction with mu > 0."""
+        return self.friction == "coulomb" and self.mu > 0.0
 
     def mesh_builder(self):
         p = self.p
         builder = functools.partial(
             type(self).builder,
-            **{name: getattr(p, name) for name in self.body_params},
-            left=p.left,
-            right=p.right,
-            depth=p.depth,
+            **{name: getattr(p, name) for name in self.body_params + self.block_params},
             track=p.slide,
-            h_contact=p.h_contact,
-            h_far=p.h_far,
-            refine=p.refine,
-            ratio=p.ratio,
-            offset=p.offset,
         )
-        return builder, 2
+        return builder, self.dim
 
     def make_constants(self, mesh) -> None:
         self.push = dolfinx.fem.Constant(mesh, 0.0)
@@ -301,13 +369,26 @@ class PressThenDrag(TwoBodyScene):
     def top_displacement(self, t: float) -> tuple[float, float]:
         """(tangential, vertical) displacement of the top at load factor t: pressing on
         [0, press_fraction], then dragging at the constant vertical displacement."""
-        f = self.p.press_fraction
-        pressed = min(t / f, 1.0)
-        dragged = max(t - f, 0.0) / (1.0 - f)
+        dragged, pressed = press_drag_factors(t, self.p.press_fraction)
         return dragged * self.p.slide, -pressed * self.p.press
 
     def set_load(self, t: float) -> None:
         self.drag.value, self.push.value = self.top_displacement(t)
+
+    def drag_steps(self, loads: np.ndarray) -> np.ndarray:
+        """The indices of the steps after the pressing."""
+        return np.flatnonzero(loads > self.p.press_fraction * (1.0 + 1e-9))
+
+    def forces_PQ(self, forces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(P, Q) per step from the pair's force on the driven body (``forces``, a row a
+        step): P its vertical component (the block pushes the body up), Q ``q_sign`` times its
+        x component."""
+        return forces[:, self.dim - 1], self.q_sign * forces[:, 0]
+
+    @staticmethod
+    def last_step(P: np.ndarray, Q: np.ndarray) -> dict[str, float]:
+        """P, Q and Q / P at the last step."""
+        return {"P": float(P[-1]), "Q": float(Q[-1]), "Q_over_P": float(Q[-1] / P[-1])}
 
 
 class SlidingContact(PressThenDrag):
@@ -326,6 +407,8 @@ class SlidingContact(PressThenDrag):
 
     builder = staticmethod(rounded_on_block)
     body_params = ("radius", "height")
+    # Q: the force along +x
+    q_sign = 1.0
 
     #: the block's clamped bottom and the rounded body's driven top: (facet tag, group)
     clamped = (RoundedOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
@@ -338,9 +421,9 @@ class SlidingContact(PressThenDrag):
         program's transient: the secant predictor extrapolates the pressing into the first
         drag step, and the search of a step runs at its prediction (|Q / P| up to 2e-3 and P
         changes of 3e-3 there with the defaults)."""
-        Q, P = forces[:, 0], forces[:, 1]
-        scores = {"P": float(P[-1]), "Q": float(Q[-1]), "Q_over_P": float(Q[-1] / P[-1])}
-        steady = np.flatnonzero(loads > self.p.press_fraction * (1.0 + 1e-9))[3:]
+        P, Q = self.forces_PQ(forces)
+        scores = self.last_step(P, Q)
+        steady = self.drag_steps(loads)[3:]
         if len(steady) >= 2:
             Pd, Qd = P[steady], Q[steady]
             scores["max_abs_Q_over_P"] = float(np.max(np.abs(Qd / Pd)))
@@ -350,7 +433,7 @@ class SlidingContact(PressThenDrag):
 
 
 @dataclass(frozen=True)
-class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
+class CattaneoCylindersParams(PressFraction, two_elastic(1000.0, 0.3)):
     R_upper: float = param(1.0, "radius R1 of the upper cylinder", positive=True)
     R_lower: float = param(1.0, "radius R2 of the lower cylinder", positive=True)
     depth: float = param(
@@ -359,9 +442,7 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
     shift: float = param(
         1.5e-3, "displacement of the top along +x after pressing", nonnegative=True
     )
-    press_fraction: float = param(
-        0.5, "fraction of the load program spent pressing, in (0, 1)", positive=True
-    )
+    press_fraction: float = press_fraction_param(0.5)
     h_contact: float = param(
         1e-3, "element size of the lower body in the contact zone", positive=True
     )
@@ -375,11 +456,6 @@ class CattaneoCylindersParams(two_elastic(1000.0, 0.3)):
         "shift of the upper body's contact nodes (fraction of an element, in [0, 1))",
         nonnegative=True,
     )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.press_fraction < 1.0:
-            raise ValueError(f"press_fraction must be < 1, got {self.press_fraction}")
 
 
 class CattaneoCylinders(HertzCylinders):
@@ -431,9 +507,9 @@ class CattaneoCylinders(HertzCylinders):
         ]
 
     def set_load(self, t: float) -> None:
-        f = self.p.press_fraction
-        self.push.value = -min(t / f, 1.0) * self.p.depth
-        self.drag.value = max(t - f, 0.0) / (1.0 - f) * self.p.shift
+        dragged, pressed = press_drag_factors(t, self.p.press_fraction)
+        self.push.value = -pressed * self.p.depth
+        self.drag.value = dragged * self.p.shift
 
     def force_scores(self, loads, forces):
         """Q, P at the last step and Q / (mu P) is in the friction references."""
