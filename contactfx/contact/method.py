@@ -84,7 +84,7 @@ NODAL_MULTIPLIER = Multiplier("nodal", nodal=True)
 class Supports:
     """What a method handles. ``why_not`` maps a capability name (``friction``, ``obstacles``,
     ``mixed_up``, ``nodal_quadrature``, ``interfaces``, ``two_body``, ``two_body_friction``,
-    ``two_body_tresca``, ``dim1``, ``iterative``, ``finite_strain``, ``two_body_finite_strain``)
+    ``two_body_tresca``, ``dim1``, ``iterative``, ``finite_strain``)
     to the reason it is not supported, quoted in the error a user sees."""
 
     friction: tuple[str, ...] = ("none",)
@@ -97,9 +97,6 @@ class Supports:
     two_body_friction: bool = True
     #: Tresca friction between two meshed bodies (a given threshold, no pressure in the bound)
     two_body_tresca: bool = False
-    #: two meshed finite-strain bodies (a hyperelastic ``--material`` in the two-body kind):
-    #: the law in the deformed configuration, searched at every Newton iteration
-    two_body_finite_strain: bool = False
     dim1: bool = True
     iterative: bool = True
     #: finite-strain bodies (a hyperelastic ``--material``): the law in the deformed

@@ -124,7 +124,6 @@ class Mortar(MethodBase):
         obstacles=False,
         interfaces=False,
         two_body=True,
-        two_body_finite_strain=True,
         dim1=False,
         iterative=False,
         why_not={
@@ -132,7 +131,6 @@ class Mortar(MethodBase):
             "interfaces": "a mortar pair joins two meshed surfaces",
             "friction": "mortar has Coulomb friction only",
             "iterative": "its condensed Jacobian is not symmetric: use LU",
-            "two_body_finite_strain": "not verified between finite-strain bodies yet",
         },
     )
 

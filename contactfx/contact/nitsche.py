@@ -65,7 +65,6 @@ class Nitsche(TrialFriction, MethodBase):
         nodal_quadrature=True,
         interfaces=True,
         two_body=True,
-        two_body_finite_strain=True,
     )
 
     def __post_init__(self) -> None:

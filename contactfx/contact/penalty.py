@@ -58,7 +58,6 @@ class Penalty(TrialFriction, MethodBase):
         interfaces=True,
         two_body=True,
         two_body_tresca=True,
-        two_body_finite_strain=True,
     )
     #: with friction, the driver keeps the last step's tangential traction (``s.traction_prev``)
     traction_history: ClassVar[bool] = True

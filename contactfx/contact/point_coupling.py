@@ -74,21 +74,27 @@ int P ([v].n - theta / gamma T_n(v)) - theta / gamma int T_n(u) T_n(v)
 - int t . ([v] - theta / gamma T_T(v)) - theta / gamma int T_T(u) . T_T(v),
 T_T(v) = (I - n n)(dP/dF : grad v) N with n held. Its stick is regularised by the step's slip,
 t = T_T(u) - gamma slip: an interface at rest keeps relaxing by (T_T(u) - t) / gamma a step.
-The frame-indifferent slip projects the last step's offset on the current tangent plane, so a
-step rotating the contact by dtheta shortens a nonzero slip by 1 - cos(dtheta): objective to
-O(dtheta^2) |slip| (tests/verification/test_large_sliding.py).
+At finite strain the slip's offset is carried into the current configuration by the rotation
+of the master surface (below), so that a step rotating the contact does not shorten it
+(tests/verification/test_large_sliding.py).
 
 Penalty friction (Coulomb |t| <= mu P, or Tresca |t| <= s where closed), small or finite
 strain: a return map at every Gauss point, t = proj_{B(0, bound)}(t_trial), with the trial
 
     t_trial = R(n_old -> n) t_old - kappa P_T ([u] - [u_old] + g_old n_m,old),
 
-the last converged step's traction t_old carried by the rotation of the master normal (in 2D
-the rotation from n_old to n; in 3D the least rotation about n_old x n, which is exact for
-rotations whose axis lies in the tangent plane), and the slip increment made frame-indifferent:
-the increment of the jump less that of the gap vector g n_m, whose rotation with the bodies
-is no slip (Mlika, Renard and Chouly 2017, doi:10.1016/j.cma.2017.01.003, the correction
-g (n - n_old) of GetFEM's ``frame_indifferent`` option). The history (t_old, g_old n_m,old,
+the last converged step's traction t_old carried by the rotation of the master surface R (in
+2D the rotation from n_old to n; in 3D, at finite strain, the rotation of the point's master
+facet over the step, the orthonormal frame of its first edge and normal at the last converged
+and the current positions, then the least rotation from R n_old to n for a point that moved
+to another facet; in 3D at small strain the least rotation about n_old x n), and the slip
+increment made frame-indifferent: the increment of the jump less that of the gap vector
+g n_m, whose rotation with the bodies is no slip (Mlika, Renard and Chouly 2017,
+doi:10.1016/j.cma.2017.01.003, the correction g (n - n_old) of GetFEM's ``frame_indifferent``
+option); at finite strain that vector (the step's slide measured in the last converged
+configuration) is carried by R too, so that a step that turns the bodies by dtheta, about
+any axis, does not shorten it by 1 - cos(dtheta) nor leave it behind a spin about the
+normal. The history (t_old, g_old n_m,old,
 n_old; Nitsche reads g_old n_m,old only) is kept per Gauss point of the slave surface (the
 same points at every search) and moved on at each converged step (``converged``). Residual
 and Jacobian come from one function of the nodal positions (:meth:`PointCoupling._point_terms`),
@@ -124,6 +130,8 @@ from contactfx.mechanics.elasticity import basis_tractions
 from contactfx.mechanics.piola import LINEAR, STRESS_MODELS, first_piola
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     from contactfx.contact.pair import ContactPair
 
 __all__ = ["PointCoupling", "Law"]
@@ -708,16 +716,17 @@ class PointCoupling:
             # the frame-indifferent slip: the increment of the jump less that of the gap
             # vector, P_T([u] - [u_old] - (g n_m - g_old n_m_old)) with P_T g n_m = 0
             slip = jump + p["d_old"][sel] if self.objective else jump
+            n_old = p["n_old"][sel]
+            turn = self._turn(x - du, x, n_old, nm)
             if self.objective and self.geometric:
                 # finite strain: that vector, jump + g_old n_m_old - g n_m, is the step's slide
                 # in the last converged configuration (the offset of the point's master point
-                # then): carried into the current one by the rotation of the normal, so that a
-                # step that turns the bodies by dtheta does not shorten it by 1 - cos(dtheta)
-                # (a point without history keeps it)
-                n_old = p["n_old"][sel]
+                # then): carried into the current one by the surface's rotation, so that a step
+                # that turns the bodies does not shorten it by 1 - cos(dtheta) (a point without
+                # history keeps it)
                 offset = slip - g[:, None] * nm
                 has = (np.einsum("pg,pg->p", n_old, n_old) > 0.0)[:, None]
-                slip = np.where(has, transport(n_old, nm, offset), offset)
+                slip = np.where(has, turn(offset), offset)
             slip = slip - np.einsum("pg,pg->p", slip, nm)[:, None] * nm
             if nitsche:
                 # Nitsche's trial: the slave's tangential traction T_T(u) = (I - n n) P(F) N
@@ -726,7 +735,7 @@ class PointCoupling:
                 TT = np.where(paired, T + Tn[:, None] * nm, 0.0)
                 trial = TT - scale[:, None] * slip
             else:
-                trial = transport(p["n_old"][sel], nm, p["t_old"][sel]) - scale[:, None] * slip
+                trial = turn(p["t_old"][sel]) - scale[:, None] * slip
             if self.mu is not None:
                 bound = self.mu * P
             else:
@@ -758,6 +767,36 @@ class PointCoupling:
                 )
         out["r"] = (p["w"][sel])[:, None] * r
         return out
+
+    def _turn(
+        self, x_old: np.ndarray, x: np.ndarray, n_old: np.ndarray, nm: np.ndarray
+    ) -> Callable[[np.ndarray], np.ndarray]:
+        """The rotation of the master surface over the step, as a map of tangential vectors
+        (P, gdim) of the last converged configuration (module docstring): in 2D and at small
+        strain the least rotation from n_old to n_m; in 3D at finite strain the rotation of
+        the point's master facet (positions x_old, x: (P, 2 d + 1, 3), the facet the last
+        d), the orthonormal frame (e_1 / |e_1|, n x e_1 / |e_1|, n) of its first edge and
+        unit normal from the last converged to the current positions, exact for a rigid
+        motion of any axis (a spin about the normal too), then the least rotation from the
+        turned n_old to n_m (a point on another facet than at the last step). Analytic:
+        complex steps pass through."""
+        if x.shape[2] == 2 or not self.geometric:
+            return lambda v: transport(n_old, nm, v)
+        d = x.shape[1] // 2
+
+        def frame(xm: np.ndarray) -> np.ndarray:
+            e1, e2 = xm[:, 1] - xm[:, 0], xm[:, 2] - xm[:, 0]
+            n = np.cross(e1, e2)
+            f1 = e1 / np.sqrt(np.einsum("pg,pg->p", e1, e1))[:, None]
+            f3 = n / np.sqrt(np.einsum("pg,pg->p", n, n))[:, None]
+            return np.stack([f1, np.cross(f3, f1), f3], axis=2)  # columns
+
+        R = np.einsum("pik,pjk->pij", frame(x[:, d + 1 :]), frame(x_old[:, d + 1 :]))
+
+        def turn(v: np.ndarray) -> np.ndarray:
+            return transport(np.einsum("pij,pj->pi", R, n_old), nm, np.einsum("pij,pj->pi", R, v))
+
+        return turn
 
     @staticmethod
     def _nitsche_stress(

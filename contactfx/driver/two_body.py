@@ -120,15 +120,6 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
-        if numerics.bulk_material(scene.material()).finite_strain:
-            if not method.supports.two_body_finite_strain:
-                raise _not_offered(
-                    method,
-                    "two_body_finite_strain",
-                    f"is not offered between two finite-strain bodies (--material "
-                    f"{numerics.material})",
-                    lambda c: c.two_body and c.two_body_finite_strain,
-                )
 
     def __init__(
         self,
@@ -147,15 +138,6 @@ class TwoBodyProblem(Problem):
         }
         self.finite_strain = any(m.finite_strain for m in materials.values())
         self.body_materials = materials if self.finite_strain else {}
-        if self.finite_strain and not method.supports.two_body_finite_strain:
-            # (check refuses it from the slave's material; a problem file may make another
-            # body finite-strain)
-            raise _not_offered(
-                method,
-                "two_body_finite_strain",
-                "is not offered between two bodies when one is finite-strain",
-                lambda c: c.two_body and c.two_body_finite_strain,
-            )
         if self.finite_strain and method.name == "nitsche":
             names = [m.name if m.finite_strain else "linear" for m in materials.values()]
             refusal = nitsche_finite_strain_refusal(names)

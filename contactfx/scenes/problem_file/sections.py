@@ -14,7 +14,6 @@ import numpy as np
 
 from contactfx.contact.interface import BartonBandis
 from contactfx.contact.point_coupling import nitsche_finite_strain_refusal
-from contactfx.contact.registry import method_class, methods_supporting
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.mechanics.hyperelastic import (
     MODELS,
@@ -533,16 +532,6 @@ def check_materials(problem: ProblemFile, numerics: Numerics) -> None:
             f"{numerics.material!r} conflicts with bodies.{i}.material = "
             f"{body.material.name!r}: numerics.material makes every linear body one model (with "
             "its E and nu); give each body's model in its [[bodies]] table instead",
-        )
-    supports = method_class(numerics.method).supports
-    if problem.pair is not None and not supports.two_body_finite_strain:
-        offered = methods_supporting(lambda c: c.two_body and c.two_body_finite_strain)
-        r.fail(
-            "numerics.method",
-            f"{numerics.method} is not offered between two bodies when one is finite-strain "
-            f"(bodies.{i}.material = {body.material.name!r}; "
-            f"{supports.why_not.get('two_body_finite_strain', 'not implemented')}); use "
-            + ", ".join(offered),
         )
     if problem.pair is not None and numerics.method == "nitsche":
         names = [b.material.name if b.material.finite_strain else "linear" for b in problem.bodies]
