@@ -146,6 +146,18 @@ CASES: list[tuple[str, list[str]]] = [
     ("hertz-cylinders-penalty", ["run", "hertz-cylinders", "--method", "penalty"]),
     ("sliding-contact-mortar", ["run", "sliding-contact", "--method", "mortar"]),
     ("cattaneo-nitsche", ["run", "cattaneo-cylinders", "--method", "nitsche"]),
+    # finite strain between two bodies (dragged bodies, friction)
+    (
+        "sliding-contact-fs-coulomb",
+        ["run", "sliding-contact", "--material", "neo-hookean", "--method", "penalty"]
+        + ["--friction", "coulomb", "--mu", "0.3", "--steps", "10"],
+    ),
+    (
+        "shallow-ironing-coulomb-short",
+        ["run", "shallow-ironing", "--slide", "1", "--steps", "10"]
+        + ["--friction", "coulomb", "--mu", "0.3"],
+    ),
+    ("sphere-slide-coarse", ["run", "sphere-slide", "--slide", "0.3", "--steps", "6"]),
     ("problem-block-on-plinth", ["solve", str(ROOT / "demos/problems/block-on-plinth.toml")]),
     ("problem-holed-pad", ["solve", str(ROOT / "demos/problems/holed-pad.toml")]),
     ("problem-pressurised-crack", ["solve", str(ROOT / "demos/problems/pressurised-crack.toml")]),
