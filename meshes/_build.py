@@ -38,6 +38,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import tempfile
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from enum import IntEnum
@@ -417,22 +418,68 @@ def file_groups(path: str | os.PathLike[str], size_factor: float = 1.0):
     """A builder that loads a ``.msh`` file or meshes a ``.geo`` file (gmsh's own parser, the
     element sizes scaled by ``size_factor``), and the list it fills, on the rank that runs it,
     with the file's named physical groups (:class:`Group`). The mesh dimension is the highest
-    dimension of a physical group."""
+    dimension of a physical group. A ``.geo`` is meshed in a child process that writes the
+    mesh (binary, every entity) for the builder to load, so that a geometry gmsh cannot mesh
+    (a syntax error, an open or self-intersecting curve loop: gmsh can terminate the process)
+    raises ValueError "FILE: gmsh failed: MESSAGE" with gmsh's error; so does a ``.msh`` gmsh
+    cannot read."""
     path = Path(path)
     groups: list[Group] = []
 
     def builder(model: type[gmsh.model]) -> None:
         import gmsh
 
-        if path.suffix == ".geo":
-            gmsh.option.setNumber("Mesh.MeshSizeFactor", float(size_factor))
-        gmsh.merge(str(path))
-        dims = [d for d, _ in model.getPhysicalGroups()]
-        if dims and path.suffix == ".geo":
-            model.mesh.generate(max(dims))
+        if path.suffix != ".geo":
+            try:
+                gmsh.merge(str(path))
+            except Exception as exc:  # gmsh's Python API raises Exception(its last error)
+                raise ValueError(f"{path}: gmsh failed: {_one_line(str(exc))}") from None
+        else:
+            with tempfile.TemporaryDirectory(prefix="contactfx-geo-") as tmp:
+                msh = Path(tmp) / f"{path.stem}.msh"
+                _mesh_geo(path, msh, size_factor)
+                gmsh.merge(str(msh))
         _collect_groups(model, groups, str(path))
 
     return builder, groups
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def _mesh_geo(geo: Path, msh: Path, size_factor: float) -> None:
+    """Mesh ``geo`` into ``msh`` in a child process (``_gmsh_child.py``); raise ValueError
+    "GEO: gmsh failed: MESSAGE" with gmsh's last error (and its last note of a problem, e.g.
+    the intersections of a self-intersecting loop) when gmsh fails or crashes."""
+    import subprocess
+    import sys
+
+    script = Path(__file__).with_name("_gmsh_child.py")
+    # no MPI state of this process: the child is a plain process, not an MPI singleton
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
+    proc = subprocess.run(
+        [sys.executable, str(script), str(geo), str(msh), repr(float(size_factor))],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=False,
+    )
+    if proc.returncode == 0 and msh.is_file():
+        return
+    lines = (proc.stdout + proc.stderr).splitlines()
+    errors = [ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("Error")]
+    notes = [ln.split(":-(", 1)[1].strip() for ln in lines if ":-(" in ln]
+    message = "; ".join(dict.fromkeys(notes[-1:] + errors[-1:]))
+    if not message:
+        message = (
+            f"gmsh crashed (signal {-proc.returncode})"
+            if proc.returncode < 0
+            else f"exit status {proc.returncode}"
+        )
+    for prefix in (f"'{geo}', ", f"'{geo}': "):  # the file is named once, first
+        message = message.removeprefix(prefix)
+    raise ValueError(f"{geo}: gmsh failed: {_one_line(message)}")
 
 
 def build_file(

@@ -128,7 +128,93 @@ def test_diverging_solve_is_reported_and_marked_failed(tmp_path, ranks):
     assert "nonlinear solve diverged at load step 1" in res.stderr
     assert "DIVERGED_MAX_IT" in res.stderr
     data = json.loads((tmp_path / "run.json").read_text())
-    assert data["status"] == "failed"
+    assert data["status"] == "failed" and data["stage"] == "solve"
+
+
+DEMOS = Path(__file__).parents[1] / "demos" / "problems"
+
+#: block-on-plinth.geo broken as a user's geometry can be: (edit, stage, the error's words)
+BROKEN = {
+    # the block 0.02 into the plinth: refused at the start (the geometry checks of the set-up)
+    "overlap": (
+        lambda g: g.replace("{-0.3, 1, 0, hu}", "{-0.3, 0.98, 0, hu}").replace(
+            "{0.3, 1, 0, hu}", "{0.3, 0.98, 0, hu}"
+        ),
+        "set-up",
+        "the bodies overlap by 0.02 at the start",
+    ),
+    "syntax error": (
+        lambda g: g.replace("Line(14) = {14, 11};", "Line(14) = {14, 11}"),
+        "mesh",
+        "bad.geo: gmsh failed: line 27: syntax error (Curve)",
+    ),
+    "open curve loop": (
+        lambda g: g.replace("Curve Loop(2) = {11, 12, 13, 14};", "Curve Loop(2) = {11, 12, 13};"),
+        "mesh",
+        "bad.geo: gmsh failed: The 1D mesh seems not to be forming a closed loop",
+    ),
+    # the block's top corners swapped: a figure eight, which gmsh meets by terminating
+    "self-intersecting loop": (
+        lambda g: (
+            g.replace("{0.3, 1.4, 0, hu * 2}", "{x, 1.4, 0, hu * 2}")
+            .replace("{-0.3, 1.4, 0, hu * 2}", "{0.3, 1.4, 0, hu * 2}")
+            .replace("{x, 1.4, 0, hu * 2}", "{-0.3, 1.4, 0, hu * 2}")
+        ),
+        "mesh",
+        "bad.geo: gmsh failed: There are 2 intersections in the 1D mesh (curves 12 14)",
+    ),
+}
+
+
+@pytest.mark.parametrize(
+    "case, ranks",
+    [(case, 1) for case in BROKEN] + [("self-intersecting loop", 2), ("overlap", 2)],
+)
+def test_failure_before_the_solve_is_one_line_and_marked_failed(tmp_path, case, ranks):
+    """A geometry that gmsh cannot mesh (its error, or its crash in a child process) or that
+    the set-up refuses: one line on rank 0, no traceback or backtrace, a non-zero exit on
+    every rank (no hang), and run.json marked failed with the stage and the same line."""
+    edit, stage, words = BROKEN[case]
+    (tmp_path / "bad.geo").write_text(edit((DEMOS / "block-on-plinth.geo").read_text()))
+    problem = (DEMOS / "block-on-plinth.toml").read_text()
+    (tmp_path / "bad.toml").write_text(problem.replace("block-on-plinth.geo", "bad.geo"))
+    out = tmp_path / "out"
+    res = run_cli("solve", str(tmp_path / "bad.toml"), "--out", str(out), ranks=ranks, timeout=60)
+    assert res.returncode != 0
+    errors = [line for line in res.stderr.splitlines() if line.startswith("contactfx: error:")]
+    assert len(errors) == 1, res.stderr
+    assert words in errors[0]
+    for noise in ("Traceback", "terminate called", "Signal:", "MPI_ABORT"):
+        assert noise not in res.stderr, res.stderr
+    data = json.loads((out / "run.json").read_text())
+    assert data["status"] == "failed" and data["stage"] == stage and data["ranks"] == ranks
+    assert data["error"] == errors[0].removeprefix("contactfx: error: ")
+    assert data["scene"] == "block-on-plinth" and data["numerics"]["method"] == "mortar"
+    assert sorted(p.name for p in out.iterdir()) == ["run.json"]
+
+
+@pytest.mark.parametrize(
+    "args, fields",
+    [
+        (["run", "hertz2d", "--E", "-1"], {"scene": "hertz2d"}),
+        (
+            ["solve", str(DEMOS / "holed-pad.toml"), "--set", "bodies.0.nu=0.5"],
+            {"problem": "holed-pad.toml"},
+        ),
+    ],
+    ids=["run", "solve"],
+)
+def test_refused_input_is_marked_failed(tmp_path, args, fields):
+    """A refused option or problem-file key with --out: run.json failed at stage input (no
+    earlier run.json in the folder stays as this run's)."""
+    (tmp_path / "run.json").write_text('{"status": "completed"}')
+    res = run_cli(*args, "--out", str(tmp_path), timeout=60)
+    assert res.returncode != 0
+    data = json.loads((tmp_path / "run.json").read_text())
+    assert data["status"] == "failed" and data["stage"] == "input"
+    assert f"contactfx: error: {data['error']}" in res.stderr.splitlines()
+    for key, value in fields.items():
+        assert value in data[key]
 
 
 def test_run_two_ranks_writes_results(tmp_path):
@@ -138,6 +224,7 @@ def test_run_two_ranks_writes_results(tmp_path):
     assert "peak pressure p0" in res.stdout and "ParaView: " in res.stdout
     data = json.loads((tmp_path / "run.json").read_text())
     assert data["status"] == "completed" and data["ranks"] == 2
+    assert "stage" not in data  # a failed run's key only
     assert data["petsc_options"] == {"snes_monitor": "None"}
     for key in ("mesh", "compile", "assembly", "solve"):
         assert data["timings"][key] >= 0.0

@@ -3,22 +3,19 @@
 from __future__ import annotations
 
 import dataclasses
-import sys
 from pathlib import Path
 
 from contactfx.cli.args import Parser, add_options
 from contactfx.contact.registry import method_class
-from contactfx.io.provenance import versions, write_json
+from contactfx.driver.pipeline import write_failed
 from contactfx.numerics import Numerics
 from contactfx.results import RunSummary
 from contactfx.scenes import SCENES, get_scene
-from contactfx.solvers.snes import ConvergenceError
 
 __all__ = [
     "cmd_list",
     "cmd_run",
     "table",
-    "write_failed",
     "print_outputs",
     "scene_parser",
     "fields_of",
@@ -157,18 +154,19 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
     if comm.rank != 0 and ("-h" in argv or "--help" in argv):
         return 0
     ns = vars(scene_parser(scene_cls).parse_args(argv[1:]))
-    scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
-    numerics = Numerics(**fields_of(Numerics, ns))
+    try:
+        scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
+        numerics = Numerics(**fields_of(Numerics, ns))
+    except ValueError as error:
+        if ns["out"] is not None:
+            write_failed(ns["out"], error, "input", comm, scene=scene_cls.name)
+        raise
     if comm.rank == 0 and not ns["quiet"]:
         print(f"contactfx: {scene.name}, method {numerics.method}, {comm.size} rank(s)", flush=True)
-    try:
-        res = scene.run(
-            numerics, comm=comm, out=ns["out"], petsc_options=petsc_options, verbose=not ns["quiet"]
-        )
-    except ConvergenceError:
-        if ns["out"] is not None:
-            write_failed(ns["out"], scene, numerics, sys.exc_info()[1], comm)
-        raise
+    # a failure from here on writes run.json marked failed (contactfx.driver.pipeline.run)
+    res = scene.run(
+        numerics, comm=comm, out=ns["out"], petsc_options=petsc_options, verbose=not ns["quiet"]
+    )
     if comm.rank == 0:
         print(table(res))
         print_outputs(res)
@@ -182,20 +180,3 @@ def print_outputs(res: RunSummary) -> None:
         if res.paraview_surface:
             print(f"  surface:  {res.paraview_surface}")
         print(f"  summary:  {Path(res.paraview).parent / 'run.json'}")
-
-
-def write_failed(out: Path, scene, numerics, error: Exception, comm) -> None:
-    """run.json marked failed, with the error: no half-written result presented as complete."""
-    data = {
-        "status": "failed",
-        "error": str(error),
-        "scene": scene.name,
-        "parameters": dataclasses.asdict(scene.p),
-        "numerics": dataclasses.asdict(numerics),
-        "versions": versions(),
-        "ranks": comm.size,
-    }
-    try:
-        write_json(Path(out) / "run.json", data, comm)
-    except OSError:
-        pass

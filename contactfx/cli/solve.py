@@ -5,13 +5,12 @@ from __future__ import annotations
 
 import csv
 import dataclasses
-import sys
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import print_outputs, table, write_failed
+from contactfx.cli.run import print_outputs, table
+from contactfx.driver.pipeline import write_failed
 from contactfx.scenes.problem_file import load_problem
-from contactfx.solvers.snes import ConvergenceError
 
 __all__ = ["cmd_solve", "cmd_check"]
 
@@ -44,7 +43,12 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
     )
     parser.add_argument("--quiet", action="store_true", help="no progress output")
     ns = parser.parse_args(argv)
-    scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
+    try:
+        scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
+    except ValueError as error:
+        if ns.out is not None:  # else the folder is named by the file's title
+            write_failed(ns.out, error, "input", comm, problem=str(ns.problem))
+        raise
     out = ns.out if ns.out is not None else ns.problem.parent / "results" / scene.name
     options = {**file_petsc, **petsc_options}
     if comm.rank == 0 and not ns.quiet:
@@ -53,11 +57,8 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
             f"{comm.size} rank(s)",
             flush=True,
         )
-    try:
-        res = scene.run(numerics, comm=comm, out=out, petsc_options=options, verbose=not ns.quiet)
-    except ConvergenceError:
-        write_failed(out, scene, numerics, sys.exc_info()[1], comm)
-        raise
+    # a failure from here on writes run.json marked failed (contactfx.driver.pipeline.run)
+    res = scene.run(numerics, comm=comm, out=out, petsc_options=options, verbose=not ns.quiet)
     written = _write_reactions(scene, out, comm)
     if comm.rank == 0:
         print(table(res))

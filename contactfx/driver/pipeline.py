@@ -22,16 +22,16 @@ from mpi4py import MPI
 from contactfx.contact.registry import methods_supporting
 from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.io.process import peak_memory_mib, reset_peak_memory
-from contactfx.io.provenance import versions, write_json
+from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog
-from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES
+from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, ConvergenceError
 from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 
 if TYPE_CHECKING:
     from contactfx.driver.problem import Forms, Method, Numerics, Problem, Scene, Solver
 
-__all__ = ["run", "setup", "prepare_output"]
+__all__ = ["STAGES", "run", "setup", "prepare_output", "write_failed"]
 
 
 def run(
@@ -49,18 +49,73 @@ def run(
     problem kind does not support (before any collective), ConvergenceError when the solve
     fails, TimeLimitExceeded when the solves run past ``time_limit`` seconds of wall time
     from the start of the first (checked collectively at every residual)."""
-    method = _checked_method(scene, numerics)
-    run_ = _Run(
-        scene,
-        numerics,
-        method,
-        comm,
-        None if out is None else Path(out),
-        dict(petsc_options or {}),
-        verbose,
-        time_limit=time_limit,
-    )
-    return run_.execute()
+    folder = None if out is None else Path(out)
+    run_: _Run | None = None
+    try:
+        method = _checked_method(scene, numerics)
+        run_ = _Run(
+            scene,
+            numerics,
+            method,
+            comm,
+            folder,
+            dict(petsc_options or {}),
+            verbose,
+            time_limit=time_limit,
+        )
+        return run_.execute()
+    except Exception as error:
+        if folder is not None:
+            stage = "input" if run_ is None else run_.stage
+            write_failed(folder, error, stage, comm, scene=scene, numerics=numerics)
+        raise
+
+
+#: the stages a run.json of a failed run names: the request and its input, the mesh, the
+#: set-up (unknowns, surfaces, forms, solver, the start and its geometry checks), the solve
+STAGES = ("input", "mesh", "set-up", "solve")
+
+
+def write_failed(
+    out: Path,
+    error: BaseException,
+    stage: str,
+    comm: MPI.Comm,
+    *,
+    scene: Scene | str | None = None,
+    numerics: Numerics | None = None,
+    **fields: Any,
+) -> None:
+    """run.json marked failed: the ``stage`` the run failed in (:data:`STAGES`), the error's
+    line, and what is known of the run (the scene, its parameters and numerics; the scene's
+    name alone when its parameters were refused; the ``fields`` given, e.g. the problem
+    file), so that no earlier result stays presented as this run's. No collective: an error
+    every rank raises alike (ValueError, OSError, ConvergenceError: the contract of the
+    pipeline) is written by rank 0; any other error by the rank it happened on (it may be on
+    that rank only, and the job is then aborted). An unwritable folder is passed over (the
+    error is reported anyway)."""
+    collective = isinstance(error, ValueError | OSError | ConvergenceError)
+    if collective and comm.rank != 0:
+        return
+    line = " ".join(str(error).split())
+    data: dict[str, Any] = {
+        "status": "failed",
+        "stage": stage,
+        "error": line if collective else f"{type(error).__name__}: {line}",
+    }
+    if isinstance(scene, str):  # its name: the parameters were refused
+        data["scene"] = scene
+    elif scene is not None:
+        data.update(scene=scene.name, parameters=dataclasses.asdict(scene.p))
+    if numerics is not None:
+        data["numerics"] = dataclasses.asdict(numerics)
+    data.update(fields)
+    data.update(versions=versions(), ranks=comm.size)
+    try:
+        Path(out).mkdir(parents=True, exist_ok=True)
+        write_json_local(Path(out) / "run.json", data)
+    except (OSError, TypeError, ValueError):
+        pass
 
 
 def setup(scene: Scene, numerics: Numerics, comm: MPI.Comm = MPI.COMM_WORLD) -> Problem:
@@ -150,6 +205,8 @@ class _Run:
         #: seconds of wall time the solves may take, or None (see run)
         self.time_limit: float | None = time_limit
         self.deadline: float | None = None
+        #: the stage the run is in (STAGES): a failure's run.json names it
+        self.stage = "input"
 
     @contextmanager
     def timed(self, phase: str) -> Iterator[None]:
@@ -168,6 +225,7 @@ class _Run:
         if self.out is not None:
             prepare_output(self.out, self.comm)
         problem, post, solver = self.build()
+        self.stage = "solve"
         try:
             steps = self.load_program(problem, solver, post)
             extra = post.finish(steps[-1].quantities, self.out)
@@ -179,8 +237,10 @@ class _Run:
         """(problem, post-processor, solver): the stages up to the load program. With
         ``--nested N``, the solver is started at every step by the chain of N coarser meshes
         (built here; their mesh and compile times count in this run's)."""
+        self.stage = "mesh"
         with self.timed("mesh"):
             mesh, facet_tags = self.scene.build_mesh(self.comm)
+        self.stage = "set-up"
         problem = self.scene.problem(self.scene, self.num, self.method, mesh, facet_tags)
         with self.timed("compile"):
             forms = problem.forms()

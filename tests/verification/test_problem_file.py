@@ -4,6 +4,7 @@ the file and the key."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 from types import SimpleNamespace
@@ -361,7 +362,10 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
     assert main(["solve", str(bad), "--out", str(tmp_path / "bad")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no physical group 'base'" in err[0]
-    assert not (tmp_path / "bad" / "run.json").exists()
+    # the groups are checked when the mesh is read: the run failed at that stage, and says so
+    data = json.loads((tmp_path / "bad" / "run.json").read_text())
+    assert data["status"] == "failed" and data["stage"] == "mesh"
+    assert "no physical group 'base'" in data["error"]
 
 
 @pytest.mark.parametrize(
