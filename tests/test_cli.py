@@ -30,6 +30,30 @@ def test_scene_help():
     assert "--radius" in res.stdout and "--refine-radius" in res.stdout
 
 
+def test_method_choices_in_help_and_list():
+    """Every option with choices lists them (params.option_help), --method first of all."""
+    from contactfx.contact.registry import METHODS
+
+    methods = "one of " + ", ".join(METHODS)
+    res = run_cli("run", "hertz2d", "--help")
+    assert res.returncode == 0
+    assert methods in " ".join(res.stdout.split())  # argparse wraps the help
+    assert "one of lu, gamg" in " ".join(res.stdout.split())
+    listed = run_cli("list")
+    method_rows = [line for line in listed.stdout.splitlines() if "--method " in line]
+    assert method_rows and all(methods in line for line in method_rows)
+
+
+def test_quiet_prints_one_line(tmp_path):
+    res = run_cli("run", "hertz2d", *FAST, "--quiet", "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert len(lines) == 1, res.stdout
+    data = json.loads((tmp_path / "run.json").read_text())
+    assert lines[0].startswith("hertz2d, nitsche P1: force ")
+    assert f"force {data['force']:.6g}," in lines[0] and f"run.json in {tmp_path}" in lines[0]
+
+
 BAD = [
     (["run", "nosuch"], "unknown scene 'nosuch'"),
     (["run", "hertz2d", "--method", "magic"], "--method must be one of"),

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import print_outputs, table, write_failed
+from contactfx.cli.run import QUIET_HELP, one_line, print_outputs, table, write_failed
 from contactfx.scenes.problem_file import load_problem
 from contactfx.solvers.snes import ConvergenceError
 
@@ -42,7 +42,7 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         default=None,
         help="output folder (default: results/<title> beside the file)",
     )
-    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     ns = parser.parse_args(argv)
     scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
     out = ns.out if ns.out is not None else ns.problem.parent / "results" / scene.name
@@ -59,7 +59,9 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         write_failed(out, scene, numerics, sys.exc_info()[1], comm)
         raise
     written = _write_reactions(scene, out, comm)
-    if comm.rank == 0:
+    if comm.rank == 0 and ns.quiet:
+        print(one_line(res))
+    elif comm.rank == 0:
         print(table(res))
         if res.interface is not None:
             for key, value in res.interface.extra.items():
