@@ -44,6 +44,24 @@ def test_method_choices_in_help_and_list():
     assert method_rows and all(methods in line for line in method_rows)
 
 
+@pytest.mark.parametrize("args", [["check", "demos/problems/holed-pad.toml"], ["list"]])
+def test_closed_pipe_ends_quietly(args):
+    """`contactfx check FILE | head` after head has gone: the reader's end of the pipe closed
+    before the first write (PETSc's SIGPIPE handler aborted MPI with a "Broken Pipe" banner)."""
+    root = Path(__file__).parents[1]
+    proc = subprocess.Popen(
+        contactfx_cmd(*args),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=clean_env(),
+        cwd=root,
+    )
+    proc.stdout.close()  # type: ignore[union-attr]
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err.decode()
+    assert not err.strip(), err.decode()
+
+
 def test_quiet_prints_one_line(tmp_path):
     res = run_cli("run", "hertz2d", *FAST, "--quiet", "--out", str(tmp_path))
     assert res.returncode == 0, res.stderr
