@@ -62,6 +62,23 @@ def test_closed_pipe_ends_quietly(args):
     assert not err.strip(), err.decode()
 
 
+@pytest.mark.parametrize(
+    "method, largest",
+    [("penalty", 1e-10), ("nitsche --theta 0", 1e-10), ("nitsche", 1e-2), ("mortar", 1e-10)],
+)
+def test_tangential_nodal_force_of_every_two_body_method(tmp_path, method, largest):
+    """Frictionless contact on patch-test's flat interface transmits no tangential nodal force
+    (the closed form: zero, to the solver's tolerance), whatever the method; Nitsche theta = 1
+    only through its consistency term's sigma_n(v) (was nan for Nitsche and penalty)."""
+    res = run_cli("run", "patch-test", "--method", *method.split(), "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    assert "nan" not in res.stdout
+    value = json.loads((tmp_path / "run.json").read_text())["scores"]["tangential_nodal_force"]
+    assert 0.0 <= value < largest
+    if method == "nitsche":
+        assert value > 1e-4  # the theta term, not round-off: theta = 0 above is
+
+
 def test_quiet_prints_one_line(tmp_path):
     res = run_cli("run", "hertz2d", *FAST, "--quiet", "--out", str(tmp_path))
     assert res.returncode == 0, res.stderr
