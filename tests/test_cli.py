@@ -79,6 +79,21 @@ def test_tangential_nodal_force_of_every_two_body_method(tmp_path, method, large
         assert value > 1e-4  # the theta term, not round-off: theta = 0 above is
 
 
+def test_locking_hint_names_the_cause_and_the_fix():
+    """nu = 0.4999999 in P1 displacements: a failed solve (cut short by -snes_max_it 2, cheap)
+    names locking and the options that cure it; not for P2 or nu <= 0.49."""
+    from contactfx.mechanics.elasticity import locking_hint
+
+    res = run_cli("run", "hertz2d", *FAST, "--nu", "0.4999999", "--", "-snes_max_it", "2")
+    assert res.returncode != 0
+    assert "DIVERGED_MAX_IT" in res.stderr and "locks" in res.stderr
+    assert "--formulation mixed-up --degree 2" in res.stderr
+    assert locking_hint(0.4999999, 2, "displacement") == ""
+    assert locking_hint(0.49, 1, "displacement") == ""
+    assert locking_hint(0.4999, 2, "mixed-up") == ""
+    assert locking_hint(None, 1, "displacement") == ""
+
+
 def test_quiet_prints_one_line(tmp_path):
     res = run_cli("run", "hertz2d", *FAST, "--quiet", "--out", str(tmp_path))
     assert res.returncode == 0, res.stderr
