@@ -15,6 +15,8 @@ import numpy as np
 import ufl
 from petsc4py import PETSc
 
+from contactfx import jit_cache
+
 __all__ = [
     "function_space",
     "petsc_vec",
@@ -45,6 +47,9 @@ __all__ = [
 ]
 
 _NEW = tuple(int(p) for p in dolfinx.__version__.split(".")[:2]) >= (0, 8)
+
+# concurrent runs wait for each other's compiles of the same forms (contactfx/jit_cache.py)
+jit_cache.install()
 
 
 def function_space(mesh, family: str, degree: int, shape: tuple[int, ...] | None = None):

@@ -9,7 +9,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["param", "validate", "Params", "option_name"]
+__all__ = ["param", "validate", "Params", "option_name", "option_help"]
 
 
 def param(
@@ -37,6 +37,16 @@ def param(
 def option_name(f: dataclasses.Field) -> str:
     """The option name of a field made with :func:`param`."""
     return f.metadata.get("option") or f.name
+
+
+def option_help(f: dataclasses.Field) -> str:
+    """The help text of a field made with :func:`param`, its choices appended (``--help`` and
+    ``contactfx list``: ``enforcement method; one of nitsche, penalty, ...``)."""
+    text = f.metadata.get("help", "")
+    choices = f.metadata.get("choices")
+    if choices is not None and len(choices) > 1:
+        text += "; one of " + ", ".join(str(c) for c in choices)
+    return text
 
 
 def validate(obj) -> None:

@@ -30,6 +30,80 @@ def test_scene_help():
     assert "--radius" in res.stdout and "--refine-radius" in res.stdout
 
 
+def test_method_choices_in_help_and_list():
+    """Every option with choices lists them (params.option_help), --method first of all."""
+    from contactfx.contact.registry import METHODS
+
+    methods = "one of " + ", ".join(METHODS)
+    res = run_cli("run", "hertz2d", "--help")
+    assert res.returncode == 0
+    assert methods in " ".join(res.stdout.split())  # argparse wraps the help
+    assert "one of lu, gamg" in " ".join(res.stdout.split())
+    listed = run_cli("list")
+    method_rows = [line for line in listed.stdout.splitlines() if "--method " in line]
+    assert method_rows and all(methods in line for line in method_rows)
+
+
+@pytest.mark.parametrize("args", [["check", "demos/problems/holed-pad.toml"], ["list"]])
+def test_closed_pipe_ends_quietly(args):
+    """`contactfx check FILE | head` after head has gone: the reader's end of the pipe closed
+    before the first write (PETSc's SIGPIPE handler aborted MPI with a "Broken Pipe" banner)."""
+    root = Path(__file__).parents[1]
+    proc = subprocess.Popen(
+        contactfx_cmd(*args),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=clean_env(),
+        cwd=root,
+    )
+    proc.stdout.close()  # type: ignore[union-attr]
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err.decode()
+    assert not err.strip(), err.decode()
+
+
+@pytest.mark.parametrize(
+    "method, largest",
+    [("penalty", 1e-10), ("nitsche --theta 0", 1e-10), ("nitsche", 1e-2), ("mortar", 1e-10)],
+)
+def test_tangential_nodal_force_of_every_two_body_method(tmp_path, method, largest):
+    """Frictionless contact on patch-test's flat interface transmits no tangential nodal force
+    (the closed form: zero, to the solver's tolerance), whatever the method; Nitsche theta = 1
+    only through its consistency term's sigma_n(v) (was nan for Nitsche and penalty)."""
+    res = run_cli("run", "patch-test", "--method", *method.split(), "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    assert "nan" not in res.stdout
+    value = json.loads((tmp_path / "run.json").read_text())["scores"]["tangential_nodal_force"]
+    assert 0.0 <= value < largest
+    if method == "nitsche":
+        assert value > 1e-4  # the theta term, not round-off: theta = 0 above is
+
+
+def test_locking_hint_names_the_cause_and_the_fix():
+    """nu = 0.4999999 in P1 displacements: a failed solve (cut short by -snes_max_it 2, cheap)
+    names locking and the options that cure it; not for P2 or nu <= 0.49."""
+    from contactfx.mechanics.elasticity import locking_hint
+
+    res = run_cli("run", "hertz2d", *FAST, "--nu", "0.4999999", "--", "-snes_max_it", "2")
+    assert res.returncode != 0
+    assert "DIVERGED_MAX_IT" in res.stderr and "locks" in res.stderr
+    assert "--formulation mixed-up --degree 2" in res.stderr
+    assert locking_hint(0.4999999, 2, "displacement") == ""
+    assert locking_hint(0.49, 1, "displacement") == ""
+    assert locking_hint(0.4999, 2, "mixed-up") == ""
+    assert locking_hint(None, 1, "displacement") == ""
+
+
+def test_quiet_prints_one_line(tmp_path):
+    res = run_cli("run", "hertz2d", *FAST, "--quiet", "--out", str(tmp_path))
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert len(lines) == 1, res.stdout
+    data = json.loads((tmp_path / "run.json").read_text())
+    assert lines[0].startswith("hertz2d, nitsche P1: force ")
+    assert f"force {data['force']:.6g}," in lines[0] and f"run.json in {tmp_path}" in lines[0]
+
+
 BAD = [
     (["run", "nosuch"], "unknown scene 'nosuch'"),
     (["run", "hertz2d", "--method", "magic"], "--method must be one of"),

@@ -9,6 +9,8 @@ Errors are one line on rank 0 and a non-zero exit status on every rank.
 from __future__ import annotations
 
 import logging
+import os
+import signal
 import sys
 
 from contactfx.cli.args import petsc_dict, split_petsc
@@ -75,7 +77,37 @@ def _quiet_compiler() -> None:
         root.addFilter(_below_warning_on_root)
 
 
+def _python_sigpipe() -> None:
+    """A closed pipe (``contactfx check FILE | head``) raises BrokenPipeError in Python, as
+    without PETSc. PETSc's initialisation installs its signal handler for every signal, also
+    SIGPIPE (which Python ignores, so that a write to a closed pipe raises): that handler prints
+    a "Caught signal number 13 Broken Pipe" banner and aborts MPI. SIGPIPE alone goes back to
+    Python's setting; PETSc keeps its handler for the others (SIGSEGV, SIGFPE, ...)."""
+    from petsc4py import PETSc  # noqa: F401  (initialises PETSc: its handlers are installed)
+
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+
+
+def _closed_stdout() -> int:
+    """The reader of our output went away (``| head``): end quietly. Python would report the
+    failed flush of the rest at exit; stdout goes to /dev/null instead."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
+    try:
+        status = _main(argv)
+        sys.stdout.flush()  # a closed pipe is found here, not at the interpreter's exit
+        return status
+    except BrokenPipeError:
+        return _closed_stdout()
+
+
+def _main(argv: list[str] | None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     _quiet_compiler()
     argv, petsc_args = split_petsc(argv)
@@ -83,6 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     import petsc4py
 
     petsc4py.init([sys.argv[0], *petsc_args])
+    _python_sigpipe()
     from mpi4py import MPI
 
     comm = MPI.COMM_WORLD
@@ -93,6 +126,8 @@ def main(argv: list[str] | None = None) -> int:
                 print(USAGE)
             return 0 if argv else 2
         return _dispatch(argv[0], argv[1:], petsc_options, comm)
+    except BrokenPipeError:
+        raise
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2, message printed)
         return int(exc.code or 0)
     except Exception as exc:  # every error becomes one line and a status

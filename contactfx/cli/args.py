@@ -8,7 +8,7 @@ import dataclasses
 import sys
 import time
 
-from contactfx.params import option_name
+from contactfx.params import option_help, option_name
 
 __all__ = [
     "Parser",
@@ -104,7 +104,7 @@ def add_options(parser, cls, defaults: dict) -> None:
             type=kind,
             default=default,
             metavar=kind.__name__.upper(),
-            help=f"{f.metadata.get('help', '')} (default: {default})",
+            help=f"{option_help(f)} (default: {default})",
         )
 
 

@@ -9,6 +9,7 @@ from contactfx.cli.args import Parser, add_options
 from contactfx.contact.registry import method_class
 from contactfx.driver.pipeline import write_failed
 from contactfx.numerics import Numerics
+from contactfx.params import option_help
 from contactfx.results import RunSummary
 from contactfx.scenes import SCENES, get_scene
 
@@ -19,7 +20,12 @@ __all__ = [
     "print_outputs",
     "scene_parser",
     "fields_of",
+    "one_line",
+    "QUIET_HELP",
 ]
+
+
+QUIET_HELP = "print one line, the result (no progress, no summary table)"
 
 
 def scene_parser(scene_cls, command: str = "run") -> Parser:
@@ -31,7 +37,7 @@ def scene_parser(scene_cls, command: str = "run") -> Parser:
     add_options(parser.add_argument_group("scene parameters"), scene_cls.Params, {})
     add_options(parser.add_argument_group("numerics"), Numerics, scene_cls.numerics_defaults)
     parser.add_argument("--out", type=Path, default=None, help="output folder (ParaView, run.json)")
-    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     return parser
 
 
@@ -42,7 +48,7 @@ def fields_of(cls, values: dict) -> dict:
 def cmd_list() -> int:
     def options(cls):
         for f in dataclasses.fields(cls):
-            print(f"    --{f.name.replace('_', '-'):22s} {f.default!s:10s} {f.metadata['help']}")
+            print(f"    --{f.name.replace('_', '-'):22s} {f.default!s:10s} {option_help(f)}")
 
     for name, cls in SCENES.items():
         print(f"{name:12s} {cls.summary}")
@@ -168,9 +174,36 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
         numerics, comm=comm, out=ns["out"], petsc_options=petsc_options, verbose=not ns["quiet"]
     )
     if comm.rank == 0:
-        print(table(res))
-        print_outputs(res)
+        if ns["quiet"]:
+            print(one_line(res))
+        else:
+            print(table(res))
+            print_outputs(res)
     return 0
+
+
+def one_line(res: RunSummary) -> str:
+    """The result in one line (``--quiet``): the scene, the method, the force, the contact size
+    and peak pressure (with their closed forms where known), the steps and where run.json is."""
+    num, ref = res.numerics, res.reference
+    kind = "P2/P1 mixed u-p" if num["formulation"] == "mixed-up" else f"P{num['degree']}"
+    parts = [f"{res.scene}, {num['method']} {kind}: force {res.force:.6g}"]
+    if res.interface is not None:
+        parts.append(f"tangential force {res.interface.tangential_force:.6g}")
+        parts.append(f"closed size {res.contact_size:.6g}")
+    else:
+        if "a" in ref:
+            parts.append(f"a {ref['a_computed']:.6g} (ref {ref['a']:.6g})")
+        else:
+            parts.append(f"contact size {res.contact_size:.6g}")
+        if "p0" in ref:
+            parts.append(f"p0 {ref['p0_computed']:.6g} (ref {ref['p0']:.6g})")
+        else:
+            parts.append(f"peak pressure {res.peak_pressure:.6g}")
+    parts.append(f"{len(res.steps)} steps, {res.newton_iterations} Newton")
+    if res.paraview:
+        parts.append(f"run.json in {Path(res.paraview).parent}")
+    return ", ".join(parts)
 
 
 def print_outputs(res: RunSummary) -> None:

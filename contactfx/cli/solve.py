@@ -8,7 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import print_outputs, table
+from contactfx.cli.run import QUIET_HELP, one_line, print_outputs, table
 from contactfx.driver.pipeline import write_failed
 from contactfx.scenes.problem_file import load_problem
 
@@ -41,7 +41,7 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         default=None,
         help="output folder (default: results/<title> beside the file)",
     )
-    parser.add_argument("--quiet", action="store_true", help="no progress output")
+    parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     ns = parser.parse_args(argv)
     try:
         scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
@@ -60,7 +60,9 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
     # a failure from here on writes run.json marked failed (contactfx.driver.pipeline.run)
     res = scene.run(numerics, comm=comm, out=out, petsc_options=options, verbose=not ns.quiet)
     written = _write_reactions(scene, out, comm)
-    if comm.rank == 0:
+    if comm.rank == 0 and ns.quiet:
+        print(one_line(res))
+    elif comm.rank == 0:
         print(table(res))
         if res.interface is not None:
             for key, value in res.interface.extra.items():

@@ -63,11 +63,13 @@ class PairCoupling(Coupling, Protocol):
     the last converged solve: ``nodal()`` (the slave contact nodes, their weights, pressure
     and gap), ``nodal_friction()`` and ``friction_state()`` (with friction), ``force()`` (the
     total normal force), ``slave_force()`` (the force vector on the slave body) and
-    ``search_gaps()`` (the gaps the last search measured); a coupling with nodal normals
-    (mortar) has them as ``normal``. ``converged()`` is called when a load step converged (a
+    ``search_gaps()`` (the gaps the last search measured) and ``nodal_normals()`` (a unit
+    normal per node of ``nodal()``). ``converged()`` is called when a load step converged (a
     coupling that keeps a history, penalty friction's, moves it on)."""
 
     def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def nodal_normals(self) -> np.ndarray: ...
 
     def converged(self) -> None: ...
 

@@ -744,6 +744,11 @@ class MortarCoupling:
         would depend on whether the last search was at the start or the end of a step)."""
         return self.nodes, self.D0, self.D * self.lam / self.D0, self.gap
 
+    def nodal_normals(self) -> np.ndarray:
+        """The unit normal n_j of each node of :meth:`nodal` (the weighted mean of the slave
+        facets' normals over its support, the one its multiplier acts along)."""
+        return self.normal
+
 
 def _owned_matrix(
     lay: NodeLayout, rows: np.ndarray, cols: np.ndarray, vals: np.ndarray

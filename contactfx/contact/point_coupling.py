@@ -927,6 +927,15 @@ class PointCoupling:
         D = sums[:, 0]
         return np.flatnonzero(on) + self.layout.start, D, sums[:, 2] / D, sums[:, 3] / sums[:, 1]
 
+    def nodal_normals(self) -> np.ndarray:
+        """The unit normal of each node of :meth:`nodal`: the contact normal of the Gauss
+        points (the one their traction -P n acts along) lumped like the pressure (weights
+        N_j w), normalised."""
+        n = self.points[0]["n"]
+        _, sums = self._lumped([n[:, i] for i in range(n.shape[1])])
+        mean = sums[:, 2:]
+        return mean / np.linalg.norm(mean, axis=1)[:, None]
+
     def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per node of :meth:`nodal`: |t_T|, |slip increment of the step| and the stick
         indicator (the fraction of the node's support in stick), lumped like the pressure."""

@@ -38,6 +38,7 @@ from contactfx.driver.fields import (
 )
 from contactfx.driver.inversion import VolumeRatio
 from contactfx.mechanics.axisymmetric import hoop_strain, measure
+from contactfx.mechanics.elasticity import locking_hint
 from contactfx.solvers.bulk import Bulk, LinearBulk, NonlinearBulk
 from contactfx.solvers.snes import owned_bc_dofs, owned_size
 
@@ -250,15 +251,28 @@ class Problem:
         """What the state shows after a failed solve (collective): with a finite-strain
         material the smallest volume ratio J = det F over the cells' sample points
         (:attr:`volume_ratio`) and the midpoint of its cell, when an element has inverted
-        (J <= 0); else ""."""
+        (J <= 0); with a near-incompressible body in P1 displacements the locking hint
+        (:func:`contactfx.mechanics.elasticity.locking_hint`); else ""."""
+        hint = locking_hint(self.largest_nu(), self.num.degree, self.num.formulation)
         if not self.material.finite_strain:
-            return ""
+            return hint
         j_min, where = self.volume_ratio.smallest(_compat.petsc_vec(self.state))
         if not j_min <= 0.0:
-            return ""
+            return hint
         at = ", ".join(f"{x:.4g}" for x in where[: self.gdim])
         value = "not a number" if np.isinf(j_min) else f"= {j_min:.3g} <= 0"
-        return f"an element inverted (J {value}) at ({at}) in the reference mesh"
+        inverted = f"an element inverted (J {value}) at ({at}) in the reference mesh"
+        return inverted + (f"; {hint}" if hint else "")
+
+    def largest_nu(self) -> float | None:
+        """The largest Poisson's ratio of the bulk (its field's, bodies of several materials),
+        None for a material without one (collective)."""
+        nu = getattr(self.material, "nu", None)
+        field = getattr(self.material, "poisson", None)
+        if isinstance(field, dolfinx.fem.Function):
+            local = float(np.max(field.x.array, initial=-1.0))
+            nu = max(nu if nu is not None else -1.0, self.mesh.comm.allreduce(local, op=MPI.MAX))
+        return nu
 
     @property
     def multiplier_mask(self) -> NDArray[np.bool_]:

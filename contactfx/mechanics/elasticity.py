@@ -28,10 +28,28 @@ import ufl
 
 from contactfx.references import oedometric_modulus
 
-__all__ = ["Elastic", "lame", "hooke", "basis_tractions"]
+__all__ = ["Elastic", "lame", "hooke", "basis_tractions", "locking_hint", "LOCKING_NU"]
 
 #: a UFL expression (ufl has no type stubs)
 Expr = Any
+
+
+#: Poisson's ratio above which P1 displacements lock (lambda / mu = 2 nu / (1 - 2 nu) > 49)
+LOCKING_NU = 0.49
+
+
+def locking_hint(nu: float | None, degree: int, formulation: str) -> str:
+    """The likely cause of a failed solve of a near-incompressible body in P1 displacements
+    (volumetric locking: the P1 displacement cannot deform at constant volume, the bulk
+    stiffness lambda swamps the shear; Newton stalls, e.g. DIVERGED_MAX_IT) and its fix, or ""
+    when that is not the case (nu <= 0.49, P2, or the mixed u-p formulation)."""
+    if nu is None or nu <= LOCKING_NU or degree != 1 or formulation != "displacement":
+        return ""
+    return (
+        f"nu = {nu:.10g} with P1 displacements: the near-incompressible body locks; use "
+        "--formulation mixed-up --degree 2 (Taylor-Hood u-p), or at least --degree 2 "
+        "(numerics.formulation, numerics.degree in a problem file)"
+    )
 
 
 def lame(E: Any, nu: Any) -> tuple[Any, Any]:

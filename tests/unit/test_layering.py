@@ -23,7 +23,7 @@ LAYERS = [
     {"driver"},
     {"numerics"},
     {"contact", "mechanics", "solvers", "io"},
-    {"params", "results", "references", "_compat", "meshes", "__init__"},
+    {"params", "results", "references", "_compat", "jit_cache", "meshes", "__init__"},
 ]
 
 

@@ -347,7 +347,6 @@ def test_cli_check_solve_and_bad_file(tmp_path, capsys):
                 "numerics.steps=1",
                 "--out",
                 str(tmp_path / "res"),
-                "--quiet",
             ]
         )
         == 0
