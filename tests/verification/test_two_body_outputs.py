@@ -126,3 +126,26 @@ def test_unbiased_surface_on_a_concave_convex_interface(shared_tmp):
     # Hertz's half-width at the biased force, R* = 6, E* = E / (2 (1 - nu^2))
     a = np.sqrt(4.0 * biased.force * 6.0 / (np.pi * 1000.0 / (2.0 * (1.0 - 0.09))))
     assert unbiased.contact_size == pytest.approx(a, rel=0.03)
+
+
+def test_a_pair_that_never_closes_warns(shared_tmp):
+    """The roller lifted 1.0 above its seat and moved down by 0.005: the run completes with a
+    zero force, and says why in run.json's ``warnings`` and in the printed summary; a run
+    that closes has ``warnings: []``."""
+    import json
+
+    from contactfx.cli.run import table
+
+    path = _seat(shared_tmp, lift=1.0)
+    out = shared_tmp / "out"
+    _, res = _run(path, ["boundary.1.displacement.y=-0.005", "numerics.steps=2"], out=out)
+    assert res.force == 0.0
+    data = json.loads((out / "run.json").read_text())
+    assert data["status"] == "completed"
+    assert data["warnings"] == [
+        "the contact pair never closed: no closed point at any of the 2 load steps (contact "
+        "force 0): check the geometry and the load"
+    ]
+    assert "  warning " in table(res) and data["warnings"][0] in table(res)
+    _, closed = _run(_seat(shared_tmp))
+    assert closed.force > 0.0 and closed.to_json()["warnings"] == []
