@@ -35,7 +35,7 @@ class _General:
     quadrature: str = param(
         "gauss",
         "contact integrals of nitsche / penalty: gauss (degree "
-        "2k + 2) or nodal (at the vertices, P1 only)",
+        "2k + 2) or nodal (at the vertices, P1 only; not between two bodies)",
         choices=("gauss", "nodal"),
     )
     degree: int = param(1, "Lagrange degree of the displacement", choices=(1, 2))

@@ -17,6 +17,7 @@ from typing import Any
 
 __all__ = [
     "StepLog",
+    "never_closed",
     "Friction",
     "InterfaceQuantities",
     "Quantities",
@@ -196,6 +197,9 @@ class RunSummary:
     #: peak resident memory of the run's processes during the run (MiB, summed over the
     #: ranks; on Linux, else each process's peak so far)
     memory_mib: float = 0.0
+    #: what the run's numbers do not say on their own, one line each (e.g. a contact pair or
+    #: obstacle that never closed over the run); run.json's ``warnings``, [] for a run without
+    warnings: list[str] = field(default_factory=list)
 
     # -- named views of the final state ---------------------------------------------------
     @property
@@ -291,10 +295,28 @@ class RunSummary:
             reference=self.reference,
             scores=self.scores,
             errors=self.errors,
+            warnings=list(self.warnings),
         )
         if self.interface is not None or self.plot is not None:
             out["plot"] = self.plot
         return out
+
+
+def never_closed(steps: list[StepLog], what: str, gap: float | None = None) -> list[str]:
+    """The warning of a contact (``what``: "pair", "obstacle") that closed at no step of the
+    run (a zero contact force at every converged step), with the smallest gap of the last
+    step where known; [] otherwise, and for interfaces (a crack may open by design)."""
+    if not steps or any(s.quantities.interface is not None for s in steps):
+        return []
+    if any(s.quantities.force > 0.0 for s in steps):
+        return []
+    line = (
+        f"the contact {what} never closed: no closed point at any of the {len(steps)} "
+        "load steps (contact force 0)"
+    )
+    if gap is not None and math.isfinite(gap):
+        line += f"; smallest gap {gap:.3g} at the last step"
+    return [line + ": check the geometry and the load"]
 
 
 #: error measures against the closed forms: column -> (label, section, key). Bench tabulates

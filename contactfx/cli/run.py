@@ -90,6 +90,7 @@ def table(res: RunSummary) -> str:
         rows += [(k.replace("_", " "), f"{v:.6g}") for k, v in {**ref, **res.errors}.items()]
     if res.plot:
         rows.append(("line plot", res.plot))
+    rows += [("warning", w) for w in res.warnings]
     width = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)
 

@@ -432,6 +432,11 @@ class PointCoupling:
             x_search=x_search,
             N_facet=np.repeat(dr.qbary[None], m, axis=0).reshape(-1, d),
             slave_nodes=dr.slave.nodes[facet],
+            # the master facet's global nodes and the point's barycentric coordinates on it
+            # (zero off the master): the unbiased variant's second direction lumps its values
+            # to the first direction's slave nodes through them (:meth:`_lumped`)
+            master_nodes=master_nodes,
+            Nm=Nm,
             facet_nodes=np.where(paired[:, None], np.sort(master_nodes, axis=1), -1),
         )
 
@@ -899,31 +904,49 @@ class PointCoupling:
         return np.concatenate(out) if out else np.zeros(0)
 
     # -- what the post-processing reads ----------------------------------------------------
-    def _lumped(self, columns: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        """Owned contact nodes (those whose support has a master on more than half of it) and
-        the N-weighted nodal means of the first direction's point values ``columns``."""
-        p = self.points[0]
-        g = self.state[0][1]
-        Nw = p["N_facet"] * (p["w"] / self.dirs[0].weight)[:, None]
-        nodes = p["slave_nodes"].ravel()
-        paired = np.isfinite(g)
-        data = np.stack(
-            [
-                Nw.ravel(),
-                (Nw * paired[:, None]).ravel(),
-                *((Nw * c[:, None]).ravel() for c in columns),
-            ],
-            axis=1,
-        )
-        sums = self.layout.node_sum(nodes, data, 2 + len(columns))
+    def _lumped(self, columns: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+        """Owned contact nodes of the first direction's slave surface (those whose support
+        has a master on more than half of it) and the weighted nodal means of the point values
+        ``columns[k]`` of each direction k: the first direction's lumped with the slave facet's
+        shape functions; the unbiased variant's second direction (points on the other
+        surface, its pressure the same interface's) carried to the slave nodes by the
+        barycentric coordinates of the points' projections onto the slave facets, so that the
+        nodal value is the mean of both sides' laws, weighted by their halves (a side may hold
+        the whole contact alone: on a concave-convex interface the polygons of the convex
+        side's points stay apart from the concave one, the concave side's points close)."""
+        blocks = []
+        for k, (p, dr) in enumerate(zip(self.points, self.dirs, strict=True)):
+            paired = np.isfinite(self.state[k][1])
+            if k == 0:
+                N, nodes = p["N_facet"], p["slave_nodes"]
+            else:
+                N, nodes = p["Nm"], p["master_nodes"]
+            # the biased variant's weights as they are; the unbiased one's halves
+            Nw = N * (p["w"] / (dr.weight if len(self.dirs) == 1 else 1.0))[:, None]
+            blocks.append(
+                np.stack(
+                    [
+                        Nw.ravel(),
+                        (Nw * paired[:, None]).ravel(),
+                        *((Nw * c[:, None]).ravel() for c in columns[k]),
+                    ],
+                    axis=1,
+                )
+            )
+            blocks[-1] = (nodes.ravel(), blocks[-1])
+        nodes = np.concatenate([b[0] for b in blocks])
+        data = np.concatenate([b[1] for b in blocks])
+        sums = self.layout.node_sum(nodes, data, 2 + len(columns[0]))
         on = (sums[:, 0] > 0.0) & (sums[:, 1] > 0.5 * sums[:, 0])
         return on, sums[on]
 
     def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
-        quadrature values lumped to the nodes of the first direction's slave surface."""
-        P, g = self.state[0][:2]
-        on, sums = self._lumped([P, np.where(np.isfinite(g), g, 0.0)])
+        quadrature values of both directions lumped to the nodes of the first direction's
+        slave surface (:meth:`_lumped`)."""
+        on, sums = self._lumped(
+            [[s[0], np.where(np.isfinite(s[1]), s[1], 0.0)] for s in self.state]
+        )
         D = sums[:, 0]
         return np.flatnonzero(on) + self.layout.start, D, sums[:, 2] / D, sums[:, 3] / sums[:, 1]
 
@@ -939,12 +962,12 @@ class PointCoupling:
     def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per node of :meth:`nodal`: |t_T|, |slip increment of the step| and the stick
         indicator (the fraction of the node's support in stick), lumped like the pressure."""
-        P, _, t, stick, slip = self.state[0]
-        assert t is not None and stick is not None and slip is not None  # with friction
-        closed_stick = (stick & (P > 0.0)).astype(float)
-        _, sums = self._lumped(
-            [np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1), closed_stick]
-        )
+        columns = []
+        for P, _, t, stick, slip in self.state:
+            assert t is not None and stick is not None and slip is not None  # with friction
+            closed_stick = (stick & (P > 0.0)).astype(float)
+            columns.append([np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1), closed_stick])
+        _, sums = self._lumped(columns)
         D = sums[:, 0]
         return sums[:, 2] / D, sums[:, 3] / D, sums[:, 4] / D > 0.5
 

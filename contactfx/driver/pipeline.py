@@ -17,6 +17,7 @@ from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from mpi4py import MPI
 
 from contactfx.contact.registry import methods_supporting
@@ -24,7 +25,7 @@ from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
-from contactfx.results import RunSummary, StepLog
+from contactfx.results import RunSummary, StepLog, never_closed
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, ConvergenceError
 from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 
@@ -391,11 +392,23 @@ class _Run:
                 else None
             ),
             memory_mib=peak_memory_mib(self.comm),
+            warnings=self.warnings(problem, steps),
             **extra,
         )
         if self.out is not None:
             write_json(self.out / "run.json", summary.to_json(), self.comm)
         return summary
+
+    def warnings(self, problem: Problem, steps: list[StepLog]) -> list[str]:
+        """run.json's ``warnings``: a contact pair or obstacle that never closed (with the
+        pair's smallest gap at the last search). Collective."""
+        pair = getattr(problem, "pair", None) is not None
+        coupling = problem.coupling() if pair else None
+        gap = None
+        if coupling is not None and hasattr(coupling, "search_gaps"):
+            local = float(np.min(coupling.search_gaps(), initial=np.inf))
+            gap = self.comm.allreduce(local, op=MPI.MIN)
+        return never_closed(steps, "pair" if pair else "obstacle", gap)
 
 
 def _progress(step: StepLog, outer: bool) -> str:

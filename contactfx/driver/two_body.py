@@ -104,6 +104,14 @@ class TwoBodyProblem(Problem):
             raise ValueError("two-body contact is implemented for P1 (--degree 1) only")
         if numerics.formulation != "displacement":
             raise ValueError("two-body contact uses --formulation displacement")
+        if numerics.quadrature != "gauss":
+            # the vertex rule was measured to make it worse: node-to-segment gaps see the
+            # master polygon's kinks (docs/verification.md, two bodies)
+            raise ValueError(
+                f"--quadrature {numerics.quadrature} is not offered between two meshed bodies "
+                "(at the slave vertices the pressure follows the master polygon's kinks and "
+                "oscillates more than at Gauss points); use --quadrature gauss"
+            )
         if numerics.friction != "none" and not method.supports.two_body_friction:
             raise _not_offered(
                 method,
