@@ -93,8 +93,15 @@ import numpy as np
 from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
-from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
-from contactfx.contact.projection import Pick, gauss_segment, gauss_triangle, pick_closest
+from contactfx.contact.pair import Facets, Side, facet_normals, facet_order, facet_rim
+from contactfx.contact.projection import (
+    TOL,
+    Pick,
+    closest_point_facets,
+    gauss_segment,
+    gauss_triangle,
+    pick_closest,
+)
 from contactfx.mechanics.elasticity import basis_tractions
 from contactfx.mechanics.piola import LINEAR, STRESS_MODELS, first_piola
 
@@ -217,6 +224,24 @@ class _Directed:
 #: how far past its edge (a fraction of its size) a point keeps its facet within a Newton
 #: solve (:meth:`PointCoupling._keep_facets`)
 KEEP_BEYOND = 0.1
+
+
+def _on_rim(closest: np.ndarray, index: np.ndarray, near: Facets) -> np.ndarray:
+    """(n,) bool: the closest points ``closest`` (n, gdim) on the master facets ``index`` (n,)
+    of ``near`` lie on the boundary of the master surface (a point beyond it, not in
+    contact): on an open edge of the facet (3D, the edge's barycentric coordinate within TOL
+    of 0) or at an open vertex (its coordinate within TOL of 1; 2D: the end of the curve).
+    The rim is that of the whole surface (:func:`contactfx.contact.pair.surface_rim`), or,
+    for facets built without it, of the ``near`` facets alone."""
+    if near.open_vertex is None or near.open_edge is None:
+        open_vertex, open_edge = facet_rim(near.nodes)
+    else:
+        open_vertex, open_edge = near.open_vertex, near.open_edge
+    # barycentric coordinates of the closest point (exact 0 and 1 at a vertex)
+    lam = closest_point_facets(closest, near.x[index]).bary
+    on_edge = (lam <= TOL) & open_edge[index]
+    at_vertex = (lam >= 1.0 - TOL) & open_vertex[index]
+    return np.any(on_edge | at_vertex, axis=1)
 
 
 def _transport(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -414,7 +439,8 @@ class PointCoupling:
             facet_nodes=np.where(paired[:, None], np.sort(master_nodes, axis=1), -1),
         )
 
-    def _project(self, xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pick:
+    @staticmethod
+    def _project(xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pick:
         """The master facet of each point (index -1: not in contact). ``kept``: (n, d)
         the sorted global nodes of each point's facet at the last search (-1: none), kept
         while the point projects inside it (:meth:`_keep_facets`)."""
@@ -447,18 +473,17 @@ class PointCoupling:
         key = None if near.X is None else facet_order(near.X)
         pick = pick_closest(xq, cand, near.x, fallback=True, key=key)
         if kept is not None:
-            self._keep_facets(xq, near, pick, kept)
+            PointCoupling._keep_facets(xq, near, pick, kept)
         off = (pick.index >= 0) & ~pick.inside
         if np.any(off):
-            # the closest point is a vertex: in contact if another master facet shares it
+            # the closest point on an edge or at a vertex of the master surface: in contact
+            # unless that is on the surface's boundary (:func:`_on_rim`)
+            beyond = _on_rim(pick.closest[off], pick.index[off], near)
             vertex = np.argmax(np.nan_to_num(pick.bary[off], nan=-1.0), axis=1)
-            node = near.nodes[pick.index[off], vertex]
-            uniq, count = np.unique(near.nodes, return_counts=True)
-            shared = count[np.searchsorted(uniq, node)] > 1
             bary = np.zeros_like(pick.bary[off])
             bary[np.arange(len(vertex)), vertex] = 1.0
             pick.bary[off] = bary
-            pick.index[np.flatnonzero(off)[~shared]] = -1
+            pick.index[np.flatnonzero(off)[beyond]] = -1
         return pick
 
     @staticmethod
