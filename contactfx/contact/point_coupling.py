@@ -26,9 +26,24 @@ derivatives are not linearised: for the closest-point projection they vanish in 
 first order (n_m is orthogonal to the master tangent and x - y is parallel to n_m), what is
 left out is the curvature (geometric) stiffness.
 
-Points whose projection falls off the master surface (no candidate facet within the search
-radius, or the closest point on an edge of the master surface that no other master facet
-shares) are not in contact.
+Points whose projection falls off the master surface are not in contact: no candidate facet
+within the search radius, or the closest point of the master surface on its boundary. A
+point that projects inside no master facet is decided by the feature of the surface its
+closest point lies on: on an edge (3D) it is in contact if two master facets share that edge
+(an interior ridge), not on a boundary edge (one facet); at a vertex, if the vertex is
+interior to the surface (2D: shared by two segments, a convex kink; the end of the curve is
+not). Every vertex of a triangulated surface is shared by several triangles, also on its
+boundary, so the vertex alone cannot tell a point at a kink from one beyond the surface's
+edge. The boundary edges and vertices are those of the whole master surface, found once by
+global node numbers (:func:`contactfx.contact.pair.surface_rim`): the master facets a rank
+gathers near its slave points may lack a facet's neighbours, and 1 and 2 ranks pair the
+same points. No tolerance beyond the 1e-10 of "inside": slave Gauss points lie inside their
+facets, so where flat slave and master surfaces end on the same plane (a symmetry plane, the
+edges of equal faces) the points project inside the master facets; the finite-strain
+hysteresis below keeps a point's facet past its edge, boundary or not. A curved master
+surface's edge on a symmetry plane counts as a boundary too (a slave point near the plane
+projecting past it is not paired; docs/verification.md section 10). A point paired off its
+facet carries its force to the facet's vertex of the largest barycentric coordinate.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
 penalty, and frictionless Nitsche as below; always searched at every Newton iteration):
