@@ -37,13 +37,16 @@ boundary, so the vertex alone cannot tell a point at a kink from one beyond the 
 edge. The boundary edges and vertices are those of the whole master surface, found once by
 global node numbers (:func:`contactfx.contact.pair.surface_rim`): the master facets a rank
 gathers near its slave points may lack a facet's neighbours, and 1 and 2 ranks pair the
-same points. No tolerance beyond the 1e-10 of "inside": slave Gauss points lie inside their
-facets, so where flat slave and master surfaces end on the same plane (a symmetry plane, the
-edges of equal faces) the points project inside the master facets; the finite-strain
-hysteresis below keeps a point's facet past its edge, boundary or not. A curved master
-surface's edge on a symmetry plane counts as a boundary too (a slave point near the plane
-projecting past it is not paired; docs/verification.md section 10). A point paired off its
-facet carries its force to the facet's vertex of the largest barycentric coordinate.
+same points. In 3D an edge of one master facet on a symmetry plane is interior, not a
+boundary (:func:`contactfx.contact.pair.mirror_edges`: both its nodes hold the displacement
+component normal to a plane they lie on, and not every component): the mirror image
+continues the surface there, and a point past it, as near a curved master's symmetry plane
+where the facets' normals tilt, is in contact (docs/verification.md section 10). No
+tolerance beyond the 1e-10 of "inside": slave Gauss points lie inside their facets, so where
+flat slave and master surfaces end on the same plane (the edges of equal faces) the points
+project inside the master facets; the finite-strain hysteresis below keeps a point's facet
+past its edge, boundary or not. A point paired off its facet carries its force to the
+facet's vertex of the largest barycentric coordinate.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
 penalty, and frictionless Nitsche as below; always searched at every Newton iteration):

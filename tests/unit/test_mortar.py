@@ -298,6 +298,65 @@ def test_surface_rim():
             assert np.array_equal(got, want[mine])
 
 
+def test_symmetry_plane_edges_not_on_the_rim():
+    """An edge of one facet on a symmetry plane (both its nodes hold the displacement
+    component normal to the plane, and lie on it) is not on the rim: the mirror image
+    continues the surface there, and a point past it is in contact. The roof's side x = 0 a
+    roller plane (u_x held); its side y = 0 holds u_x too but lies in no plane x = const (the
+    plane test: still a boundary), its side y = 1 is clamped (every component held: the
+    surface ends there), its side x = 1 free. Over the ranks the same as on one rank."""
+    from mpi4py import MPI
+
+    from contactfx.contact.pair import facet_rim, mirror_edges, surface_rim
+    from contactfx.contact.point_coupling import PointCoupling
+
+    n = 4
+    roof = _pyramid(n)
+    X = roof.X
+    held = np.zeros(X.shape, dtype=bool)
+    held[..., 0] = (X[..., 0] == 0.0) | (X[..., 1] == 0.0)
+    held[X[..., 1] == 1.0] = True
+    ends = X[np.arange(len(roof))[:, None], (np.arange(3) + 1) % 3]  # edge i from i + 1
+    others = X[np.arange(len(roof))[:, None], (np.arange(3) + 2) % 3]
+
+    def side(c: int, value: float) -> np.ndarray:
+        return (ends[..., c] == value) & (others[..., c] == value)
+
+    assert np.array_equal(mirror_edges(X, held, 1e-12), side(0, 0.0))
+    # a node of the plane moved off it by more than round-off: its two edges are not on it
+    shifted = X.copy()
+    shifted[..., 0] += np.where(X[..., 1] == 0.5, 1e-9, 0.0)
+    assert mirror_edges(shifted, held, 1e-12).sum() == side(0, 0.0).sum() - 2
+    open_vertex, open_edge = facet_rim(roof.nodes, X, held)
+    assert open_edge.sum() == 3 * n
+    assert np.array_equal(open_edge, side(0, 1.0) | side(1, 0.0) | side(1, 1.0))
+    x, y = X[..., 0], X[..., 1]
+    assert np.array_equal(open_vertex, (x == 1.0) | (y == 0.0) | (y == 1.0))
+    # without the flags every side is on the rim
+    assert facet_rim(roof.nodes)[1].sum() == 4 * n
+    comm = MPI.COMM_WORLD
+    rank = np.random.default_rng(7).integers(0, comm.size, len(roof))
+    mine = rank == comm.rank
+    parallel = surface_rim(comm, roof.nodes[mine], X[mine], held[mine])
+    for got, want in zip(parallel, (open_vertex, open_edge), strict=True):
+        assert np.array_equal(got, want[mine])
+    # past the roller plane: paired; past the other sides: not
+    roof.open_vertex, roof.open_edge = open_vertex, open_edge
+    points = np.array(
+        [
+            [-0.1, 0.3, -0.06],  # beyond the roller plane x = 0
+            [-0.1, 0.5, 0.0],  # beyond the end of the ridge y = 0.5 on the roller plane
+            [1.1, 0.3, -0.06],  # beyond the free side x = 1
+            [0.3, -0.1, 0.0],  # beyond y = 0 (u_x held, not its plane)
+            [0.3, 1.1, 0.0],  # beyond the clamped side y = 1
+            [-0.1, -0.1, -0.15],  # beyond the corner of the roller plane and y = 0
+        ]
+    )
+    pick = PointCoupling._project(points, roof)
+    assert not pick.inside.any()
+    assert list(pick.index >= 0) == [True, True, False, False, False, False]
+
+
 def test_points_beyond_the_master_rim_unpaired():
     """The point coupling's pairing off a master facet: a point whose closest point on the
     master surface is on an interior ridge or at an interior vertex (a convex kink) is in
