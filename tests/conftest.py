@@ -59,12 +59,15 @@ def run_cli(*args: str, ranks: int = 1, timeout: float = 300, cwd=None):
     )
 
 
-def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "fd_", history=None):
+def jacobian_check(
+    scene, num, displace, *, freeze: bool = True, prefix: str = "fd_", history=None, noise=1e-5
+):
     """(error(eps), coupling, solver) of a two-body scene: the relative error of J du against
     the central difference of the residual (contact terms included) at the state
     ``displace(X, upper)`` (X: the owned nodes' reference coordinates, upper: the upper body's
     nodes among them) plus noise. ``freeze``: the projection searched once at that state (else
-    the coupling's own search at every residual, as finite strain does). ``history(coupling)``
+    the coupling's own search at every residual, as finite strain does). ``noise``: the size
+    of the random displacement added to every node. ``history(coupling)``
     sets a history (penalty friction's last converged traction, gap and normal) before the
     residuals."""
     import numpy as np
@@ -91,7 +94,7 @@ def jacobian_check(scene, num, displace, *, freeze: bool = True, prefix: str = "
     upper = np.zeros(len(X), dtype=bool)
     nodes = np.asarray(nodes, dtype=np.int64)
     upper[nodes[nodes < len(X)]] = True
-    u = displace(X, upper) + 1e-5 * rng.standard_normal(X.shape)
+    u = displace(X, upper) + noise * rng.standard_normal(X.shape)
     x.getArray()[:] = u.ravel()
     x.ghostUpdate()
     solver._sync(x)

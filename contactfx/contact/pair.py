@@ -16,6 +16,16 @@ candidates per facet on a graded mesh). The cost is one
 ``alltoall`` of the facets near each rank's slave region: at 1 rank nothing is sent, at p
 ranks each master facet is sent to the ranks whose slave region it meets (usually one or
 two), never the whole surface to everybody.
+
+The rim of a surface (:func:`surface_rim`): which vertices and edges of its facets lie on the
+surface's boundary (3D: an edge of one facet only, and its end vertices; 2D: a vertex of one
+segment only), found once by global node numbers when the side is built (each facet sent to
+the ranks that own its vertices by the rule node % size, one ``alltoall`` there and back) and
+carried with the facets through the search: what tells a point beyond the master surface
+from a point at a kink of it (:mod:`contactfx.contact.point_coupling`) on any partition. In
+3D an edge of one facet on a symmetry plane is not on the rim (:func:`mirror_edges`: the
+mirror image continues the surface there); the Dirichlet flags of the facets' nodes (a
+ghost's from its owner, :func:`node_held`) travel with them in the same exchange.
 """
 
 from __future__ import annotations
@@ -43,7 +53,15 @@ __all__ = [
     "gather_near",
     "owners",
     "facet_order",
+    "facet_rim",
+    "mirror_edges",
+    "node_held",
+    "surface_rim",
 ]
+
+#: reference coordinates of the nodes of an edge on a symmetry plane: equal to this fraction
+#: of the surface's size (the bounding box's diagonal)
+PLANE_TOL = 1e-12
 
 
 @dataclass
@@ -51,11 +69,25 @@ class Facets:
     """Facets in the current configuration: ``x`` (m, d, gdim) vertex coordinates and
     ``nodes`` (m, d) global node (dof block) indices; ``X`` (m, d, gdim) the reference
     coordinates (the same bits on every partition, unlike the global indices: what orders
-    facets independently of the partition, :func:`facet_order`)."""
+    facets independently of the partition, :func:`facet_order`); ``open_vertex`` and
+    ``open_edge`` (m, d) bool the rim of the surface they belong to (:func:`surface_rim`),
+    or None (unknown)."""
 
     x: np.ndarray
     nodes: np.ndarray
     X: np.ndarray | None = None
+    open_vertex: np.ndarray | None = None
+    open_edge: np.ndarray | None = None
+
+    def subset(self, keep: np.ndarray) -> Facets:
+        """The facets selected by ``keep`` (a mask or indices), with their fields."""
+
+        def sub(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[keep]
+
+        return Facets(
+            self.x[keep], self.nodes[keep], sub(self.X), sub(self.open_vertex), sub(self.open_edge)
+        )
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -81,7 +113,8 @@ class Side:
     global indices, ``X`` (m, d, gdim): reference coordinates; ``cell`` (m,): the local cell
     of each facet, ``cell_local`` / ``cell_nodes`` (m, d + 1) its nodes (local, global) and
     ``cell_X`` (m, d + 1, gdim) their reference coordinates (the stress of the body at its
-    surface, for Nitsche)."""
+    surface, for Nitsche); ``open_vertex`` / ``open_edge`` the rim of the whole surface
+    (:func:`surface_rim`)."""
 
     tag: int
     local: np.ndarray
@@ -91,18 +124,26 @@ class Side:
     cell_local: np.ndarray
     cell_nodes: np.ndarray
     cell_X: np.ndarray
+    #: (m, d) the rim of the whole surface (:func:`surface_rim`), None: unknown
+    open_vertex: np.ndarray | None = None
+    open_edge: np.ndarray | None = None
 
     def current(self, u: np.ndarray) -> Facets:
         """The facets at x = X + u; ``u`` the local (owned + ghost) array, blocked (n, gdim)."""
-        return Facets(self.X + u[self.local], self.nodes, self.X)
+        return Facets(self.X + u[self.local], self.nodes, self.X, self.open_vertex, self.open_edge)
 
     def __len__(self) -> int:
         return len(self.local)
 
 
-def side_of(V: dolfinx.fem.FunctionSpace, facet_tags: Any, tag: int) -> Side:
+def side_of(
+    V: dolfinx.fem.FunctionSpace, facet_tags: Any, tag: int, fixed: np.ndarray | None = None
+) -> Side:
     """The owned facets tagged ``tag`` of the P1 vector space V, oriented outwards
-    (``facet_tags``: dolfinx's mesh tags, whose class differs between its versions)."""
+    (``facet_tags``: dolfinx's mesh tags, whose class differs between its versions), and the
+    rim of their surface; ``fixed``: the owned Dirichlet dofs (bool (n_owned * bs,), as
+    ``ContactPair.fixed``), whose symmetry planes are then not part of the rim
+    (:func:`mirror_edges`). Collective."""
     mesh = V.mesh
     tdim = mesh.topology.dim
     fdim = tdim - 1
@@ -140,9 +181,150 @@ def side_of(V: dolfinx.fem.FunctionSpace, facet_tags: Any, tag: int) -> Side:
         out = imap.local_to_global(a.ravel().astype(np.int32))
         return np.asarray(out, dtype=np.int64).reshape(a.shape)
 
+    nodes = glob(local)
+    held = None if fixed is None else node_held(V, fixed)[local]
+    open_vertex, open_edge = surface_rim(mesh.comm, nodes, X[local], held)
     return Side(
-        tag, local, glob(local), X[local], cells, cell_local, glob(cell_local), X[cell_local]
+        tag,
+        local,
+        nodes,
+        X[local],
+        cells,
+        cell_local,
+        glob(cell_local),
+        X[cell_local],
+        open_vertex,
+        open_edge,
     )
+
+
+def node_held(V: dolfinx.fem.FunctionSpace, fixed: np.ndarray) -> np.ndarray:
+    """(n, gdim) bool: which displacement components of each local node (owned and ghost) of
+    the P1 vector space V a Dirichlet condition holds, from the owned Dirichlet dofs ``fixed``
+    (bool (n_owned * bs,)): a ghost's flags are its owner's (one scatter). Collective."""
+    import dolfinx.fem  # here: the module imports dolfinx for its annotations only
+
+    bs = V.dofmap.index_map_bs
+    flags = dolfinx.fem.Function(V)
+    flags.x.array[:] = 0.0
+    flags.x.array[: len(fixed)] = np.asarray(fixed, dtype=bool)
+    flags.x.scatter_forward()
+    return np.real(flags.x.array).reshape(-1, bs)[:, : V.mesh.geometry.dim] != 0.0
+
+
+def mirror_edges(X: np.ndarray, held: np.ndarray, tol: float) -> np.ndarray:
+    """(m, 3) bool: the edge of each triangle opposite vertex i lies on a symmetry plane.
+    ``X`` (m, 3, 3) the reference coordinates of the triangles' vertices, ``held`` (m, 3, 3)
+    which of their displacement components a Dirichlet condition holds (:func:`node_held`).
+    An edge is on a symmetry plane if, for some axis k, both its nodes hold component k and
+    lie on one plane normal to axis k (their k-th coordinates equal to ``tol``): a roller
+    plane, where the mirror image of the body continues its surface. Not if both nodes hold
+    every component: a clamped or rigidly driven face (``sphere-slide``: the hemisphere's rim
+    on its driven flat top), where the surface ends. The held value is not looked at: a face
+    driven along its normal only (a frictionless platen, ``hertz-spheres``' flat cuts) counts
+    as a symmetry plane too. 2D is left as it was (:func:`facet_rim`)."""
+    ends = np.array([[1, 2], [2, 0], [0, 1]])
+    Xa, Xb = X[:, ends[:, 0]], X[:, ends[:, 1]]
+    ha, hb = held[:, ends[:, 0]], held[:, ends[:, 1]]
+    roller = np.any(ha & hb & (np.abs(Xa - Xb) <= tol), axis=2)
+    clamped = np.all(ha, axis=2) & np.all(hb, axis=2)
+    return roller & ~clamped
+
+
+def _size(X: np.ndarray, comm: MPI.Comm | None = None) -> float:
+    """The diagonal of the bounding box of the points ``X`` (..., gdim) (of all ranks)."""
+    gdim = X.shape[-1]
+    pts = X.reshape(-1, gdim)
+    lo = pts.min(axis=0) if len(pts) else np.full(gdim, np.inf)
+    hi = pts.max(axis=0) if len(pts) else np.full(gdim, -np.inf)
+    if comm is not None and comm.size > 1:
+        lo = np.min(comm.allgather(lo), axis=0)
+        hi = np.max(comm.allgather(hi), axis=0)
+    return float(np.linalg.norm(hi - lo)) if np.all(hi >= lo) else 0.0
+
+
+def facet_rim(
+    nodes: np.ndarray,
+    X: np.ndarray | None = None,
+    held: np.ndarray | None = None,
+    tol: float | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rim of the surface made of the facets ``nodes`` (m, d) (global node indices):
+    ``open_vertex`` (m, d), vertex i of the facet on the surface's boundary, and ``open_edge``
+    (m, d), the facet's edge opposite vertex i on it (3D). 2D: a vertex of one segment only
+    (the end of an open curve), ``open_edge`` all False (the closest point of a segment off
+    it is a vertex). 3D: an edge of one triangle only, and the vertices of such edges; with
+    the reference coordinates ``X`` (m, d, gdim) and the held components ``held`` (m, d,
+    gdim) of the facets' nodes, an edge of one triangle on a symmetry plane is not on the
+    rim (:func:`mirror_edges`; ``tol``: absolute, default :data:`PLANE_TOL` times the size
+    of the facets)."""
+    m, d = nodes.shape
+    if d == 2:
+        uniq, count = np.unique(nodes, return_counts=True)
+        open_vertex = count[np.searchsorted(uniq, nodes)] == 1
+        return open_vertex.reshape(m, d), np.zeros((m, d), dtype=bool)
+    # edge i: the vertices other than i, sorted
+    edges = np.sort(nodes[:, [[1, 2], [2, 0], [0, 1]]], axis=2)
+    flat = edges.reshape(-1, 2)
+    if len(flat) == 0:
+        return np.zeros((m, d), dtype=bool), np.zeros((m, d), dtype=bool)
+    _, inverse, count = np.unique(flat, axis=0, return_inverse=True, return_counts=True)
+    open_edge = (count[inverse.reshape(-1)] == 1).reshape(m, d)
+    if X is not None and held is not None:
+        open_edge &= ~mirror_edges(X, held, PLANE_TOL * _size(X) if tol is None else tol)
+    open_vertex = np.isin(nodes, np.unique(edges[open_edge]))
+    return open_vertex, open_edge
+
+
+def surface_rim(
+    comm: MPI.Comm,
+    nodes: np.ndarray,
+    X: np.ndarray | None = None,
+    held: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`facet_rim` of the surface whose facets are distributed over the ranks of
+    ``comm`` (``nodes`` (m, d): this rank's facets, each facet on one rank; ``X`` and
+    ``held`` (m, d, gdim) their nodes' reference coordinates and held components, or None),
+    for this rank's facets; the same on any partition. Each facet goes to the ranks that own
+    one of its vertices (node % size), with its coordinates and flags: there are all the
+    facets around each of their vertices, so the rank sees each vertex it owns, and each edge
+    with an end it owns, as the whole surface does; it answers for those, and the answers
+    are joined. The plane tolerance is :data:`PLANE_TOL` of the whole surface's size.
+    Collective."""
+    m, d = nodes.shape
+    size = comm.size
+    tol = None if X is None or held is None else PLANE_TOL * _size(X, comm)
+    if size == 1:
+        return facet_rim(nodes, X, held, tol)
+    chosen = [np.flatnonzero(np.any(nodes % size == r, axis=1)) for r in range(size)]
+    if X is None or held is None:
+        received = comm.alltoall([(nodes[c],) for c in chosen])
+    else:
+        received = comm.alltoall([(nodes[c], X[c], held[c]) for c in chosen])
+    counts = [len(g[0]) for g in received]
+
+    def joined(i: int, *shape: int) -> np.ndarray:
+        return np.concatenate([np.reshape(g[i], (-1, *shape)) for g in received])
+
+    got = joined(0, d).astype(np.int64)
+    if X is None or held is None:
+        open_vertex, open_edge = facet_rim(got)
+    else:
+        gdim = X.shape[2]
+        open_vertex, open_edge = facet_rim(got, joined(1, d, gdim), joined(2, d, gdim), tol)
+    mine = got % size == comm.rank
+    open_vertex &= mine
+    # the edge opposite vertex i: an end of it owned here
+    open_edge &= np.roll(mine, -1, axis=1) | np.roll(mine, -2, axis=1)
+    bounds = np.cumsum([0, *counts])
+    answers = comm.alltoall(
+        [(open_vertex[a:b], open_edge[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+    )
+    out_vertex, out_edge = np.zeros((m, d), dtype=bool), np.zeros((m, d), dtype=bool)
+    for c, (v, e) in zip(chosen, answers, strict=True):
+        out_vertex[c] |= v
+        out_edge[c] |= e
+    return out_vertex, out_edge
 
 
 def facet_normals(x: np.ndarray) -> np.ndarray:
@@ -169,23 +351,28 @@ def gather_near(comm: MPI.Comm, master: Facets, region: Facets, radius: float) -
     else:
         box = np.stack([np.full(gdim, np.inf), np.full(gdim, -np.inf)])
     boxes = comm.allgather(box)
-    if comm.size == 1:
-        keep = _boxes_meet(master.x.min(axis=1), master.x.max(axis=1), boxes[0])
-        return Facets(
-            master.x[keep], master.nodes[keep], None if master.X is None else master.X[keep]
-        )
     lo, hi = master.x.min(axis=1), master.x.max(axis=1)
+    if comm.size == 1:
+        return master.subset(_boxes_meet(lo, hi, boxes[0]))
     ref = master.x if master.X is None else master.X
+    rim = master.open_vertex is not None and master.open_edge is not None
     sends = []
     for b in boxes:
         keep = _boxes_meet(lo, hi, b)
-        sends.append((master.x[keep], master.nodes[keep], ref[keep]))
+        part = [master.x[keep], master.nodes[keep], ref[keep]]
+        if rim:
+            part += [master.open_vertex[keep], master.open_edge[keep]]  # type: ignore[index]
+        sends.append(tuple(part))
     received = comm.alltoall(sends)
     d = master.x.shape[1]
-    x = np.concatenate([r[0] for r in received]).reshape(-1, d, gdim)
-    nodes = np.concatenate([r[1] for r in received]).reshape(-1, d)
-    X = np.concatenate([r[2] for r in received]).reshape(-1, d, gdim)
-    return Facets(x, nodes, None if master.X is None else X)
+
+    def joined(i: int, *shape: int) -> np.ndarray:
+        return np.concatenate([r[i] for r in received]).reshape(-1, *shape)
+
+    x, nodes, X = joined(0, d, gdim), joined(1, d), joined(2, d, gdim)
+    if not rim:
+        return Facets(x, nodes, None if master.X is None else X)
+    return Facets(x, nodes, None if master.X is None else X, joined(3, d), joined(4, d))
 
 
 def facet_order(X: np.ndarray) -> np.ndarray:

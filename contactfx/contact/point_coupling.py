@@ -26,9 +26,27 @@ derivatives are not linearised: for the closest-point projection they vanish in 
 first order (n_m is orthogonal to the master tangent and x - y is parallel to n_m), what is
 left out is the curvature (geometric) stiffness.
 
-Points whose projection falls off the master surface (no candidate facet within the search
-radius, or the closest point on an edge of the master surface that no other master facet
-shares) are not in contact.
+Points whose projection falls off the master surface are not in contact: no candidate facet
+within the search radius, or the closest point of the master surface on its boundary. A
+point that projects inside no master facet is decided by the feature of the surface its
+closest point lies on: on an edge (3D) it is in contact if two master facets share that edge
+(an interior ridge), not on a boundary edge (one facet); at a vertex, if the vertex is
+interior to the surface (2D: shared by two segments, a convex kink; the end of the curve is
+not). Every vertex of a triangulated surface is shared by several triangles, also on its
+boundary, so the vertex alone cannot tell a point at a kink from one beyond the surface's
+edge. The boundary edges and vertices are those of the whole master surface, found once by
+global node numbers (:func:`contactfx.contact.pair.surface_rim`): the master facets a rank
+gathers near its slave points may lack a facet's neighbours, and 1 and 2 ranks pair the
+same points. In 3D an edge of one master facet on a symmetry plane is interior, not a
+boundary (:func:`contactfx.contact.pair.mirror_edges`: both its nodes hold the displacement
+component normal to a plane they lie on, and not every component): the mirror image
+continues the surface there, and a point past it, as near a curved master's symmetry plane
+where the facets' normals tilt, is in contact (docs/verification.md section 10). No
+tolerance beyond the 1e-10 of "inside": slave Gauss points lie inside their facets, so where
+flat slave and master surfaces end on the same plane (the edges of equal faces) the points
+project inside the master facets; the finite-strain hysteresis below keeps a point's facet
+past its edge, boundary or not. A point paired off its facet carries its force to the
+facet's vertex of the largest barycentric coordinate.
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
 penalty, and Nitsche as below, each with or without friction; always searched at every Newton
@@ -118,9 +136,11 @@ import numpy as np
 from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
-from contactfx.contact.pair import Facets, Side, facet_normals, facet_order
+from contactfx.contact.pair import Facets, Side, facet_normals, facet_order, facet_rim
 from contactfx.contact.projection import (
+    TOL,
     Pick,
+    closest_point_facets,
     gauss_segment,
     gauss_triangle,
     pick_closest,
@@ -245,6 +265,24 @@ class _Directed:
 #: how far past its edge (a fraction of its size) a point keeps its facet within a Newton
 #: solve (:meth:`PointCoupling._keep_facets`)
 KEEP_BEYOND = 0.1
+
+
+def _on_rim(closest: np.ndarray, index: np.ndarray, near: Facets) -> np.ndarray:
+    """(n,) bool: the closest points ``closest`` (n, gdim) on the master facets ``index`` (n,)
+    of ``near`` lie on the boundary of the master surface (a point beyond it, not in
+    contact): on an open edge of the facet (3D, the edge's barycentric coordinate within TOL
+    of 0) or at an open vertex (its coordinate within TOL of 1; 2D: the end of the curve).
+    The rim is that of the whole surface (:func:`contactfx.contact.pair.surface_rim`), or,
+    for facets built without it, of the ``near`` facets alone."""
+    if near.open_vertex is None or near.open_edge is None:
+        open_vertex, open_edge = facet_rim(near.nodes)
+    else:
+        open_vertex, open_edge = near.open_vertex, near.open_edge
+    # barycentric coordinates of the closest point (exact 0 and 1 at a vertex)
+    lam = closest_point_facets(closest, near.x[index]).bary
+    on_edge = (lam <= TOL) & open_edge[index]
+    at_vertex = (lam >= 1.0 - TOL) & open_vertex[index]
+    return np.any(on_edge | at_vertex, axis=1)
 
 
 class PointCoupling:
@@ -440,7 +478,8 @@ class PointCoupling:
             facet_nodes=np.where(paired[:, None], np.sort(master_nodes, axis=1), -1),
         )
 
-    def _project(self, xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pick:
+    @staticmethod
+    def _project(xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pick:
         """The master facet of each point (index -1: not in contact). ``kept``: (n, d)
         the sorted global nodes of each point's facet at the last search (-1: none), kept
         while the point projects inside it (:meth:`_keep_facets`)."""
@@ -473,18 +512,17 @@ class PointCoupling:
         key = None if near.X is None else facet_order(near.X)
         pick = pick_closest(xq, cand, near.x, fallback=True, key=key)
         if kept is not None:
-            self._keep_facets(xq, near, pick, kept)
+            PointCoupling._keep_facets(xq, near, pick, kept)
         off = (pick.index >= 0) & ~pick.inside
         if np.any(off):
-            # the closest point is a vertex: in contact if another master facet shares it
+            # the closest point on an edge or at a vertex of the master surface: in contact
+            # unless that is on the surface's boundary (:func:`_on_rim`)
+            beyond = _on_rim(pick.closest[off], pick.index[off], near)
             vertex = np.argmax(np.nan_to_num(pick.bary[off], nan=-1.0), axis=1)
-            node = near.nodes[pick.index[off], vertex]
-            uniq, count = np.unique(near.nodes, return_counts=True)
-            shared = count[np.searchsorted(uniq, node)] > 1
             bary = np.zeros_like(pick.bary[off])
             bary[np.arange(len(vertex)), vertex] = 1.0
             pick.bary[off] = bary
-            pick.index[np.flatnonzero(off)[~shared]] = -1
+            pick.index[np.flatnonzero(off)[beyond]] = -1
         return pick
 
     @staticmethod
@@ -953,9 +991,13 @@ class PointCoupling:
     def nodal_normals(self) -> np.ndarray:
         """The unit normal of each node of :meth:`nodal`: the contact normal of the Gauss
         points (the one their traction -P n acts along) lumped like the pressure (weights
-        N_j w), normalised."""
-        n = self.points[0]["n"]
-        _, sums = self._lumped([n[:, i] for i in range(n.shape[1])])
+        N_j w; the unbiased variant's second direction with its normal reversed, the first
+        direction's slave normal), normalised."""
+        columns = [
+            [(1.0 if k == 0 else -1.0) * p["n"][:, i] for i in range(p["n"].shape[1])]
+            for k, p in enumerate(self.points)
+        ]
+        _, sums = self._lumped(columns)
         mean = sums[:, 2:]
         return mean / np.linalg.norm(mean, axis=1)[:, None]
 

@@ -194,8 +194,9 @@ class TwoBodyProblem(Problem):
             fixed[dofs[dofs < n_dofs]] = True
         self.pair = ContactPair(
             self.layout,
-            side_of(self.V, self.facet_tags, scene.slave_tag),
-            side_of(self.V, self.facet_tags, scene.master_tag),
+            # the rims of the surfaces without their edges on symmetry planes
+            side_of(self.V, self.facet_tags, scene.slave_tag, fixed),
+            side_of(self.V, self.facet_tags, scene.master_tag, fixed),
             scene.contact_modulus(),
             # finite strain: the contact in the deformed configuration, searched at every
             # Newton iteration (large sliding moves a point across master facets in a step)

@@ -243,3 +243,146 @@ def test_mortar_search_across_ranks_matches_serial():
     across = overlap & (s_rank[:, None] != m_rank[None, :])
     if p > 1:
         assert np.any(across) and np.any(overlap & ~across)
+
+
+def _pyramid(n: int) -> Facets:
+    """A triangulation of the unit square (n x n grid, n even, each cell cut along its
+    diagonal) lifted to z = 0.5 - |x - 0.5| - 0.3 |y - 0.5|, normals up: a convex roof, flat
+    on each triangle, with ridges along x = 0.5 and y = 0.5 and its apex at the centre."""
+    s = np.linspace(0.0, 1.0, n + 1)
+    X, Y = (a.ravel() for a in np.meshgrid(s, s, indexing="ij"))
+    pts = np.stack([X, Y, 0.5 - np.abs(X - 0.5) - 0.3 * np.abs(Y - 0.5)], axis=1)
+    tris = []
+    for a in range(n):
+        for b in range(n):
+            v00, v10, v01, v11 = (
+                a * (n + 1) + b,
+                (a + 1) * (n + 1) + b,
+                a * (n + 1) + b + 1,
+                (a + 1) * (n + 1) + b + 1,
+            )
+            tris += [(v00, v10, v11), (v00, v11, v01)]
+    tris = np.array(tris)
+    return Facets(pts[tris], tris + 1000, pts[tris])
+
+
+def test_surface_rim():
+    """The rim of a surface: the edges of one facet only and their vertices (3D), the ends of
+    a curve (2D); over the ranks (each facet on one of them) the same as on one rank."""
+    from mpi4py import MPI
+
+    from contactfx.contact.pair import facet_rim, surface_rim
+
+    n = 4
+    roof = _pyramid(n)
+    open_vertex, open_edge = facet_rim(roof.nodes)
+    assert open_edge.sum() == 4 * n  # the square's boundary
+    ends = roof.X[np.arange(len(roof))[:, None], (np.arange(3) + 1) % 3]  # edge i from i + 1
+    others = roof.X[np.arange(len(roof))[:, None], (np.arange(3) + 2) % 3]
+    on_side = np.zeros_like(open_edge)
+    for c in (0, 1):
+        for value in (0.0, 1.0):
+            on_side |= (ends[..., c] == value) & (others[..., c] == value)
+    assert np.array_equal(open_edge, on_side)
+    xy = roof.X[..., :2]
+    assert np.array_equal(open_vertex, np.any((xy == 0.0) | (xy == 1.0), axis=2))
+    curve = _line(np.linspace(0.0, 1.0, 6), 0.0, 0)
+    v, e = facet_rim(curve.nodes)
+    assert v.sum() == 2 and v[0, 0] and v[-1, 1] and not e.any()
+    comm = MPI.COMM_WORLD
+    for whole in (roof, curve):
+        rank = np.random.default_rng(5).integers(0, comm.size, len(whole))
+        mine = rank == comm.rank
+        parallel = surface_rim(comm, whole.nodes[mine])
+        for got, want in zip(parallel, facet_rim(whole.nodes), strict=True):
+            assert np.array_equal(got, want[mine])
+
+
+def test_symmetry_plane_edges_not_on_the_rim():
+    """An edge of one facet on a symmetry plane (both its nodes hold the displacement
+    component normal to the plane, and lie on it) is not on the rim: the mirror image
+    continues the surface there, and a point past it is in contact. The roof's side x = 0 a
+    roller plane (u_x held); its side y = 0 holds u_x too but lies in no plane x = const (the
+    plane test: still a boundary), its side y = 1 is clamped (every component held: the
+    surface ends there), its side x = 1 free. Over the ranks the same as on one rank."""
+    from mpi4py import MPI
+
+    from contactfx.contact.pair import facet_rim, mirror_edges, surface_rim
+    from contactfx.contact.point_coupling import PointCoupling
+
+    n = 4
+    roof = _pyramid(n)
+    X = roof.X
+    held = np.zeros(X.shape, dtype=bool)
+    held[..., 0] = (X[..., 0] == 0.0) | (X[..., 1] == 0.0)
+    held[X[..., 1] == 1.0] = True
+    ends = X[np.arange(len(roof))[:, None], (np.arange(3) + 1) % 3]  # edge i from i + 1
+    others = X[np.arange(len(roof))[:, None], (np.arange(3) + 2) % 3]
+
+    def side(c: int, value: float) -> np.ndarray:
+        return (ends[..., c] == value) & (others[..., c] == value)
+
+    assert np.array_equal(mirror_edges(X, held, 1e-12), side(0, 0.0))
+    # a node of the plane moved off it by more than round-off: its two edges are not on it
+    shifted = X.copy()
+    shifted[..., 0] += np.where(X[..., 1] == 0.5, 1e-9, 0.0)
+    assert mirror_edges(shifted, held, 1e-12).sum() == side(0, 0.0).sum() - 2
+    open_vertex, open_edge = facet_rim(roof.nodes, X, held)
+    assert open_edge.sum() == 3 * n
+    assert np.array_equal(open_edge, side(0, 1.0) | side(1, 0.0) | side(1, 1.0))
+    x, y = X[..., 0], X[..., 1]
+    assert np.array_equal(open_vertex, (x == 1.0) | (y == 0.0) | (y == 1.0))
+    # without the flags every side is on the rim
+    assert facet_rim(roof.nodes)[1].sum() == 4 * n
+    comm = MPI.COMM_WORLD
+    rank = np.random.default_rng(7).integers(0, comm.size, len(roof))
+    mine = rank == comm.rank
+    parallel = surface_rim(comm, roof.nodes[mine], X[mine], held[mine])
+    for got, want in zip(parallel, (open_vertex, open_edge), strict=True):
+        assert np.array_equal(got, want[mine])
+    # past the roller plane: paired; past the other sides: not
+    roof.open_vertex, roof.open_edge = open_vertex, open_edge
+    points = np.array(
+        [
+            [-0.1, 0.3, -0.06],  # beyond the roller plane x = 0
+            [-0.1, 0.5, 0.0],  # beyond the end of the ridge y = 0.5 on the roller plane
+            [1.1, 0.3, -0.06],  # beyond the free side x = 1
+            [0.3, -0.1, 0.0],  # beyond y = 0 (u_x held, not its plane)
+            [0.3, 1.1, 0.0],  # beyond the clamped side y = 1
+            [-0.1, -0.1, -0.15],  # beyond the corner of the roller plane and y = 0
+        ]
+    )
+    pick = PointCoupling._project(points, roof)
+    assert not pick.inside.any()
+    assert list(pick.index >= 0) == [True, True, False, False, False, False]
+
+
+def test_points_beyond_the_master_rim_unpaired():
+    """The point coupling's pairing off a master facet: a point whose closest point on the
+    master surface is on an interior ridge or at an interior vertex (a convex kink) is in
+    contact, one whose closest point is on the surface's boundary (edge or vertex; 2D: the end
+    of the curve) is beyond the surface and is not."""
+    from contactfx.contact.pair import facet_rim
+    from contactfx.contact.point_coupling import PointCoupling
+
+    roof = _pyramid(4)
+    roof.open_vertex, roof.open_edge = facet_rim(roof.nodes)
+    points = np.array(
+        [
+            [0.5, 0.5, 0.8],  # above the apex: the closest point is the apex
+            [0.3, 0.5, 0.45],  # above the ridge y = 0.5: on the ridge
+            [1.1, 0.3, -0.06],  # beyond the boundary edge x = 1
+            [1.1, 0.5, 0.0],  # beyond the end of the ridge: a boundary vertex
+            [1.1, 1.1, -0.15],  # beyond a corner of the square
+            [0.6, 0.3, 0.5],  # above a facet (inside it)
+        ]
+    )
+    pick = PointCoupling._project(points, roof)
+    assert list(pick.inside) == [False] * 5 + [True]
+    assert list(pick.index >= 0) == [True, True, False, False, False, True]
+    # 2D: a convex kink (0, 0) -> (1, 0.5) -> (2, 0), normals up (right to left)
+    x = np.array([[[2.0, 0.0], [1.0, 0.5]], [[1.0, 0.5], [0.0, 0.0]]])
+    curve = Facets(x, np.array([[2, 1], [1, 0]]), x)
+    pick = PointCoupling._project(np.array([[1.0, 0.8], [-0.2, -0.05], [2.1, 0.1]]), curve)
+    assert not pick.inside.any()
+    assert list(pick.index >= 0) == [True, False, False]

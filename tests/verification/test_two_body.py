@@ -441,6 +441,108 @@ def test_unsupported_body_apart_refused():
         scene.run(Numerics(method="nitsche"), verbose=False)
 
 
+#: the width of the upper box of :class:`_StripOnBox` (along x)
+STRIP = 0.55
+
+
+def _strip_on_box(
+    model, *, width: float, h_lower: float, h_upper: float, h1: float, ratio: float, offset: float
+) -> None:
+    """gmsh builder: the stacked boxes of :func:`contactfx.meshes.two_body.stacked_boxes`
+    (``offset`` 0) with the upper box a strip [0, STRIP] x [0, width] x [0, h_upper] on the
+    lower box [0, width]^2 x [-h_lower, 0], whose top is split into two faces along the line
+    x = STRIP: its facets tile [0, STRIP] x [0, width] exactly."""
+    from contactfx.meshes import StackedBoxesCells as C
+    from contactfx.meshes import StackedBoxesFacets as F
+    from contactfx.meshes.two_body import (
+        add_body_groups,
+        faces_by_plane,
+        generate_mesh,
+        set_body_sizes,
+    )
+
+    assert offset == 0.0
+    lower = model.occ.addBox(0.0, 0.0, -h_lower, width, width, h_lower)
+    upper = model.occ.addBox(0.0, 0.0, 0.0, STRIP, width, h_upper)
+    line = model.occ.addLine(
+        model.occ.addPoint(STRIP, 0.0, 0.0), model.occ.addPoint(STRIP, width, 0.0)
+    )
+    # the lower box cut by the line: its top split into two faces along x = STRIP
+    out, _ = model.occ.fragment([(3, lower)], [(1, line)])
+    (lower,) = [tag for d, tag in out if d == 3]
+    model.occ.synchronize()
+    planes = {}
+    for body, top, size in ((lower, 0.0, width), (upper, h_upper, STRIP)):
+        low = body == lower
+        planes[body] = faces_by_plane(
+            model,
+            3,
+            body,
+            {
+                F.LOWER_X0 if low else F.UPPER_X0: (0, 0.0),
+                F.LOWER_X1 if low else F.UPPER_X1: (0, size),
+                F.LOWER_Y0 if low else F.UPPER_Y0: (1, 0.0),
+                F.LOWER_Y1 if low else F.UPPER_Y1: (1, width),
+                F.LOWER_BOTTOM if low else F.UPPER_BOTTOM: (2, -h_lower if low else 0.0),
+                F.LOWER_TOP if low else F.UPPER_TOP: (2, top),
+            },
+        )
+    add_body_groups(model, {C.LOWER: (lower, planes[lower]), C.UPPER: (upper, planes[upper])})
+    set_body_sizes(
+        model, 3, [(lower, h1, h1), (upper, ratio * h1, ratio * h1)], "0", dist_min=0.0, grading=1.0
+    )
+    generate_mesh(model, 3)
+
+
+class _StripOnBox(PatchTest):
+    """The 3D patch test with the upper box a strip x < STRIP (:func:`_strip_on_box`)."""
+
+    def mesh_builder(self):
+        builder, dim = super().mesh_builder()
+        return functools.partial(_strip_on_box, **builder.keywords), dim
+
+
+def test_slave_points_beyond_the_master_surface_unpaired():
+    """Gauss-point Nitsche, the lower box's top the slave, the strip's bottom the master:
+    the slave face reaches past the master's boundary edge x = STRIP (and meets the master's
+    other edges on x = 0, y = 0, y = 1). At the state u_z = -q z / (lambda + 2 mu) in the
+    lower box (sigma_zz = -q, its top in place) and the strip at rest, the gap is 0 and the
+    law's pressure -sigma_n - gamma g = q at every paired point: the slave points under the
+    strip are paired, those beyond its edge are not (their closest point on the master
+    surface is on its boundary edge or at a vertex of it), and the contact force is q times
+    the overlap area STRIP x width (the slave facets tile it exactly). Before the boundary
+    edges were told from the interior ones in 3D, every point beyond was paired with a
+    vertex of the edge, with the same pressure q: a force of q width^2."""
+    scene = _StripOnBox(PatchTest.Params(dim=3, h=0.2, offset=0.0, slave="lower"))
+    num = Numerics(method="nitsche", theta=1)
+    E, nu, q = scene.p.E_lower, scene.p.nu_lower, scene.p.pressure
+    strain = -q * (1.0 + nu) * (1.0 - 2.0 * nu) / (E * (1.0 - nu))  # -q / (lambda + 2 mu)
+
+    def displace(X, up):
+        u = np.zeros_like(X)
+        u[~up, 2] = strain * X[~up, 2]
+        return u
+
+    _, coupling, solver = jacobian_check(scene, num, displace, noise=0.0)
+    dr, points = coupling.dirs[0], coupling.points[0]
+    X = np.einsum("qb,mbg->mqg", dr.qbary, dr.slave.X).reshape(-1, 3)
+    under = X[:, 0] < STRIP
+    # no Gauss point on the edge (the slave facets do not cross it)
+    assert np.all(np.abs(X[:, 0] - STRIP) > 1e-3)
+    comm = MPI.COMM_WORLD
+    total = comm.allreduce(len(X), op=MPI.SUM)
+    wrong = comm.allreduce(int(np.sum(points["paired"] != under)), op=MPI.SUM)
+    beyond = comm.allreduce(int(np.sum(~under)), op=MPI.SUM)
+    assert 0 < beyond < total and wrong == 0
+    P = coupling.state[0][0]
+    # the pressure q of the exact state at round-off (the P1 gradient of a linear field)
+    assert np.allclose(P[under], q, rtol=1e-10, atol=0.0)
+    assert np.all(P[~under] == 0.0)
+    width = scene.p.width
+    assert coupling.force() == pytest.approx(q * STRIP * width, rel=1e-10)
+    solver.destroy()
+
+
 def _sliding_coulomb(method: str = "nitsche"):
     from contactfx.scenes.two_body_2d import SlidingContact
 
