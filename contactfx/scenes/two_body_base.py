@@ -26,10 +26,14 @@ __all__ = [
     "radial_edge",
     "contact_edge",
     "CONTACT_EDGES",
+    "INTERFERENCES",
 ]
 
 #: the rules of :func:`contact_edge`
 CONTACT_EDGES = ("x-max", "x-band", "radial")
+#: what ``contact.interference`` may name: ``ramp`` removes an initial overlap of the pair
+#: progressively over the load program (:class:`contactfx.driver.two_body.TwoBodyProblem`)
+INTERFERENCES = ("ramp",)
 
 
 def line_edge(s: np.ndarray, p: np.ndarray) -> float | None:
@@ -184,6 +188,11 @@ class TwoBodyScene(Scene):
         if self.size_rule == "disc-radius":
             return float(np.sqrt(measure / np.pi))
         return 0.5 * measure
+
+    def interference(self) -> str | None:
+        """How an initial overlap of the pair is taken (``ramp``: removed over the load
+        program), or None: an overlap is refused."""
+        return None
 
     def edge_ring(self) -> float | None:
         """The ring width of the ``radial`` edge rule (the slave element size)."""
