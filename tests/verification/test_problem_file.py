@@ -69,6 +69,7 @@ def test_contact_pair_problem_reactions_balance():
         "bored-block.toml",
         "rubber-pad.toml",
         "o-ring.toml",
+        "shrink-fit.toml",
     ],
 )
 def test_problem_file_ranks_agree(name):
