@@ -93,6 +93,8 @@ class TwoBodyProblem(Problem):
     layout: NodeLayout
     pair: ContactPair
     _coupling: Any
+    #: an interference fit's largest overlap at the start (0: none recorded)
+    initial_overlap: float = 0.0
 
     @classmethod
     def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
@@ -365,6 +367,8 @@ class TwoBodyProblem(Problem):
         if scene.interference() == "ramp":
             coupling.record_start()
             self.pair.interference = True
+            #: the largest overlap at the start (run.json's score ``initial_overlap``)
+            self.initial_overlap = max(-least, 0.0)
         fixed = np.zeros(len(self.state.x.array) // self.gdim, dtype=bool)
         for bc in self.bcs:
             fixed[np.asarray(_compat.bc_dofs(bc)) // self.gdim] = True
@@ -548,6 +552,8 @@ class TwoBodyPost:
             owned = self.rotation.function_space.dofmap.index_map.size_local
             largest = float(np.max(self.rotation.x.array[:owned], initial=0.0))
             scores["linear_body_rotation"] = self.comm.allreduce(largest, op=MPI.MAX)
+        if pair.interference:  # the interference fit's largest overlap at the start
+            scores["initial_overlap"] = self.pb.initial_overlap
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
         plot = None

@@ -272,3 +272,5 @@ def test_shrink_fit_demo():
     p = lame_pressure(E, NU, A, B, C, DELTA)
     assert res.force / ((B - DELTA) * np.pi / 2) == pytest.approx(p, rel=0.014)
     assert scene.mean_pressure == pytest.approx(p, rel=0.014)
+    # run.json's score: the largest overlap at the start (mortar's weighted nodal gaps)
+    assert res.scores["initial_overlap"] == pytest.approx(DELTA, rel=0.01)
