@@ -220,7 +220,8 @@ class TwoBodyScene(Scene):
     def problem_data(self, numerics) -> dict:
         """Bodies (the cell groups with their materials), the scene's supports and loads, the
         contact pair (slave and master surfaces, h, the body the pair force is reported on,
-        the contact edge rule) and the symmetry and contact size outputs."""
+        the contact edge rule, an interference fit) and the symmetry and contact size
+        outputs."""
         other = "lower" if self.p.slave == "upper" else "upper"
         mats = self.materials()
         pair = {
@@ -233,6 +234,8 @@ class TwoBodyScene(Scene):
             pair["edge"] = self.edge_rule
             if self.edge_ring() is not None:
                 pair["edge_ring"] = float(self.edge_ring())
+        if self.interference() is not None:
+            pair["interference"] = self.interference()
         return {
             "bodies": [
                 export.body(self.cells[b].name.lower(), mats[b]) for b in ("lower", "upper")
