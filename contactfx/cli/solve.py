@@ -147,6 +147,14 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     from contactfx.driver.pipeline import setup
 
     problem = setup(scene, numerics, comm=comm)
+    # a pair's overlap at the start (collective), refused without contact.interference
+    overlap = None
+    if scene.spec.pair is not None and hasattr(problem, "initial_gap"):
+        least, tol = problem.initial_gap()
+        refusal = problem.overlap_refusal(least, tol)
+        if refusal is not None:
+            raise ValueError(f"{ns.problem}: {refusal}")
+        overlap = max(-least, 0.0), tol
     if comm.rank != 0:
         return 0
     pb = scene.spec
@@ -203,6 +211,14 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print("  initial    displacement given (Newton's start)")
     if pb.pair is not None:
         print(f"  contact    slave {pb.pair.slave}, master {pb.pair.master}")
+    # (an overlap at round-off, flat faces meshed touching, is no overlap)
+    if overlap is not None and (overlap[0] > 1e-6 * overlap[1] or pb.pair.interference):
+        how = (
+            f"interference = {pb.pair.interference}: removed over the load program"
+            if pb.pair.interference is not None
+            else f"within the tolerance {overlap[1]:.3g}"
+        )
+        print(f"  overlap    largest {overlap[0]:.6g} at the start ({how})")
     for pin in pb.pins:
         print(f"  pin        {pin.point.tolist()}: fixed {','.join('xyz'[c] for c in pin.fix)}")
     if pb.interface is not None:

@@ -64,8 +64,10 @@ class PairCoupling(Coupling, Protocol):
     and gap), ``nodal_friction()`` and ``friction_state()`` (with friction), ``force()`` (the
     total normal force), ``slave_force()`` (the force vector on the slave body) and
     ``search_gaps()`` (the gaps the last search measured) and ``nodal_normals()`` (a unit
-    normal per node of ``nodal()``). ``converged()`` is called when a load step converged (a
-    coupling that keeps a history, penalty friction's, moves it on)."""
+    normal per node of ``nodal()``); ``record_start()`` takes the last search's gaps (at the
+    start) as an interference fit's initial overlaps (hidden by ``pair.hidden()``).
+    ``converged()`` is called when a load step converged (a coupling that keeps a history,
+    penalty friction's, moves it on)."""
 
     def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]: ...
 
@@ -82,6 +84,8 @@ class PairCoupling(Coupling, Protocol):
     def slave_force(self) -> np.ndarray: ...
 
     def search_gaps(self) -> np.ndarray: ...
+
+    def record_start(self) -> None: ...
 
 
 def aij(comm: MPI.Comm, rows_local: int, rows_global: int, per_row: int = 16) -> PETSc.Mat:

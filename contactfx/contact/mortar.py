@@ -298,6 +298,11 @@ class MortarCoupling:
         #: weighted gap vectors b_j and nodal normals of the owned slave nodes closed at the
         #: last converged step (sorted global nodes, (m, gdim) vectors, (m, gdim) normals)
         self.objective = pair.finite_strain and self.mu is not None
+        #: an interference fit: the owned slave nodes' initial overlaps max(-g0_j, 0) (sorted
+        #: global nodes, values; :meth:`record_start`) and, per contact node of the last
+        #: search, its own (0 for a node without one)
+        self._initial: tuple[np.ndarray, np.ndarray] | None = None
+        self.overlap = np.zeros(0)
         empty = np.zeros((0, self.layout.gdim))
         self._b_old: tuple[np.ndarray, np.ndarray, np.ndarray] = (
             np.zeros(0, dtype=np.int64),
@@ -392,6 +397,7 @@ class MortarCoupling:
         n_free, tangents, free = n_free[contact], tangents[contact], free[contact]
         self.h = self.D ** (1.0 / max(gdim - 1, 1))
         self.c = self.r0 * self.pair.E / self.h
+        self.overlap = self._overlap_of(self.nodes)
         self.normal_rows = (self.nodes * bs + self.comp - lay.start * bs).astype(np.int32)
         for M in (self.T, self.G, self.TK):
             if M is not None:
@@ -494,7 +500,9 @@ class MortarCoupling:
         self.G.mult(x, self._g)
         self._g.axpy(1.0, self.g0)
         lam = self._y.getArray()[self.normal_rows]
-        cg = self.c * self._g.getArray()[self.normal_rows]
+        # an interference fit's hidden overlap: g_j + (1 - t) max(-g0_j, 0)
+        g = self._g.getArray()[self.normal_rows] + self.pair.hidden() * self.overlap
+        cg = self.c * g
         if self.ncp == "min":
             # a tie (lambda = 0, g at round-off of either sign, as on coinciding flat
             # surfaces at the start) is active: gaps below 1e-12 h_j count as closed in the
@@ -730,6 +738,25 @@ class MortarCoupling:
         slip = np.where(self.tmask, self._g.getArray()[self.tangent_rows()], 0.0)
         traction = self.D * np.linalg.norm(self.lam_t, axis=1) / self.D0
         return traction, np.linalg.norm(slip, axis=1), self.stick
+
+    def record_start(self) -> None:
+        """An interference fit: the initial overlap max(-g0_j, 0) of every contact node from
+        the weighted gaps of the last search (at the start, u = 0), hidden by the
+        complementarity in the proportion ``pair.hidden()`` of the load program."""
+        gaps = self.search_gaps()
+        self._initial = (self.nodes.copy(), np.maximum(-gaps, 0.0))
+        self.overlap = self._overlap_of(self.nodes)
+
+    def _overlap_of(self, nodes: np.ndarray) -> np.ndarray:
+        """The recorded initial overlaps of the sorted owned ``nodes`` (0 without)."""
+        out = np.zeros(len(nodes))
+        if self._initial is None or not len(self._initial[0]):
+            return out
+        known, values = self._initial
+        pos = np.minimum(np.searchsorted(known, nodes), len(known) - 1)
+        hit = known[pos] == nodes
+        out[hit] = values[pos[hit]]
+        return out
 
     def search_gaps(self) -> np.ndarray:
         """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""

@@ -433,6 +433,18 @@ class ContactPair:
     previous: dolfinx.fem.Function | None = None
     #: Tresca friction's threshold (None: Coulomb with ``mu``, or frictionless)
     threshold: float | None = None
+    #: an initial overlap removed over the load program (``contact.interference = "ramp"``):
+    #: the couplings record each point's / node's gap g0 at the start and their laws take
+    #: g + (1 - t) max(-g0, 0) for the gap g, t the load factor ``load`` (set by the problem)
+    interference: bool = False
+    load: float = 1.0
+
+    def hidden(self) -> float:
+        """The fraction (1 - t) of the initial overlap still hidden at the load factor t
+        (t clipped to [0, 1]); 0 without ``interference``."""
+        if not self.interference:
+            return 0.0
+        return 1.0 - min(max(float(self.load), 0.0), 1.0)
 
     def search(
         self, slave: Facets, master: Facets, pairs: bool = True

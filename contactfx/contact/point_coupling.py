@@ -253,6 +253,9 @@ class _Directed:
         #: per Gauss point the sorted global nodes of its master facet at the last search
         #: (-1: none)
         self.kept = np.zeros((0, d), dtype=np.int64)
+        #: an interference fit: per Gauss point the initial overlap max(-g0, 0) (the gap at
+        #: the start, :meth:`PointCoupling.record_start`; empty: none)
+        self.overlap = np.zeros(0)
 
     def history(self, n: int, gdim: int) -> dict[str, np.ndarray]:
         """The history arrays (zero before the first converged step), shared with the
@@ -459,6 +462,7 @@ class PointCoupling:
             **extra,
             rows=rows,
             N=N,
+            overlap=dr.overlap if len(dr.overlap) == len(xq) else np.zeros(len(xq)),
             inside=paired & np.asarray(pick.inside, dtype=bool),
             Jn=Jn,
             S=S,
@@ -594,6 +598,7 @@ class PointCoupling:
         u = vals[p["idx"]]
         x = p["X"] + u
         g = np.where(p["paired"], -np.einsum("pi,pi->p", p["Jn"], x), np.inf)
+        g = g + self.pair.hidden() * p["overlap"]  # an interference fit's hidden overlap
         law = self.law
         if law.kind == "penalty":
             arg = -p["scale"] * g
@@ -737,8 +742,11 @@ class PointCoupling:
             nm, bary = -p["n"][sel], p["bary"][sel]
         gap = xs - np.einsum("pb,pbg->pg", bary, xm)
         g = np.einsum("pg,pg->p", gap, nm)
+        # an interference fit's hidden overlap (a shift of the gap: the friction's gap vector
+        # g n_m keeps the geometric gap)
+        g_law = g + self.pair.hidden() * p["overlap"][sel]
         scale = p["scale"][sel]
-        arg = -scale * g
+        arg = -scale * g_law
         nitsche = self.law.kind == "nitsche"
         if nitsche:
             # the slave's first Piola traction P(F) N and its derivative (dP/dF : grad v) N;
@@ -750,7 +758,7 @@ class PointCoupling:
         active = p["paired"][sel] & (arg.real > -p["tie"][sel])
         P = np.where(active, arg, 0.0)
         tau = P[:, None] * nm  # -P n with n = -n_m
-        out = dict(P=P, g=g, nm=nm)
+        out = dict(P=P, g=g, nm=nm, g_law=g_law)
         if self.frictional:
             du = x - (p["X"][sel] + p["u_prev"][sel]).reshape(x.shape)
             jump = np.einsum("pa,pag->pg", N, du[:, : d + 1]) - np.einsum(
@@ -889,7 +897,7 @@ class PointCoupling:
             x = (p["X"] + vals[p["idx"]]).reshape(len(every), m // gdim, gdim)
             o = self._point_terms(p, x, every, geometric=False)
             F.setValues(p["rows"].ravel(), o["r"].ravel(), addv=PETSc.InsertMode.ADD_VALUES)
-            g = np.where(p["paired"], o["g"], np.inf)
+            g = np.where(p["paired"], o["g_law"], np.inf)
             self.state.append((o["P"], g, o.get("t"), o.get("stick"), o.get("slip")))
             # the gap vector's normal part g n_m: with the projection of the step's search
             # (small strain) x_s - y also holds the step's sliding, which is the slip
@@ -935,6 +943,15 @@ class PointCoupling:
                 "through the other)"
             )
         return None
+
+    def record_start(self) -> None:
+        """An interference fit: the initial overlap max(-g0, 0) of every Gauss point from the
+        gaps g0 of the last search (at the start, u = 0), hidden by the law in the proportion
+        ``pair.hidden()`` of the load program (:class:`contactfx.contact.pair.ContactPair`)."""
+        for dr, p in zip(self.dirs, self.points, strict=True):
+            g0 = -np.einsum("pi,pi->p", p["Jn"], p["x_search"])
+            dr.overlap = np.where(p["paired"], np.maximum(-g0, 0.0), 0.0)
+            p["overlap"] = dr.overlap
 
     def search_gaps(self) -> np.ndarray:
         """The gaps of this rank's paired Gauss points at the last search."""

@@ -298,7 +298,7 @@ class _Run:
             confined=problem.confined,
             iterate=problem.iterate,
             deadline=self.deadline,
-            roundoff_stop=problem.material.finite_strain,
+            roundoff_stop=problem.material.finite_strain or problem.roundoff_stop,
         )
         solver.timer.assembly += assembly
         if problem.material.finite_strain and self.num.inversion_check == "halve":

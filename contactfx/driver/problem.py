@@ -108,6 +108,10 @@ class Problem:
     #: whether the kind solves axisymmetric bodies (its integrals weighted by r, the hoop term;
     #: :mod:`contactfx.mechanics.axisymmetric`)
     axisymmetric = False
+    #: Newton stops at the residual's round-off level too (:class:`contactfx.solvers.snes.
+    #: _RoundOffStop`): finite strain, and an interference fit (the interference's own contact
+    #: forces set a floor that a well-predicted step's relative tolerance does not reach)
+    roundoff_stop = False
 
     scene: Scene
     num: Numerics

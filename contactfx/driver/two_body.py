@@ -93,6 +93,8 @@ class TwoBodyProblem(Problem):
     layout: NodeLayout
     pair: ContactPair
     _coupling: Any
+    #: an interference fit's largest overlap at the start (0: none recorded)
+    initial_overlap: float = 0.0
 
     @classmethod
     def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
@@ -313,24 +315,60 @@ class TwoBodyProblem(Problem):
     def apply_load(self, t: float) -> None:
         self.tload.value = t
         self.scene.set_load(t)
+        # an interference fit: the hidden part of the initial overlap, (1 - t)
+        self.pair.load = t
+
+    @property
+    def roundoff_stop(self) -> bool:  # type: ignore[override]
+        """An interference fit: Newton stops at the residual's round-off level too (the
+        predicted step starts near the solution, the interference's contact forces set the
+        floor)."""
+        return self.scene.interference() is not None
+
+    def initial_gap(self) -> tuple[float, float]:
+        """(the least gap of the pair at the start over all ranks, the overlap tolerated
+        without ``contact.interference``: 1 % of the contact element size, since two
+        polygonal approximations of touching curved surfaces cross by O(h^2 / R)): the
+        coupling searched at u = 0 (its gaps: the Gauss points' or the weighted nodal
+        gaps). Collective."""
+        coupling = self.coupling()
+        coupling.update(np.zeros_like(self.state.x.array))
+        gaps = coupling.search_gaps()
+        least = self.mesh.comm.allreduce(float(np.min(gaps, initial=np.inf)), op=MPI.MIN)
+        return least, 1e-2 * self.scene.h_contact()
+
+    def overlap_refusal(self, least: float, tol: float) -> str | None:
+        """Why the start is refused: an overlap of more than ``tol`` without
+        ``contact.interference``, or None."""
+        if least >= -tol or self.scene.interference() is not None:
+            return None
+        return (
+            f"the bodies overlap by {-least:.3g} at the start (more than {tol:.3g}): for a "
+            'press or shrink fit set interference = "ramp" on the [[contact]] pair (the '
+            "overlap removed over the load program), else move them apart or correct the "
+            "geometry"
+        )
 
     def start(self, solver: Solver) -> None:
         """From the undeformed state (the Dirichlet values are set by the solve), after two
         checks of the geometry at the start (collective, so that every rank raises alike):
-        the bodies must not overlap by more than 1 % of the contact element size (two
-        polygonal approximations of touching curved surfaces cross by O(h^2 / R)), and a body
-        without any support must touch the other one (else the first solve is singular)."""
+        the bodies must not overlap by more than 1 % of the contact element size
+        (:meth:`initial_gap`) unless the pair is an interference fit, and a body without any
+        support must touch the other one (else the first solve is singular). An interference
+        fit (``contact.interference = "ramp"``) records the initial gaps g0 in the coupling,
+        whose law then takes g + (1 - t) max(-g0, 0) at the load factor t: at t = 0 the
+        overlap is hidden, at t = 1 the whole interference acts."""
         comm, scene = self.mesh.comm, self.scene
         coupling = self.coupling()
-        coupling.update(np.zeros_like(self.state.x.array))
-        gaps = coupling.search_gaps()
-        least = comm.allreduce(float(np.min(gaps, initial=np.inf)), op=MPI.MIN)
-        tol = 1e-2 * scene.h_contact()
-        if least < -tol:
-            raise ValueError(
-                f"the bodies overlap by {-least:.3g} at the start (more than "
-                f"{tol:.3g}): move them apart or correct the geometry"
-            )
+        least, tol = self.initial_gap()
+        refusal = self.overlap_refusal(least, tol)
+        if refusal is not None:
+            raise ValueError(refusal)
+        if scene.interference() == "ramp":
+            coupling.record_start()
+            self.pair.interference = True
+            #: the largest overlap at the start (run.json's score ``initial_overlap``)
+            self.initial_overlap = max(-least, 0.0)
         fixed = np.zeros(len(self.state.x.array) // self.gdim, dtype=bool)
         for bc in self.bcs:
             fixed[np.asarray(_compat.bc_dofs(bc)) // self.gdim] = True
@@ -514,6 +552,8 @@ class TwoBodyPost:
             owned = self.rotation.function_space.dofmap.index_map.size_local
             largest = float(np.max(self.rotation.x.array[:owned], initial=0.0))
             scores["linear_body_rotation"] = self.comm.allreduce(largest, op=MPI.MAX)
+        if pair.interference:  # the interference fit's largest overlap at the start
+            scores["initial_overlap"] = self.pb.initial_overlap
         scores["searches"] = pair.searches
         scores["search_time"] = self.comm.allreduce(pair.search_time, op=MPI.MAX)
         plot = None

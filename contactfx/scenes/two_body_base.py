@@ -26,10 +26,14 @@ __all__ = [
     "radial_edge",
     "contact_edge",
     "CONTACT_EDGES",
+    "INTERFERENCES",
 ]
 
 #: the rules of :func:`contact_edge`
 CONTACT_EDGES = ("x-max", "x-band", "radial")
+#: what ``contact.interference`` may name: ``ramp`` removes an initial overlap of the pair
+#: progressively over the load program (:class:`contactfx.driver.two_body.TwoBodyProblem`)
+INTERFERENCES = ("ramp",)
 
 
 def line_edge(s: np.ndarray, p: np.ndarray) -> float | None:
@@ -185,6 +189,11 @@ class TwoBodyScene(Scene):
             return float(np.sqrt(measure / np.pi))
         return 0.5 * measure
 
+    def interference(self) -> str | None:
+        """How an initial overlap of the pair is taken (``ramp``: removed over the load
+        program), or None: an overlap is refused."""
+        return None
+
     def edge_ring(self) -> float | None:
         """The ring width of the ``radial`` edge rule (the slave element size)."""
         return None
@@ -211,7 +220,8 @@ class TwoBodyScene(Scene):
     def problem_data(self, numerics) -> dict:
         """Bodies (the cell groups with their materials), the scene's supports and loads, the
         contact pair (slave and master surfaces, h, the body the pair force is reported on,
-        the contact edge rule) and the symmetry and contact size outputs."""
+        the contact edge rule, an interference fit) and the symmetry and contact size
+        outputs."""
         other = "lower" if self.p.slave == "upper" else "upper"
         mats = self.materials()
         pair = {
@@ -224,6 +234,8 @@ class TwoBodyScene(Scene):
             pair["edge"] = self.edge_rule
             if self.edge_ring() is not None:
                 pair["edge_ring"] = float(self.edge_ring())
+        if self.interference() is not None:
+            pair["interference"] = self.interference()
         return {
             "bodies": [
                 export.body(self.cells[b].name.lower(), mats[b]) for b in ("lower", "upper")

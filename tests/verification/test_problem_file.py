@@ -69,6 +69,7 @@ def test_contact_pair_problem_reactions_balance():
         "bored-block.toml",
         "rubber-pad.toml",
         "o-ring.toml",
+        "shrink-fit.toml",
     ],
 )
 def test_problem_file_ranks_agree(name):
@@ -275,6 +276,10 @@ def _pair_key(line: str):
         (_pair_key('edge = "radial"'), "contact.0.edge_ring: missing"),
         (_pair_key('edge = "radial"\nedge_ring = 0.0'), "contact.0.edge_ring: must be > 0"),
         (_pair_key("edge_ring = 0.01"), "contact.0.edge_ring: the ring width of edge = 'radial'"),
+        (
+            _pair_key('interference = "press"'),
+            "contact.0.interference: must be one of ramp, got 'press'",
+        ),
         (_pair_key("colour = 1"), "contact.0.colour: unknown key"),
         (
             lambda t: t.replace('slave = "block_bottom"', 'slave = "both"'),

@@ -509,6 +509,10 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
             return self.materials()[slave]
         return max((b.material for b in self.spec.bodies), key=lambda m: m.E)
 
+    def interference(self) -> str | None:
+        """``contact.interference``: how an initial overlap of the pair is taken."""
+        return self.spec.pair.interference
+
     def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
         """The contact size by the rule ``contact.edge`` (:func:`contact_edge`), else None
         (the measure rule of ``output.contact_size``)."""

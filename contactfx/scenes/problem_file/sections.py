@@ -40,7 +40,7 @@ from contactfx.scenes.problem_file.specs import (
     PinSpec,
     ProblemFile,
 )
-from contactfx.scenes.two_body_base import CONTACT_EDGES
+from contactfx.scenes.two_body_base import CONTACT_EDGES, INTERFERENCES
 
 __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read", "check_materials"]
 
@@ -83,7 +83,7 @@ KEYS = {
         "edge_radius",
         "h",
     ),
-    "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring"),
+    "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring", "interference"),
     "interface": (
         "group",
         "fluid_pressure",
@@ -414,7 +414,10 @@ def read_pair(r: Reader, data: dict, bodies: tuple[BodySpec, ...]) -> PairSpec:
             "contact.0.edge_ring",
             "missing (the ring width of edge = 'radial', about the slave element size)",
         )
-    return PairSpec(slave, master, h, force_on, edge, ring)
+    interference = None
+    if "interference" in c:
+        interference = r.string(c, "contact.0", "interference", INTERFERENCES)
+    return PairSpec(slave, master, h, force_on, edge, ring, interference)
 
 
 def read_output(r: Reader, data: dict) -> OutputSpec:

@@ -135,6 +135,8 @@ class PairSpec:
     force_on: str | None = None
     edge: str | None = None
     edge_ring: float | None = None
+    #: an initial overlap of the pair: "ramp" (removed over the load program) or None
+    interference: str | None = None
 
 
 @dataclass(frozen=True)
