@@ -147,6 +147,7 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     from contactfx.driver.pipeline import setup
 
     problem = setup(scene, numerics, comm=comm)
+    dofs = problem.dofs()  # collective (a sum over the ranks): before rank 0 alone prints
     if comm.rank != 0:
         return 0
     pb = scene.spec
@@ -154,7 +155,7 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     where = (
         f"{pb.mesh.file} (size factor {pb.mesh.size})" if pb.mesh.builder is None else pb.mesh.label
     )
-    print(f"  mesh       {where}, {scene.gdim}D, {problem.dofs()} dofs")
+    print(f"  mesh       {where}, {scene.gdim}D, {dofs} dofs")
     print("  groups     " + scene.group_list())
     # each body's material as the run takes it: its own, or a linear one under numerics.material
     materials = [numerics.bulk_material(body.material) for body in pb.bodies]
