@@ -69,6 +69,8 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
                 print(f"  {key.replace('_', ' '):<42s}  {value:.6g}")
         for g, values in _last_reactions(scene).items():
             print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
+        if scene.spec.output.symmetry_planes:
+            print(f"  {_full_model(scene.spec.output)}")
         if written:
             print(f"  forces per step: {written} (and history.png)")
         print_outputs(res)
@@ -222,4 +224,15 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print(f"  petsc      {file_petsc}")
     if pb.output.reactions:
         print(f"  output     reactions of {', '.join(pb.output.reactions)}")
+    if pb.output.symmetry_planes:
+        print(f"  symmetry   {_full_model(pb.output)}")
     return 0
+
+
+def _full_model(output) -> str:
+    """How the forces of a model with mirror planes are reported (the full model's)."""
+    axes = ", ".join("xyz"[k] for k in output.symmetry_planes)
+    return (
+        f"forces of the full model: {output.symmetry:g} times the model's, 0 along {axes} "
+        "(normal to the mirror planes)"
+    )

@@ -214,3 +214,14 @@ def test_bad_symmetry_keys(tmp_path, edit, message):
         scene.build_mesh(MPI.COMM_SELF)
     assert message in str(err.value)
     assert "\n" not in str(err.value)
+
+
+def test_check_names_the_convention(shared_tmp, capsys):
+    from contactfx.cli import main
+
+    assert main(["check", str(_file(shared_tmp, "half.toml", HALF))]) == 0
+    if MPI.COMM_WORLD.rank == 0:
+        assert (
+            "symmetry   forces of the full model: 2 times the model's, 0 along x (normal to "
+            "the mirror planes)" in capsys.readouterr().out
+        )
