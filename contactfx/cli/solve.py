@@ -69,6 +69,8 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
                 print(f"  {key.replace('_', ' '):<42s}  {value:.6g}")
         for g, values in _last_reactions(scene).items():
             print(f"  reaction on {g:<28s}  " + "  ".join(f"{v:.6g}" for v in values))
+        if scene.spec.output.symmetry_planes:
+            print(f"  {_full_model(scene.spec.output)}")
         if written:
             print(f"  forces per step: {written} (and history.png)")
         print_outputs(res)
@@ -155,6 +157,7 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         if refusal is not None:
             raise ValueError(f"{ns.problem}: {refusal}")
         overlap = max(-least, 0.0), tol
+    dofs = problem.dofs()  # collective (a sum over the ranks): before rank 0 alone prints
     if comm.rank != 0:
         return 0
     pb = scene.spec
@@ -162,7 +165,7 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
     where = (
         f"{pb.mesh.file} (size factor {pb.mesh.size})" if pb.mesh.builder is None else pb.mesh.label
     )
-    print(f"  mesh       {where}, {scene.gdim}D, {problem.dofs()} dofs")
+    print(f"  mesh       {where}, {scene.gdim}D, {dofs} dofs")
     print("  groups     " + scene.group_list())
     # each body's material as the run takes it: its own, or a linear one under numerics.material
     materials = [numerics.bulk_material(body.material) for body in pb.bodies]
@@ -237,4 +240,15 @@ def cmd_check(argv: list[str], petsc_options: dict, comm) -> int:
         print(f"  petsc      {file_petsc}")
     if pb.output.reactions:
         print(f"  output     reactions of {', '.join(pb.output.reactions)}")
+    if pb.output.symmetry_planes:
+        print(f"  symmetry   {_full_model(pb.output)}")
     return 0
+
+
+def _full_model(output) -> str:
+    """How the forces of a model with mirror planes are reported (the full model's)."""
+    axes = ", ".join("xyz"[k] for k in output.symmetry_planes)
+    return (
+        f"forces of the full model: {output.symmetry:g} times the model's, 0 along {axes} "
+        "(normal to the mirror planes)"
+    )

@@ -395,12 +395,13 @@ class _FrictionPost:
         excess = global_sum(self.excess_form, comm)
         stick = global_sum(self.stick_form, comm) * scene.symmetry
         self.accumulate_slip()
+        # the full model's force: the components normal to a mirror plane cancel
+        factors = scene.force_symmetry(len(self.tforce_forms))
         return Friction(
             tangential_force=[
-                global_sum(f, comm) * scene.tangential_symmetry[i]
-                for i, f in enumerate(self.tforce_forms)
+                global_sum(f, comm) * factors[i] + 0.0 for i, f in enumerate(self.tforce_forms)
             ],
-            bound=bound * scene.tangential_symmetry[0],
+            bound=bound * scene.symmetry,
             stick_size=scene.contact_size(stick),
             slip_fraction=1.0 - stick / measure if measure > 0.0 else 0.0,
             excess=excess / bound if bound > 0.0 else excess,

@@ -493,9 +493,11 @@ class TwoBodyPost:
 
     def pair_force(self) -> np.ndarray:
         """The force of the pair on the upper body (the coupling's force on the slave body,
-        with the sign of the slave side), times the scene's symmetry. Collective."""
+        with the sign of the slave side), the full model's (``Scene.force_symmetry``: the
+        components normal to a mirror plane are 0). Collective."""
         sign = 1.0 if self.scene.slave_is_upper else -1.0
-        return sign * self.scene.symmetry * self.pb.coupling().slave_force()
+        force = self.pb.coupling().slave_force()
+        return sign * self.scene.force_symmetry(len(force)) * force + 0.0  # no -0.0
 
     def tangential_nodal_force(self, solver: Solver, local: np.ndarray) -> float:
         """sum_j |f_j - (n_j . f_j) n_j| / sum_j |n_j . f_j| over the slave contact nodes j

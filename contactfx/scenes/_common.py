@@ -49,11 +49,12 @@ def prescribe_component(V, facet_tags, tag: int, component: int, value):
     return _compat.dirichletbc(value, dofs, sub)
 
 
-def reaction_forces(V, facet_tags, tags: dict, reactions, scale: float = 1.0) -> dict:
+def reaction_forces(V, facet_tags, tags: dict, reactions, scale=1.0) -> dict:
     """The force the supports exert on the body on each group of facets: ``tags`` maps a name
     to a facet tag, ``reactions`` is ``solver.reactions()`` (R(u) + F_c(u), nonzero on the
     supported rows at a solution); each group's reaction is the sum of its owned rows, per
-    component, times ``scale`` (the model's symmetry multiplicity, the axisymmetric 2 pi).
+    component, times ``scale`` (a number or one factor per component: the full model's force,
+    ``Scene.force_symmetry``).
     Collective; returns {name: array (components,)}. A node shared by two groups counts in both."""
     values = reactions.getArray()
     n_owned = len(values)  # the owned dofs come first in the local (unrolled) numbering
@@ -67,6 +68,6 @@ def reaction_forces(V, facet_tags, tags: dict, reactions, scale: float = 1.0) ->
         for c in range(components):
             sub = V.sub(c) if V.num_sub_spaces else V
             dofs = np.asarray(_compat.locate_dofs_topological(sub, fdim, facets))
-            total[c] = float(np.sum(values[dofs[dofs < n_owned]])) * scale
-        out[name] = comm.allreduce(total, op=MPI.SUM)
+            total[c] = float(np.sum(values[dofs[dofs < n_owned]]))
+        out[name] = comm.allreduce(total, op=MPI.SUM) * scale + 0.0  # no -0.0
     return out

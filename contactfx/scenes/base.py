@@ -72,6 +72,21 @@ class Scene:
     #: a body of revolution computed on its (r, z) section (x[0] = r >= 0):
     #: :mod:`contactfx.mechanics.axisymmetric`
     axisymmetric: ClassVar[bool] = False
+    #: the axes normal to the model's mirror planes (a quarter model cut by x = 0 and y = 0:
+    #: (0, 1)); the full model's forces have no component along them (:meth:`force_symmetry`)
+    symmetry_planes: ClassVar[tuple[int, ...]] = ()
+
+    def force_symmetry(self, n: int) -> np.ndarray:
+        """The factors (n,) that make a force vector of the modelled part the full model's
+        (docs/architecture.md, "Symmetry"): the multiplicity ``symmetry`` for a component that
+        every mirror plane contains (the mirror images add), 0 for a component normal to a
+        mirror plane (``symmetry_planes``) and for the radial one of a body of revolution (the
+        images cancel). A scalar force (the normal contact force, a bound mu P) takes
+        ``symmetry`` itself."""
+        factors = np.full(n, float(getattr(self, "symmetry", 1.0)))
+        cancel = {*self.symmetry_planes, *((0,) if self.axisymmetric else ())}
+        factors[[k for k in sorted(cancel) if k < n]] = 0.0
+        return factors
 
     def __init__(self, params) -> None:
         self.p = params
@@ -167,10 +182,8 @@ class ObstacleScene(Scene):
 
     problem = ObstacleProblem
     contact_tag: ClassVar[int]
-    #: multiplicity of the modelled part (4 for a quarter model) for forces
+    #: multiplicity of the modelled part (4 for a quarter model) for forces and areas
     symmetry: ClassVar[float] = 1.0
-    #: multiplicity of the modelled part for each tangential force component
-    tangential_symmetry: ClassVar[tuple] = (1.0, 1.0, 1.0)
 
     def obstacle(self) -> Obstacle:
         raise NotImplementedError

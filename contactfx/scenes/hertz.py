@@ -240,8 +240,9 @@ class QuarterBlock(ObstacleScene):
         self.shift = getattr(params, "shift", 0.0)
         self.half = self.shift > 0.0
         self.symmetry = 2.0 if self.half else 4.0
-        # the half model's mirror image doubles F_x and cancels F_y
-        self.tangential_symmetry = (2.0, 0.0, 2.0)
+        # the mirror images add F_z (and F_x of the half model) and cancel F_y (and F_x of
+        # the quarter model)
+        self.symmetry_planes = (1,) if self.half else (0, 1)
 
     def refine_radius(self) -> float:
         raise NotImplementedError
@@ -285,7 +286,7 @@ class QuarterBlock(ObstacleScene):
             },
             "output": {
                 "symmetry": self.symmetry,
-                "tangential_symmetry": list(self.tangential_symmetry),
+                "symmetry_planes": ["xyz"[k] for k in self.symmetry_planes],
             },
         }
 
@@ -355,10 +356,9 @@ class HertzAxi(ObstacleScene):
     Params = HertzAxiParams
     contact_tag = RectangleFacets.TOP
     axisymmetric = True
-    #: forces and areas are 2 pi times their integrals over the section (weighted by r)
+    #: forces and areas are 2 pi times their integrals over the section (weighted by r); the
+    #: radial forces cancel over the revolution (``Scene.force_symmetry``)
     symmetry = 2.0 * np.pi
-    #: the radial tangential tractions cancel over the revolution, the axial ones add
-    tangential_symmetry = (0.0, 2.0 * np.pi, 0.0)
 
     def mesh_builder(self):
         p = self.p

@@ -30,10 +30,11 @@ No closed form: the scores are checks of the discrete solution.
   (:func:`contactfx.scenes._common.reaction_forces`), against the pair's force. The driven top
   carries the pair's force on the sphere (the sphere's internal forces sum to zero):
   ``equilibrium_top`` = |F_top + F_pair| / |F_pair| over the x and z components (the y
-  components are also carried by the symmetry plane); the clamped bottom carries the pair's
-  force on the block, minus that on the sphere: ``equilibrium_bottom`` = |F_bottom - F_pair| /
-  |F_pair|. Both vanish at an exact solution of the discrete equations; they are Newton's
-  residual on the free rows (the solver's tolerance).
+  components are 0: the full model's forces, whose mirror images cancel along y); the clamped
+  bottom carries the pair's force on the block, minus that on the sphere:
+  ``equilibrium_bottom`` = |F_bottom - F_pair| / |F_pair|. Both vanish at an exact solution
+  of the discrete equations; they are Newton's residual on the free rows (the solver's
+  tolerance).
 """
 
 from __future__ import annotations
@@ -110,6 +111,7 @@ class SphereSlide(PressThenDrag):
         "upper": SphereOnBlockFacets.SPHERE_CONTACT,
     }
     symmetry = 2.0
+    symmetry_planes = (1,)  # y = 0
     # the radius of a disc of the closed nodes' area
     size_rule = "disc-radius"
     numerics_defaults = {
@@ -173,10 +175,11 @@ class SphereSlide(PressThenDrag):
         friction history)."""
         r = solver.reactions()
         tags = {"top": self.driven[0], "bottom": self.clamped[0]}
-        reactions = reaction_forces(problem.V, problem.facet_tags, tags, r, self.symmetry)
+        full = self.force_symmetry(3)  # the full model's: F_y cancels
+        reactions = reaction_forces(problem.V, problem.facet_tags, tags, r, full)
         r.destroy()
         sign = 1.0 if self.slave_is_upper else -1.0
-        pair = sign * self.symmetry * problem.coupling().slave_force()
+        pair = sign * full * problem.coupling().slave_force()
         rec = {"load": load, "pair": pair, "curvature": self.curvature(problem), **reactions}
         if problem.friction is not None:
             comm = problem.mesh.comm

@@ -223,6 +223,7 @@ class HertzCylinders(_TwoHertz):
     cells = {"lower": CylindersCells.LOWER, "upper": CylindersCells.UPPER}
     surfaces = {"lower": CylindersFacets.LOWER_CONTACT, "upper": CylindersFacets.UPPER_CONTACT}
     symmetry = 2.0
+    symmetry_planes = (0,)  # x = 0
     # the contact half-width from the two outermost closed nodes (near the edge of a smooth
     # contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a - x)); a lumped
     # measure of the closed nodes would err by up to h / 2
@@ -308,6 +309,7 @@ class HertzSpheres(_TwoHertz):
     cells = {"lower": SpheresCells.LOWER, "upper": SpheresCells.UPPER}
     surfaces = {"lower": SpheresFacets.LOWER_CONTACT, "upper": SpheresFacets.UPPER_CONTACT}
     symmetry = 4.0
+    symmetry_planes = (0, 1)  # x = 0 and y = 0
     # the radius of a disc of the closed nodes' area (the fallback of the edge rule)
     size_rule = "disc-radius"
     # the contact radius from the closed slave nodes: :func:`radial_edge` of their radial

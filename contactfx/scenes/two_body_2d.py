@@ -198,6 +198,7 @@ class PunchFoundation(TwoBodyScene):
         "upper": PunchFoundationFacets.PUNCH_CONTACT,
     }
     symmetry = 2.0
+    symmetry_planes = (0,)  # x = 0
 
     def mesh_builder(self):
         p = self.p
@@ -465,7 +466,8 @@ class CattaneoCylinders(HertzCylinders):
         "stick half-width c / a = sqrt(1 - Q / (mu P))"
     )
     Params = CattaneoCylindersParams
-    symmetry = 1.0
+    symmetry = 1.0  # the whole pair: the shear breaks the mirror symmetry about x = 0
+    symmetry_planes = ()
     numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 8}
 
     # half the distance between the two edges of the contact band (each from the two

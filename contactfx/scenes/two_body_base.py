@@ -128,7 +128,8 @@ class TwoBodyScene(Scene):
     problem = TwoBodyProblem
     cells: ClassVar[dict[str, int]]
     surfaces: ClassVar[dict[str, int]]
-    #: multiplicity of the modelled part for forces and contact measures
+    #: multiplicity of the modelled part for forces and contact measures (2 to the number of
+    #: ``symmetry_planes``)
     symmetry: ClassVar[float] = 1.0
     #: the contact size from the measure m of the closed set (full model): ``half-measure``
     #: m / 2 (a half-width), ``measure`` m, ``disc-radius`` sqrt(m / pi)
@@ -236,13 +237,16 @@ class TwoBodyScene(Scene):
                 pair["edge_ring"] = float(self.edge_ring())
         if self.interference() is not None:
             pair["interference"] = self.interference()
+        output: dict = {"symmetry": float(self.symmetry)}
+        if self.symmetry_planes:
+            output["symmetry_planes"] = ["xyz"[k] for k in self.symmetry_planes]
         return {
             "bodies": [
                 export.body(self.cells[b].name.lower(), mats[b]) for b in ("lower", "upper")
             ],
             "boundary": self.boundary_data(),
             "contact": [pair],
-            "output": {"symmetry": float(self.symmetry), "contact_size": self.size_rule},
+            "output": {**output, "contact_size": self.size_rule},
         }
 
     def reference(self, force: float) -> dict[str, float]:
@@ -267,5 +271,6 @@ class TwoBodyScene(Scene):
     def force_scores(self, loads: np.ndarray, forces: np.ndarray) -> dict[str, float]:
         """Scores from the history of the pair's force on the upper body: ``loads`` (steps,)
         the load factors of the converged steps, ``forces`` (steps, gdim) the force vectors
-        (the sum over the slave nodes of D_j lambda_j n_j, times ``symmetry``)."""
+        (the sum over the slave nodes of D_j lambda_j n_j, the full model's:
+        ``Scene.force_symmetry``)."""
         return {}

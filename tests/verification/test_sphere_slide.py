@@ -57,6 +57,9 @@ def test_sphere_slide_equilibrium(run):
         # 5.7e-9 at the first step of the default mesh)
         assert np.linalg.norm(rec["top"][[0, 2]] + pair) < 1e-8 * scale
         assert np.linalg.norm(rec["bottom"][[0, 2]] - pair) < 1e-8 * scale
+        # the full model's forces (half model on y = 0): their y components cancel
+        assert rec["pair"][1] == rec["top"][1] == rec["bottom"][1] == 0.0
+    assert res.friction.tangential_force[1] == 0.0
     scores = res.scores
     assert scores["equilibrium_top"] < 1e-8 and scores["equilibrium_bottom"] < 1e-8
 

@@ -10,7 +10,8 @@ facet group (plane, circle / cylinder, sphere, parabola / paraboloid, sinusoid, 
 rounded edges, or a signed distance expression; moved by ``motion`` times an amplitude or along
 a ``path``), a contact pair between two bodies, or an interface; then an optional initial
 displacement (Newton's start), the numerics, PETSc options and outputs (reactions, probes, the
-model's symmetry multiplicity)::
+mirror planes of a symmetric part, ``symmetry_planes = ["x", "y"]`` for a quarter model: every
+force is then the full model's, 2^n times the model's along the planes, 0 normal to them)::
 
     [mesh]
     file = "block.geo"                 # relative to the problem file

@@ -65,13 +65,11 @@ class _FileMesh:
         self._constants: list[tuple[dolfinx.fem.Constant, list, np.ndarray]] = []
         self.axisymmetric = problem.mesh.axisymmetric
         # a body of revolution: forces and areas 2 pi times the section's (weighted) integrals;
-        # the radial forces cancel over the revolution, the axial ones add
+        # the radial forces cancel over the revolution, the axial ones add; the components
+        # normal to a mirror plane cancel (Scene.force_symmetry)
         turn = 2.0 * np.pi if self.axisymmetric else 1.0
         self.symmetry = problem.output.symmetry * turn
-        if problem.output.tangential_symmetry is not None:
-            self.tangential_symmetry = tuple(problem.output.tangential_symmetry)
-        elif self.axisymmetric:
-            self.tangential_symmetry = (0.0, turn * problem.output.symmetry, 0.0)
+        self.symmetry_planes = problem.output.symmetry_planes
 
     def _fail(self, key: str, message: str):
         raise ProblemError(f"{self.spec.path}: {key}: {message}")
@@ -94,6 +92,13 @@ class _FileMesh:
         self.cell_tags = data.cell_tags
         self._facet_tags = data.facet_tags
         self._check_groups()
+        for k in self.symmetry_planes:
+            if k >= self.gdim:
+                self._fail(
+                    "output.symmetry_planes",
+                    f"'{AXES[k]}' is no axis of a {self.gdim}D mesh (the axes normal to the "
+                    "mirror planes)",
+                )
         if self.axisymmetric:
             self._check_axisymmetric(data.mesh)
         return data.mesh, data.facet_tags
@@ -312,8 +317,9 @@ class _FileMesh:
     # -- reactions -----------------------------------------------------------------------
     def on_step(self, problem, solver, load: float, quantities) -> None:
         """The step's contact force, the probes, and the reaction force of each group of
-        ``output.reactions``: the force the supports exert on the body there, per component
-        (axisymmetric: totals over the circumference).
+        ``output.reactions``: the force the supports exert on the body there, per component,
+        the full model's like the contact force (``Scene.force_symmetry``: ``symmetry`` times
+        the model's, 0 along the normal of a mirror plane and, axisymmetric, along r).
         At a solution f_int(u) - f_ext + F_c(u) = R, nonzero on the supported dofs only
         (ContactSNES.reactions); R is summed over the group's owned dofs. (The condensed
         mortar rewrites the rows of the slave nodes: a support sharing nodes with a mortar
@@ -324,12 +330,12 @@ class _FileMesh:
             self.reaction_rows.append(row)
             return
         r = solver.reactions()
-        # axisymmetric: the residual is per radian; report the total over the circumference
-        # (Abaqus's convention for CAX elements: the radial one is the sum of the radial
-        # forces all around, whose vector sum vanishes)
-        turn = 2.0 * np.pi if self.axisymmetric else 1.0
+        # the full model's force vector: axisymmetric, the residual is per radian and the
+        # axial total over the circumference 2 pi times it, while the radial forces all
+        # around sum to zero (not Abaqus's CAX convention, the sum of their magnitudes)
         tags = {g: self.groups[g].tag for g in self.spec.output.reactions}
-        forces = reaction_forces(problem.V, self._facet_tags, tags, r, turn)
+        full = self.force_symmetry(self.gdim)
+        forces = reaction_forces(problem.V, self._facet_tags, tags, r, full)
         for g, force in forces.items():
             for c in range(self.gdim):
                 row[f"{g}_{AXES[c]}"] = float(force[c])

@@ -99,7 +99,7 @@ KEYS = {
         "reactions",
         "probes",
         "symmetry",
-        "tangential_symmetry",
+        "symmetry_planes",
         "contact_size",
         "mean_displacement",
     ),
@@ -421,17 +421,48 @@ def read_pair(r: Reader, data: dict, bodies: tuple[BodySpec, ...]) -> PairSpec:
 
 
 def read_output(r: Reader, data: dict) -> OutputSpec:
-    output = r.table(data.get("output", {}), "output", KEYS["output"])
+    raw = data.get("output", {})
+    if isinstance(raw, dict) and "tangential_symmetry" in raw:
+        r.fail(
+            "output.tangential_symmetry",
+            "replaced by symmetry_planes, the axes normal to the mirror planes (e.g. "
+            '["x", "y"] for a quarter model): every force is the full model\'s, its components '
+            "along them 0",
+        )
+    output = r.table(raw, "output", KEYS["output"])
     reactions = output.get("reactions", [])
     if not isinstance(reactions, list) or not all(isinstance(g, str) for g in reactions):
         r.fail("output.reactions", f"expected a list of group names, got {reactions!r}")
     probes = output.get("probes", [])
     if not isinstance(probes, list) or not all(numbers(q, (2, 3)) for q in probes):
         r.fail("output.probes", f"expected a list of points [x, y(, z)], got {probes!r}")
-    symmetry = r.number(output, "output", "symmetry", 1.0, positive=True)
-    tsym = output.get("tangential_symmetry")
-    if tsym is not None and not numbers(tsym):
-        r.fail("output.tangential_symmetry", f"expected a list of numbers, got {tsym!r}")
+    planes = output.get("symmetry_planes", [])
+    if (
+        not isinstance(planes, list)
+        or not all(isinstance(a, str) and a in AXES for a in planes)
+        or len(set(planes)) != len(planes)
+    ):
+        r.fail(
+            "output.symmetry_planes",
+            "expected a list of distinct axes normal to the mirror planes, e.g. "
+            f'["x", "y"] for a quarter model cut by x = 0 and y = 0, got {planes!r}',
+        )
+    # each mirror plane doubles the model
+    full = 2.0 ** len(planes)
+    symmetry = r.number(output, "output", "symmetry", full, positive=True)
+    if planes and symmetry != full:
+        r.fail(
+            "output.symmetry",
+            f"{symmetry:g} with {len(planes)} mirror plane(s) in symmetry_planes: each "
+            f"doubles the model, so {full:g} (or leave symmetry out)",
+        )
+    if symmetry != 1.0 and not planes:
+        r.fail(
+            "output.symmetry",
+            f"{symmetry:g} needs the mirror planes: symmetry_planes = [...], the axes normal "
+            'to them (["x", "y"] for a quarter model cut by x = 0 and y = 0; the full '
+            "model's force components along them are 0)",
+        )
     mean = output.get("mean_displacement", {})
     if not isinstance(mean, dict) or not all(
         isinstance(v, list) and len(v) == 2 and isinstance(v[0], str) and v[1] in AXES
@@ -449,7 +480,7 @@ def read_output(r: Reader, data: dict) -> OutputSpec:
         tuple(reactions),
         tuple(tuple(float(v) for v in q) for q in probes),
         symmetry,
-        None if tsym is None else tuple(float(v) for v in tsym),
+        tuple(AXES.index(a) for a in planes),
         size,
         {name: (v[0], v[1]) for name, v in mean.items()},
     )

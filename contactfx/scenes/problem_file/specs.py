@@ -155,13 +155,14 @@ class InterfaceSpec:
 
 @dataclass(frozen=True)
 class OutputSpec:
-    """``[output]``: reactions per group, probe points, the model's symmetry multiplicity, the
-    contact size rule, mean displacements over facet groups."""
+    """``[output]``: reactions per group, probe points, the model's symmetry multiplicity and
+    its mirror planes (the axes normal to them), the contact size rule, mean displacements
+    over facet groups."""
 
     reactions: tuple[str, ...] = ()
     probes: tuple[tuple[float, ...], ...] = ()
     symmetry: float = 1.0
-    tangential_symmetry: tuple[float, ...] | None = None
+    symmetry_planes: tuple[int, ...] = ()
     contact_size: str | None = None
     mean_displacement: dict[str, tuple[str, str]] = field(default_factory=dict)
 
