@@ -377,6 +377,7 @@ def test_rigid_rotation_is_objective(objective):
         assert dt > 0.5 and dP > 1e-3 and dF > 1e-4
 
 
+@pytest.mark.serial_only  # two runs on one rank each (points compared one by one)
 def test_rigid_rotation_nitsche_friction():
     """Nitsche with Coulomb friction on the rotated patch. Its stick is regularised by the
     step's slip (t = T_T(u) - gamma slip below the bound): the pressed interface keeps
@@ -414,6 +415,7 @@ def test_rigid_rotation_nitsche_friction():
         assert np.max(np.abs(F - h["F"])) < 1e-8
 
 
+@pytest.mark.serial_only  # two runs on one rank each (points compared one by one)
 @pytest.mark.parametrize("method", ["penalty", "nitsche"])
 def test_rigid_spin_about_the_normal_is_objective(method):
     """3D: the rotated patch spun by 90 degrees about the interface's normal (the vertical
