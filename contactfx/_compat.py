@@ -38,6 +38,7 @@ __all__ = [
     "quadrature_space",
     "quadrature_rule",
     "eval_expression",
+    "geometry_nodes",
     "cell_coordinates",
     "numpy_math",
     "ufl_math",
@@ -221,14 +222,20 @@ def eval_expression(expr: dolfinx.fem.Expression, mesh, cells: np.ndarray) -> np
     return expr.eval(mesh, cells) if _NEW else expr.eval(cells)
 
 
-def cell_coordinates(mesh) -> np.ndarray:
-    """(cells incl. ghosts, nodes per cell, gdim): the coordinates of every local cell's
-    geometry nodes (its vertices for an affine mesh)."""
+def geometry_nodes(mesh) -> np.ndarray:
+    """(cells incl. ghosts, nodes per cell): the indices into ``mesh.geometry.x`` of every local
+    cell's geometry nodes (0.9: an array already; 0.5: an adjacency list)."""
     dofmap = mesh.geometry.dofmap
     if not isinstance(dofmap, np.ndarray):
         n = dofmap.links(0).size if dofmap.num_nodes else 0
         dofmap = dofmap.array.reshape(-1, n)
-    return mesh.geometry.x[dofmap][:, :, : mesh.geometry.dim]
+    return dofmap
+
+
+def cell_coordinates(mesh) -> np.ndarray:
+    """(cells incl. ghosts, nodes per cell, gdim): the coordinates of every local cell's
+    geometry nodes (its vertices for an affine mesh)."""
+    return mesh.geometry.x[geometry_nodes(mesh)][:, :, : mesh.geometry.dim]
 
 
 def entity_coordinates(mesh, dim: int, entities: np.ndarray) -> np.ndarray:

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from contactfx import _compat
 from contactfx.scenes.problem_file import FileTwoBodyScene, load_problem
 
 #: the rings: inner a < b, outer b - DELTA < c (radial interference DELTA), E, nu
@@ -288,12 +289,7 @@ class _FitPatch:
             def build_mesh(self, comm):
                 mesh, facet_tags = super().build_mesh(comm)
                 upper = self.cell_tags.indices[self.cell_tags.values == self.cells["upper"]]
-                dofmap = mesh.geometry.dofmap
-                nodes = np.unique(
-                    np.concatenate([dofmap.links(c) for c in upper])
-                    if len(upper)
-                    else np.zeros(0, dtype=np.int32)
-                )
+                nodes = np.unique(_compat.geometry_nodes(mesh)[upper])
                 mesh.geometry.x[nodes, dim - 1] += lift
                 return mesh, facet_tags
 
