@@ -448,6 +448,10 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
+#: how many times gmsh may split intersecting edges and mesh again before a .geo is refused
+MAX_RETRIES = 20
+
+
 def _mesh_geo(geo: Path, msh: Path, size_factor: float) -> None:
     """Mesh ``geo`` into ``msh`` in a child process (``_gmsh_child.py``); raise ValueError
     "GEO: gmsh failed: MESSAGE" with gmsh's last error (and its last note of a problem, e.g.
@@ -458,16 +462,27 @@ def _mesh_geo(geo: Path, msh: Path, size_factor: float) -> None:
     script = Path(__file__).with_name("_gmsh_child.py")
     # no MPI state of this process: the child is a plain process, not an MPI singleton
     env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX_", "PRTE_"))}
-    proc = subprocess.run(
+    proc = subprocess.Popen(
         [sys.executable, str(script), str(geo), str(msh), repr(float(size_factor))],
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
         text=True,
         env=env,
-        check=False,
     )
+    assert proc.stdout is not None
+    lines, retries = [], 0
+    for line in proc.stdout:
+        lines.append(line.rstrip("\n"))
+        # gmsh 4.13 meets a self-intersecting loop by splitting the intersecting edges and
+        # meshing again, without end (gmsh 4.8 terminates): a recovery that keeps failing
+        if "trying again" in line:
+            retries += 1
+            if retries > MAX_RETRIES:
+                proc.kill()
+                break
+    proc.wait()
     if proc.returncode == 0 and msh.is_file():
         return
-    lines = (proc.stdout + proc.stderr).splitlines()
     errors = [ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("Error")]
     notes = [ln.split(":-(", 1)[1].strip() for ln in lines if ":-(" in ln]
     message = "; ".join(dict.fromkeys(notes[-1:] + errors[-1:]))
