@@ -223,10 +223,9 @@ class HertzCylinders(_TwoHertz):
     cells = {"lower": CylindersCells.LOWER, "upper": CylindersCells.UPPER}
     surfaces = {"lower": CylindersFacets.LOWER_CONTACT, "upper": CylindersFacets.UPPER_CONTACT}
     symmetry = 2.0
-    # the contact half-width from the two outermost closed nodes (near the edge of a smooth
-    # contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a - x)); a lumped
-    # measure of the closed nodes would err by up to h / 2
-    edge_rule = "x-max"
+    # the contact half-width from the zero contour of p - (E / h) g (the default of every
+    # pair, :class:`contactfx.contact_edge.ContourMeasure`); edge = "x-max" in a problem file
+    # extrapolates p^2 from the two outermost closed nodes instead
 
     def mesh_builder(self):
         p = self.p
@@ -308,11 +307,8 @@ class HertzSpheres(_TwoHertz):
     cells = {"lower": SpheresCells.LOWER, "upper": SpheresCells.UPPER}
     surfaces = {"lower": SpheresFacets.LOWER_CONTACT, "upper": SpheresFacets.UPPER_CONTACT}
     symmetry = 4.0
-    # the radius of a disc of the closed nodes' area (the fallback of the edge rule)
+    # the radius of the disc of the area enclosed by the zero contour of p - (E / h) g
     size_rule = "disc-radius"
-    # the contact radius from the closed slave nodes: :func:`radial_edge` of their radial
-    # distances sqrt(x^2 + y^2), rings of the slave element size
-    edge_rule = "radial"
 
     def mesh_builder(self):
         p = self.p
