@@ -212,15 +212,21 @@ class ContourMeasure:
 
 
 def facet_dofs(Q1, facets: np.ndarray) -> np.ndarray:
-    """(owned facets, nodes): the P1 space Q1's dofs of the owned ones among the local
-    ``facets`` (each facet once over the ranks)."""
-    import dolfinx
-
+    """(owned facets, nodes): the P1 space Q1's dofs of the vertices of the owned ones among
+    the local ``facets`` (each facet once over the ranks), through a cell of each (a P1 cell's
+    dofs follow its vertices)."""
     mesh = Q1.mesh
-    fdim = mesh.topology.dim - 1
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
     owned = mesh.topology.index_map(fdim).size_local
     facets = np.asarray(facets)[np.asarray(facets) < owned]
-    dofs = [
-        dolfinx.fem.locate_dofs_topological(Q1, fdim, np.array([f], dtype=np.int32)) for f in facets
-    ]
-    return np.array(dofs, dtype=np.int64).reshape(len(facets), -1)
+    for d0, d1 in ((fdim, tdim), (fdim, 0), (tdim, 0)):
+        mesh.topology.create_connectivity(d0, d1)
+    f2c, f2v = mesh.topology.connectivity(fdim, tdim), mesh.topology.connectivity(fdim, 0)
+    c2v = mesh.topology.connectivity(tdim, 0)
+    rows = []
+    for f in facets:
+        cell = f2c.links(f)[0]
+        dof_of = dict(zip(c2v.links(cell), Q1.dofmap.cell_dofs(cell), strict=True))
+        rows.append([dof_of[v] for v in f2v.links(f)])
+    return np.array(rows, dtype=np.int64).reshape(len(facets), -1)
