@@ -71,7 +71,8 @@ class TwoBodyScene(Scene):
     edge_rule: ClassVar[str | None] = None
     #: run.json's h_contact is the element size in the contact zone measured at the last step
     #: (the mean longest edge of the slave facets with a closed node), not :meth:`h_contact`
-    h_contact_in_zone: ClassVar[bool] = False
+    #: (which scales the methods' parameters and the closed forms' a_error_over_h)
+    h_contact_in_zone: ClassVar[bool] = True
 
     @property
     def slave_tag(self) -> int:

@@ -452,10 +452,6 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
     problem is finite strain when either is hyperelastic, and a linear body then keeps its
     small-strain stress (:mod:`contactfx.driver.two_body`), which the summary notes."""
 
-    # run.json's h_contact: the slave element size where the pair closed (the pair's h, the
-    # longest facet of both contact groups, scales the methods' parameters)
-    h_contact_in_zone = True
-
     def __init__(self, problem: ProblemFile) -> None:
         super().__init__(problem)
         linear = [b.group for b in problem.bodies if not b.material.finite_strain]
