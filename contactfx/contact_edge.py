@@ -153,7 +153,7 @@ class ContourMeasure:
     """
 
     def __init__(self, dofs: np.ndarray, x: np.ndarray, axisymmetric: bool = False) -> None:
-        self.dofs = np.asarray(dofs, dtype=np.int64).reshape(len(dofs), -1)
+        self.dofs = np.asarray(dofs, dtype=np.int64)
         self.pts = x[self.dofs]
         nv = self.dofs.shape[1]
         #: segments and triangles (the contour of quadrilateral facets is not implemented)
@@ -229,4 +229,6 @@ def facet_dofs(Q1, facets: np.ndarray) -> np.ndarray:
         cell = f2c.links(f)[0]
         dof_of = dict(zip(c2v.links(cell), Q1.dofmap.cell_dofs(cell), strict=True))
         rows.append([dof_of[v] for v in f2v.links(f)])
-    return np.array(rows, dtype=np.int64).reshape(len(facets), -1)
+    if not rows:  # no owned contact facet on this rank
+        return np.zeros((0, fdim + 1), dtype=np.int64)
+    return np.array(rows, dtype=np.int64)
