@@ -25,6 +25,7 @@ from contactfx import _compat
 from contactfx.contact.gap import ContactSurface
 from contactfx.contact.laws import active, positive_part
 from contactfx.contact.surface import Expr
+from contactfx.contact_edge import ContourMeasure, facet_dofs
 from contactfx.driver.fields import (
     NodalProjection,
     global_sum,
@@ -227,6 +228,11 @@ class ObstaclePost:
         mesh, s, method, gdim = pb.mesh, pb.surface, pb.method, pb.gdim
         self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
         self.nodal = NodalProjection(pb.dsc, self.Q1)
+        self.contour = ContourMeasure(
+            facet_dofs(self.Q1, pb.contact_facets),
+            _compat.dof_coordinates(self.Q1),
+            pb.scene.axisymmetric,
+        )
         self.pressure = dolfinx.fem.Function(self.Q1, name="contact_pressure")
         self.gap = dolfinx.fem.Function(self.Q1, name="gap")
         self.status = dolfinx.fem.Function(self.Q1, name="contact_status")
@@ -275,9 +281,17 @@ class ObstaclePost:
         friction = None
         if self.friction is not None:
             friction = self.friction.evaluate(measure)
+        # the contact size from the zero contour of p - (E / h) g (the closed set's measure
+        # above stays the friction's)
+        contour = measure
+        if self.comm.allreduce(self.contour.supported, op=MPI.LAND):
+            p, g = self.pressure.x.array, self.gap.x.array
+            nu = self.scene.material().nu  # E* against the rigid obstacle
+            local = self.contour(p, g, self.scene.contact_modulus() / (1.0 - nu**2))
+            contour = self.comm.allreduce(local, op=MPI.SUM) * self.scene.symmetry
         return Quantities(
             force=force * self.scene.symmetry,
-            contact_size=self.scene.contact_size(measure),
+            contact_size=self.scene.contact_size(contour),
             peak_pressure=peak,
             max_penetration=penetration,
             complementarity=complementarity,

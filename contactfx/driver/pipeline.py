@@ -371,6 +371,8 @@ class _Run:
     def record(
         self, problem: Problem, mesh: Any, steps: list[StepLog], extra: dict[str, Any]
     ) -> RunSummary:
+        # a problem file's pair: the element size in the contact zone (post-processor's)
+        h_contact = extra.pop("h_contact", None) or self.scene.h_contact()
         summary = RunSummary(
             scene=self.scene.name,
             parameters=dataclasses.asdict(self.scene.p),
@@ -381,7 +383,7 @@ class _Run:
             ranks=self.comm.size,
             dofs=problem.dofs(),
             cells=mesh.topology.index_map(mesh.topology.dim).size_global,
-            h_contact=self.scene.h_contact(),
+            h_contact=h_contact,
             steps=steps,
             timings=dict(self.timings),
             quantities=steps[-1].quantities,

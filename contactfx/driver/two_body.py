@@ -54,6 +54,7 @@ from contactfx.contact.coupling import NodeLayout
 from contactfx.contact.laws import Coulomb, Tresca
 from contactfx.contact.pair import ContactPair, Side, side_of
 from contactfx.contact.point_coupling import nitsche_finite_strain_refusal
+from contactfx.contact_edge import ContourMeasure, check_edge_rule, facet_dofs
 from contactfx.driver.fields import nodal_contact
 from contactfx.driver.interface_post import pyplot
 from contactfx.driver.obstacle import closed_form_errors
@@ -188,6 +189,7 @@ class TwoBodyProblem(Problem):
             count = comm.allreduce(int(np.sum(self.facet_tags.values == tag)), op=MPI.SUM)
             if count == 0:
                 raise ValueError(f"the {what} surface (facet tag {tag}) has no facet")
+        self.check_edge_rule()
         self.layout = NodeLayout(self.V)
         n_dofs = self.layout.n_owned * self.layout.bs
         fixed = np.zeros(n_dofs, dtype=bool)  # owned Dirichlet dofs (symmetry planes, rollers)
@@ -386,6 +388,18 @@ class TwoBodyProblem(Problem):
                     "be singular"
                 )
 
+    def check_edge_rule(self) -> None:
+        """Refuse a contact edge rule that does not apply to the slave surface (x-band on a
+        half or quarter model) in one line, before the solve. Collective."""
+        rule = self.scene.contact_edge_rule()
+        if rule is None:
+            return
+        fdim = self.mesh.topology.dim - 1
+        facets = self.facet_tags.indices[self.facet_tags.values == self.scene.slave_tag]
+        x = _compat.entity_coordinates(self.mesh, fdim, facets).reshape(-1, self.mesh.geometry.dim)
+        x_all = np.concatenate(self.mesh.comm.allgather(x))
+        check_edge_rule(rule, x_all, self.mesh.geometry.dim, "contact.0.edge")
+
     def post_processor(self) -> TwoBodyPost:
         return TwoBodyPost(self)
 
@@ -428,6 +442,12 @@ class TwoBodyPost:
         bc_rows = [_compat.bc_dofs(bc) for bc in pb.bcs]
         rows = np.unique(np.concatenate(bc_rows)) if bc_rows else np.zeros(0, dtype=np.int64)
         self.bc_rows = rows[rows < n]
+        # the owned slave facets' P1 nodes and their longest edges (the contact zone's size)
+        self.contour = ContourMeasure(facet_dofs(self.Q1, pb.contact_facets), self.x)
+        self.contour.supported = self.comm.allreduce(self.contour.supported, op=MPI.LAND)
+        self.facet_dofs, self.facet_size = self.contour.dofs, self.contour.size
+        #: the contact zone's element size at the last evaluated step
+        self.zone_size = 0.0
 
     def evaluate(self, solver: Solver) -> Quantities:
         nodes, D, lam, gap = self.pb.coupling().nodal()
@@ -454,11 +474,18 @@ class TwoBodyPost:
         sym = self.scene.symmetry
         force = self.pb.coupling().force() * sym
         measure = self.comm.allreduce(float(np.sum(D[closed[local]])), op=MPI.SUM) * sym
+        if self.contour.supported:  # the zero contour of p - (E / h) g (else the closed nodes')
+            E = self.scene.pair_modulus()
+            contour = self.contour(self.pressure.x.array, self.gap.x.array, E)
+            measure = self.comm.allreduce(contour, op=MPI.SUM) * sym
         size = self.scene.contact_size(measure)
-        x = self.x[local][closed[local]]
-        x_all = np.concatenate(self.comm.allgather(x))
-        p_all = np.concatenate(self.comm.allgather(lam[closed[local]]))
-        edge = self.scene.contact_edge(x_all, p_all)
+        edge = None
+        if self.scene.contact_edge_rule() is not None:  # every slave node, closed and open
+            x_all = np.concatenate(self.comm.allgather(self.x[local]))
+            p_all = np.concatenate(self.comm.allgather(lam))
+            c_all = np.concatenate(self.comm.allgather(closed[local]))
+            edge = self.scene.contact_edge(x_all, p_all, c_all)
+        self.zone_size = self.contact_zone_size(closed)
         self.history.append((float(self.pb.tload.value), self.pair_force()))
         self.tangential.append(self.tangential_nodal_force(solver, local))
         return Quantities(
@@ -469,6 +496,14 @@ class TwoBodyPost:
             complementarity=complementarity,
             friction=self.friction(),
         )
+
+    def contact_zone_size(self, closed: np.ndarray) -> float:
+        """The element size in the contact zone: the mean longest edge of the slave facets
+        with a closed node (0 with none closed). Collective."""
+        touching = np.any(closed[self.facet_dofs], axis=1) if len(self.facet_dofs) else []
+        total = self.comm.allreduce(float(np.sum(self.facet_size[touching])), op=MPI.SUM)
+        count = self.comm.allreduce(int(np.count_nonzero(touching)), op=MPI.SUM)
+        return total / count if count else 0.0
 
     def friction(self) -> Friction | None:
         """Coulomb friction of the pair: the tangential force on the upper body (the last
@@ -573,7 +608,11 @@ class TwoBodyPost:
                     comments="",
                     header=header,
                 )
+        extra: dict[str, Any] = {}
+        if self.scene.h_contact_in_zone and self.zone_size > 0.0:
+            extra["h_contact"] = self.zone_size
         return {
+            **extra,
             "reference": reference,
             "scores": scores,
             "errors": {},

@@ -224,10 +224,9 @@ class HertzCylinders(_TwoHertz):
     surfaces = {"lower": CylindersFacets.LOWER_CONTACT, "upper": CylindersFacets.UPPER_CONTACT}
     symmetry = 2.0
     symmetry_planes = (0,)  # x = 0
-    # the contact half-width from the two outermost closed nodes (near the edge of a smooth
-    # contact p^2 falls linearly with the distance to the edge, p ~ sqrt(a - x)); a lumped
-    # measure of the closed nodes would err by up to h / 2
-    edge_rule = "x-max"
+    # the contact half-width from the zero contour of p - (E / h) g (the default of every
+    # pair, :class:`contactfx.contact_edge.ContourMeasure`); edge = "x-max" in a problem file
+    # extrapolates p^2 from the two outermost closed nodes instead
 
     def mesh_builder(self):
         p = self.p
@@ -310,11 +309,8 @@ class HertzSpheres(_TwoHertz):
     surfaces = {"lower": SpheresFacets.LOWER_CONTACT, "upper": SpheresFacets.UPPER_CONTACT}
     symmetry = 4.0
     symmetry_planes = (0, 1)  # x = 0 and y = 0
-    # the radius of a disc of the closed nodes' area (the fallback of the edge rule)
+    # the radius of the disc of the area enclosed by the zero contour of p - (E / h) g
     size_rule = "disc-radius"
-    # the contact radius from the closed slave nodes: :func:`radial_edge` of their radial
-    # distances sqrt(x^2 + y^2), rings of the slave element size
-    edge_rule = "radial"
 
     def mesh_builder(self):
         p = self.p

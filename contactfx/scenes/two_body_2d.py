@@ -470,9 +470,7 @@ class CattaneoCylinders(HertzCylinders):
     symmetry_planes = ()
     numerics_defaults = {"friction": "coulomb", "mu": 0.3, "steps": 8}
 
-    # half the distance between the two edges of the contact band (each from the two
-    # outermost closed nodes on its side, as :class:`HertzCylinders`)
-    edge_rule = "x-band"
+    # half the length of the contact band inside the zero contour of p - (E / h) g
 
     def mesh_builder(self):
         p = self.p

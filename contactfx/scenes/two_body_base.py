@@ -12,6 +12,7 @@ import dolfinx
 import numpy as np
 
 from contactfx import _compat
+from contactfx.contact_edge import CONTACT_EDGES, contact_edge, line_edge, radial_edge
 from contactfx.driver.two_body import TwoBodyProblem
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import build
@@ -29,71 +30,9 @@ __all__ = [
     "INTERFERENCES",
 ]
 
-#: the rules of :func:`contact_edge`
-CONTACT_EDGES = ("x-max", "x-band", "radial")
 #: what ``contact.interference`` may name: ``ramp`` removes an initial overlap of the pair
 #: progressively over the load program (:class:`contactfx.driver.two_body.TwoBodyProblem`)
 INTERFERENCES = ("ramp",)
-
-
-def line_edge(s: np.ndarray, p: np.ndarray) -> float | None:
-    """The edge of a smooth contact on the side of growing s from the closed nodes at s with
-    the pressures p > 0: the zero of the straight line through (s, p^2) at the two outermost
-    closed nodes (near the edge of a smooth contact p^2 falls linearly with the distance to
-    the edge, p ~ sqrt(a - s)); a lumped measure of the closed nodes would err by up to h / 2.
-    None with fewer than two closed nodes."""
-    if len(s) < 2:
-        return None
-    order = np.argsort(s)
-    (x1, x2), (p1, p2) = s[order][-2:], p[order][-2:]
-    if not p1 > p2:
-        return float(x2)
-    return float(x2 + p2**2 * (x2 - x1) / (p1**2 - p2**2))
-
-
-def radial_edge(r: np.ndarray, p: np.ndarray, width: float) -> float | None:
-    """The radius of a round contact area from its closed nodes at the radii r with the
-    pressures p > 0: the closed nodes are binned in rings of ``width`` (the slave element
-    size), each ring gives its mean radius and mean p^2, and the straight line of p^2 through
-    the two outermost rings is extrapolated to zero (near the edge of a smooth contact p^2 falls
-    linearly with the distance to the edge; for Hertz p^2 = p0^2 (1 - r^2 / a^2) exactly
-    linear in r^2, and the line in r errs by O((width / a)^2)). Averaging over a ring of nodes
-    smooths the scatter of single nodes of an unstructured surface mesh. None with fewer than
-    two rings."""
-    if len(r) == 0:
-        return None
-    ring = np.floor(r / width).astype(np.int64)
-    rings, inv = np.unique(ring, return_inverse=True)
-    if len(rings) < 2:
-        return None
-    count = np.bincount(inv)
-    r_mean = np.bincount(inv, weights=r) / count
-    p2_mean = np.bincount(inv, weights=p**2) / count
-    (r1, r2), (q1, q2) = r_mean[-2:], p2_mean[-2:]
-    if not q1 > q2:
-        return float(r2)
-    return float(r2 + q2 * (r2 - r1) / (q1 - q2))
-
-
-def contact_edge(
-    rule: str | None, x: np.ndarray, p: np.ndarray, ring: float | None = None
-) -> float | None:
-    """The contact half-width / radius from the slave nodes x (all ranks) with the pressures
-    p by the rule: ``x-max`` the edge on the side of growing x (:func:`line_edge`; a symmetric
-    contact modelled on x >= 0), ``x-band`` half the distance between the edges on both sides
-    in x (a contact band that may move), ``radial`` the radius from rings of width ``ring``
-    about the axis x = y = 0 (:func:`radial_edge`); None (no rule, or too few closed nodes)
-    for the measure of the closed nodes."""
-    closed = p > 0.0
-    xc, pc = x[closed], p[closed]
-    if rule == "x-max":
-        return line_edge(xc[:, 0], pc)
-    if rule == "x-band":
-        right, left = line_edge(xc[:, 0], pc), line_edge(-xc[:, 0], pc)
-        return None if right is None or left is None else 0.5 * (right + left)
-    if rule == "radial":
-        return radial_edge(np.hypot(xc[:, 0], xc[:, 1]), pc, ring)
-    return None
 
 
 def two_elastic(E0: float, nu0: float) -> type:
@@ -136,6 +75,10 @@ class TwoBodyScene(Scene):
     size_rule: ClassVar[str] = "half-measure"
     #: the rule of :func:`contact_edge` (None: the contact size from the measure)
     edge_rule: ClassVar[str | None] = None
+    #: run.json's h_contact is the element size in the contact zone measured at the last step
+    #: (the mean longest edge of the slave facets with a closed node), not :meth:`h_contact`
+    #: (which scales the methods' parameters and the closed forms' a_error_over_h)
+    h_contact_in_zone: ClassVar[bool] = True
 
     @property
     def slave_tag(self) -> int:
@@ -159,6 +102,11 @@ class TwoBodyScene(Scene):
     def material(self) -> Elastic:
         """The slave body's material (it scales the methods' parameters)."""
         return self.materials()[self.p.slave]
+
+    def pair_modulus(self) -> float:
+        """The pair's contact modulus E* = 1 / sum (1 - nu^2) / E over its two bodies (it
+        scales the gap in the contour of the contact size)."""
+        return 1.0 / sum((1.0 - m.nu**2) / m.E for m in self.materials().values())
 
     def mesh_of(self, comm, builder, gdim: int):
         data = build(comm, builder, gdim, self.name)
@@ -199,10 +147,15 @@ class TwoBodyScene(Scene):
         """The ring width of the ``radial`` edge rule (the slave element size)."""
         return None
 
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
+    def contact_edge_rule(self) -> str | None:
+        """The rule of :func:`contact_edge` (None: the contact size from the measure)."""
+        return self.edge_rule
+
+    def contact_edge(self, x: np.ndarray, p: np.ndarray, closed: np.ndarray) -> float | None:
         """The contact half-width / radius from the slave nodes of every rank (coordinates x,
-        pressures p) by :attr:`edge_rule`, or None for the measure of the closed nodes."""
-        return contact_edge(self.edge_rule, x, p, self.edge_ring())
+        nodal pressures p, the closed ones marked) by :meth:`contact_edge_rule`, or None for
+        the measure of the closed nodes."""
+        return contact_edge(self.contact_edge_rule(), x, p, self.edge_ring(), closed)
 
     # -- the scene as a problem file ----------------------------------------------------------
     def build_mesh(self, comm):

@@ -51,7 +51,9 @@ def test_nested_uzawa_carries_the_multiplier():
     iterations), the converged solution is the same to the Uzawa tolerance 1e-8."""
     plain, chain = _pair(FINE, 1, method="al-uzawa")
     assert chain.force == pytest.approx(plain.force, rel=1e-7)
-    assert chain.contact_size == pytest.approx(plain.contact_size, rel=1e-12)
+    # the contact size follows p and g continuously (the zero contour of p - (E* / h) g; the
+    # closed set's measure was the same to the bit): 6e-11 apart
+    assert chain.contact_size == pytest.approx(plain.contact_size, rel=1e-9)
     assert chain.outer_iterations < plain.outer_iterations
 
 

@@ -31,7 +31,7 @@ from contactfx.scenes.interface_base import InterfaceScene
 from contactfx.scenes.problem_file.expressions import DistanceObstacle
 from contactfx.scenes.problem_file.reader import ProblemError, Reader, amplitude_at
 from contactfx.scenes.problem_file.specs import AXES, ProblemFile
-from contactfx.scenes.two_body_base import TwoBodyScene, contact_edge
+from contactfx.scenes.two_body_base import TwoBodyScene
 
 __all__ = ["FileParams", "FileObstacleScene", "FileTwoBodyScene", "FileInterfaceScene"]
 
@@ -484,6 +484,7 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
                 f"the surface must bound one body, it bounds {sorted(bodies) or 'none'}",
             )
         self._slave_body = bodies[0]
+        self._master_bodies = self._bodies_touching(mesh, facet_tags, self._master)
         return mesh, facet_tags
 
     # (before the mesh is read the tags are unknown; the file's names were checked distinct)
@@ -519,10 +520,21 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
         """``contact.interference``: how an initial overlap of the pair is taken."""
         return self.spec.pair.interference
 
-    def contact_edge(self, x: np.ndarray, p: np.ndarray) -> float | None:
-        """The contact size by the rule ``contact.edge`` (:func:`contact_edge`), else None
-        (the measure rule of ``output.contact_size``)."""
-        return contact_edge(self.spec.pair.edge, x, p, self.spec.pair.edge_ring)
+    def pair_modulus(self) -> float:
+        """E* of the slave body and the master surface's body (the stiffest if it bounds
+        several)."""
+        m = self.materials()
+        slave = m[self._slave_body]
+        master = max((m[b] for b in self._master_bodies), key=lambda e: e.E, default=slave)
+        return 1.0 / sum((1.0 - e.nu**2) / e.E for e in (slave, master))
+
+    def contact_edge_rule(self) -> str | None:
+        """The rule ``contact.edge`` (:func:`contact_edge`), else None (the measure rule of
+        ``output.contact_size``)."""
+        return self.spec.pair.edge
+
+    def edge_ring(self) -> float | None:
+        return self.spec.pair.edge_ring
 
 
 class FileInterfaceScene(_FileMesh, InterfaceScene):
