@@ -23,7 +23,16 @@ LAYERS = [
     {"driver"},
     {"numerics"},
     {"contact", "mechanics", "solvers", "io"},
-    {"params", "results", "references", "_compat", "jit_cache", "meshes", "__init__"},
+    {
+        "params",
+        "results",
+        "references",
+        "_compat",
+        "jit_cache",
+        "contact_edge",
+        "meshes",
+        "__init__",
+    },
 ]
 
 
