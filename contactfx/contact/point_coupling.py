@@ -270,6 +270,23 @@ class _Directed:
 KEEP_BEYOND = 0.1
 
 
+def _candidates(xq: np.ndarray, near: Facets, padding: np.ndarray) -> np.ndarray:
+    """(n, width) the facets of ``near`` whose bounding box padded by ``padding`` (per facet)
+    holds each point of ``xq`` (-1: none)."""
+    from contactfx import _compat
+
+    tree = _compat.FacetTree(near.x, padding)  # type: ignore[arg-type]
+    rows, facets = tree.collide_points(xq)
+    counts = np.bincount(rows, minlength=len(xq))
+    width = max(int(counts.max(initial=0)), 1)
+    cand = -np.ones((len(xq), width), dtype=np.int64)
+    order = np.argsort(rows, kind="stable")
+    rows, facets = rows[order], facets[order]
+    slot = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
+    cand[rows, slot] = facets
+    return cand
+
+
 def _on_rim(closest: np.ndarray, index: np.ndarray, near: Facets) -> np.ndarray:
     """(n,) bool: the closest points ``closest`` (n, gdim) on the master facets ``index`` (n,)
     of ``near`` lie on the boundary of the master surface (a point beyond it, not in
@@ -487,7 +504,6 @@ class PointCoupling:
         """The master facet of each point (index -1: not in contact). ``kept``: (n, d)
         the sorted global nodes of each point's facet at the last search (-1: none), kept
         while the point projects inside it (:meth:`_keep_facets`)."""
-        from contactfx import _compat
 
         n, d = xq.shape
         if n == 0 or len(near) == 0:  # nothing to project, or nothing near: no contact
@@ -501,20 +517,22 @@ class PointCoupling:
                 np.full(n, np.nan),
             )
         # FacetTree takes a padding per facet too (its docstring; the annotation says float)
-        tree = _compat.FacetTree(near.x, near.diameters())  # type: ignore[arg-type]
-        rows, facets = tree.collide_points(xq)
-        counts = np.bincount(rows, minlength=len(xq))
-        width = max(int(counts.max(initial=0)), 1)
-        cand = -np.ones((len(xq), width), dtype=np.int64)
-        order = np.argsort(rows, kind="stable")
-        rows, facets = rows[order], facets[order]
-        slot = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
-        cand[rows, slot] = facets
+        cand = _candidates(xq, near, near.diameters())
         # ties (a point equally far from facets sharing an edge or a vertex, to round-off) go
         # to the facet first in the order of the reference coordinates: the same choice on
         # every partition (the candidates' order and the global numbers depend on it)
         key = None if near.X is None else facet_order(near.X)
         pick = pick_closest(xq, cand, near.x, fallback=True, key=key)
+        off = (pick.index >= 0) & ~pick.inside
+        if np.any(off):
+            # a point whose closest candidate is off its facet: its candidates are the facets
+            # within their own size, so the closest facet (a small one on the surface's rim)
+            # can be missing; the facets within the largest size decide (the same pick
+            # wherever the closest facet was a candidate)
+            wide = _candidates(xq[off], near, np.full(len(near), near.diameters().max()))
+            again = pick_closest(xq[off], wide, near.x, fallback=True, key=key)
+            for field, value in zip(pick, again, strict=True):
+                field[off] = value
         if kept is not None:
             PointCoupling._keep_facets(xq, near, pick, kept)
         off = (pick.index >= 0) & ~pick.inside
