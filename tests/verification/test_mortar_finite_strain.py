@@ -30,7 +30,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 from test_large_sliding import Q as Q_SLIDE
-from test_large_sliding import RotatedPatch, SlidingPatch
+from test_large_sliding import RotatedPatch, SlidingPatch, rotation_change
 
 from contactfx import _compat
 from contactfx.scenes import Numerics
@@ -209,19 +209,9 @@ def test_mortar_rigid_rotation_is_objective(objective):
     # stuck (mu = 1) with a tangential multiplier (the shear) on the whole interface
     assert np.all(pressed["P"] > 0.0) and np.min(pressed["t"]) > 0.0
 
-    def change(r):
-        a = r["angle"]
-        R = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
-        F = np.einsum("ji,cjk->cik", R, r["F"])  # R^T F: the state in the rotating frame
-        return (
-            np.max(np.abs(r["P"] - pressed["P"])) / np.max(pressed["P"]),
-            np.max(np.abs(r["t"] - pressed["t"])) / np.max(pressed["t"]),
-            np.max(np.abs(F - pressed["F"])),
-        )
-
     if objective:
         for r in rotated:
-            dP, dt, dF = change(r)
+            dP, dt, dF = rotation_change(r, pressed)
             # the rotated state solves the rotated problem (the weights of the mortar
             # integrals do not change under a rigid motion and the slip is frame-indifferent,
             # contactfx.contact.mortar): the solver's tolerance, 1e-8 (measured 2.4e-12,
@@ -233,5 +223,5 @@ def test_mortar_rigid_rotation_is_objective(objective):
         # tangential part (the nodal normal is an average over the node's facets) as slip:
         # the tangential multiplier drifts with the angle (measured 1.1e-6 of it at the
         # quarter turn, 100 times the objective run's)
-        _, dt, _ = change(rotated[-1])
+        _, dt, _ = rotation_change(rotated[-1], pressed)
         assert dt > 1e-7
