@@ -538,7 +538,11 @@ class MortarCoupling:
         arg = lam - cg
         xi = self.mu * np.maximum(arg, 0.0)
         nz = np.linalg.norm(z, axis=1)
-        stick = (nz <= xi) & (xi > 0.0)
+        # a tie (both the bound and |lambda_T + c v| at round-off, as on coinciding flat
+        # surfaces at the start) sticks, on every partition alike: the normal's tie rule
+        # (:meth:`_state`), with the bound's round-off mu c 1e-12 h_j
+        tie = 1e-12 * self.c * self.h
+        stick = (nz <= xi + self.mu * tie) & (arg >= -tie)
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
         ratio = np.where(stick, 1.0, xi / np.where(nz > 0.0, nz, 1.0))
         proj = np.where(stick[:, None], z, xi[:, None] * zhat)
