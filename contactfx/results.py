@@ -15,6 +15,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 __all__ = [
     "StepLog",
     "never_closed",
@@ -317,6 +319,69 @@ def never_closed(steps: list[StepLog], what: str, gap: float | None = None) -> l
     if gap is not None and math.isfinite(gap):
         line += f"; smallest gap {gap:.3g} at the last step"
     return [line + ": check the geometry and the load"]
+
+
+#: the pieces of a closed set (connected over the slave facets) from which its nodal pressure
+#: is said to oscillate (:func:`zone_messages`): a contact of one or two zones, each with a
+#: node left open at a pressure ripple, stays below; every other node open is far above
+PIECES = 5
+
+
+def _pieces(nodes: np.ndarray, closed: np.ndarray) -> int:
+    """The connected pieces of the closed nodes over the facets ``nodes`` (m, d)."""
+    ids = np.unique(nodes[closed])
+    if len(ids) == 0:
+        return 0
+    label = np.arange(len(ids))
+    # the facets' edges between two closed nodes
+    d = nodes.shape[1]
+    a, b = [], []
+    for i in range(d):
+        for j in range(i + 1, d):
+            both = closed[:, i] & closed[:, j]
+            a.append(nodes[both, i])
+            b.append(nodes[both, j])
+    ea = np.searchsorted(ids, np.concatenate(a))
+    eb = np.searchsorted(ids, np.concatenate(b))
+    while True:  # label propagation to the smallest label of each piece
+        low = np.minimum(label[ea], label[eb])
+        new = label.copy()
+        np.minimum.at(new, ea, low)
+        np.minimum.at(new, eb, low)
+        new = new[new]  # jump to the label's label
+        if np.array_equal(new, label):
+            return len(np.unique(label))
+        label = new
+
+
+def zone_messages(
+    nodes: np.ndarray, closed: np.ndarray, rim: np.ndarray, size: np.ndarray
+) -> list[str]:
+    """The warnings on a contact zone of the whole slave surface (the arguments of
+    :func:`contactfx.driver.two_body.zone_warnings`, all ranks' facets)."""
+    out = []
+    if np.any(closed & rim):
+        out.append(
+            "the contact zone reaches the end of the slave surface (its rim): where the "
+            "body's surface goes on beyond it, the contact may too (extend the slave group)"
+        )
+    touched = np.any(closed, axis=1)
+    edge = touched & ~np.all(closed, axis=1)
+    if np.any(edge) and np.any(touched):
+        ratio = float(np.max(size[edge]) / np.min(size[touched]))
+        if ratio > 2.0:
+            out.append(
+                f"the contact zone's edge lies on facets {ratio:.2g} times the finest it "
+                "covers: the contact has grown out of the refined region (refine further out)"
+            )
+    pieces = _pieces(nodes, closed)
+    if pieces >= PIECES:
+        out.append(
+            f"the closed set breaks into {pieces} pieces along the slave surface: the nodal "
+            "pressure oscillates between closed and open nodes (mortar on a curved "
+            'interface: smoothing = "normals" on the pair; Gauss-point methods: a finer mesh)'
+        )
+    return out
 
 
 #: error measures against the closed forms: column -> (label, section, key). Bench tabulates

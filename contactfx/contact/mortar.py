@@ -84,7 +84,7 @@ from petsc4py import PETSc
 
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.method import MethodBase, Supports
-from contactfx.contact.pair import Facets, facet_normals, owners
+from contactfx.contact.pair import Facets, facet_normals, node_held, owners
 from contactfx.contact.projection import (
     gauss_segment,
     gauss_triangle,
@@ -92,6 +92,7 @@ from contactfx.contact.projection import (
     transport,
     triangle_overlaps,
 )
+from contactfx.contact.smoothing import bulges, deviation, dual_moments, vertex_normals
 from contactfx.params import param, validate
 
 if TYPE_CHECKING:
@@ -102,9 +103,12 @@ if TYPE_CHECKING:
 
 __all__ = ["Mortar", "MortarCoupling", "mortar_matrices", "dual_triangle"]
 
-#: the local mortar integrals (:func:`mortar_matrices`): D contributions, weighted normals
-#: and the triplets (slave node, master node, value) of M
-_Integrals: TypeAlias = tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray]]
+#: the local mortar integrals (:func:`mortar_matrices`): D contributions, weighted normals,
+#: the triplets (slave node, master node, value) of M and the smooth master's deviation
+#: contributions
+_Integrals: TypeAlias = tuple[
+    np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray
+]
 
 
 @dataclass(frozen=True)
@@ -178,9 +182,12 @@ def mortar_matrices(
     ``slave.x.shape[1]``): D contributions (m_s, d) per slave facet node (int N_j),
     measure-weighted normal contributions (m_s, d, gdim), and the triplets (slave node, master
     node, value) of M over the candidate ``pairs`` (slave facet indices, master facet indices)
-    whose normals face each other and whose projections overlap. ``order``: Gauss points per
-    overlap segment in 2D; the 3D fan triangles use the degree-2 rule (psi_j N_k is quadratic
-    on a fan triangle, where both are affine)."""
+    whose normals face each other and whose projections overlap, and, per slave facet node
+    (m_s, d), int psi_j d_m: the master's smooth surface's deviation d_m from its facets
+    (``master.bulge``, :mod:`.smoothing`; zeros without) weighted by the dual basis.
+    ``order``: Gauss points per overlap segment in 2D (psi_j d_m is cubic: exact from 2);
+    the 3D fan triangles use the degree-2 rule (psi_j N_k is quadratic on a fan triangle,
+    where both are affine), degree 3 for psi_j d_m."""
     if slave.x.shape[1] == 3:
         return _mortar_triangles(slave, master, pairs)
     xs, xm = slave.x, master.x
@@ -196,6 +203,7 @@ def mortar_matrices(
     xi, eta = ov.xi[ov.valid], ov.eta[ov.valid]
     g, w = gauss_segment(order)
     rows, cols, vals = [], [], []
+    corr = np.zeros(D.shape)
     for gq, wq in zip(g, w, strict=True):
         xq = xi[:, 0] + gq * (xi[:, 1] - xi[:, 0])
         eq = eta[:, 0] + gq * (eta[:, 1] - eta[:, 0])
@@ -204,11 +212,14 @@ def mortar_matrices(
         rows.append(np.repeat(slave.nodes[i][:, :, None], 2, axis=2))
         cols.append(np.repeat(master.nodes[k][:, None, :], 2, axis=1))
         vals.append(contrib)
+        if master.bulge is not None:
+            dm = deviation(master.bulge[k], _linear(eq))
+            np.add.at(corr, i, (weight * dm)[:, None] * _dual(xq))
     flat = [
         np.concatenate([a.reshape(-1) for a in arr]) if arr else np.zeros(0)
         for arr in (rows, cols, vals)
     ]
-    return D, normals, (flat[0].astype(np.int64), flat[1].astype(np.int64), flat[2])
+    return D, normals, (flat[0].astype(np.int64), flat[1].astype(np.int64), flat[2]), corr
 
 
 def _mortar_triangles(
@@ -249,12 +260,22 @@ def _mortar_triangles(
         lm = lq[0] * mb[:, :, 0] + lq[1] * mb[:, :, 1] + lq[2] * mb[:, :, 2]
         psi = (wq * fan_area)[:, :, None] * dual_triangle(ls)
         vals += np.matmul(psi.transpose(0, 2, 1), lm)
+    corr = np.zeros(D.shape)
+    if master.bulge is not None:
+        points, weights = gauss_triangle(3)
+        for lq, wq in zip(points, weights, strict=True):
+            ls = lq[0] * sb[:, :, 0] + lq[1] * sb[:, :, 1] + lq[2] * sb[:, :, 2]
+            lm = lq[0] * mb[:, :, 0] + lq[1] * mb[:, :, 1] + lq[2] * mb[:, :, 2]
+            dm = deviation(master.bulge[k][:, None, :], lm)
+            psi = (wq * fan_area * dm)[:, :, None] * dual_triangle(ls)
+            np.add.at(corr, i, psi.sum(axis=1))
     rows = np.repeat(slave.nodes[i][:, :, None], 3, axis=2)
     cols = np.repeat(master.nodes[k][:, None, :], 3, axis=1)
     return (
         D,
         normals,
         (rows.reshape(-1).astype(np.int64), cols.reshape(-1).astype(np.int64), vals.reshape(-1)),
+        corr,
     )
 
 
@@ -282,6 +303,10 @@ class MortarCoupling:
         self.layout: NodeLayout = pair.layout
         self.comm = self.layout.comm
         self.search_each_newton = pair.search_each_newton
+        #: the held components of the slave and master facets' vertices (m, d, gdim), for
+        #: the smooth surfaces' normals on symmetry planes (:mod:`.smoothing`); made at the
+        #: first search
+        self._held: tuple[np.ndarray, np.ndarray] | None = None
         self.ranges = owners(self.layout.imap, self.comm)
         # the row operator T, the gap (and slip) rows G, T K and the gaps at the reference
         # configuration: made by the search (update), T K at the next Jacobian
@@ -320,11 +345,24 @@ class MortarCoupling:
         nodes = slave.nodes.reshape(-1)
         if self._reference is None:
             self._reference = self._node_sums(nodes, nodal_weights(pair.slave.X))
+        own = np.zeros(slave.nodes.shape)  # int psi_j d_s: the slave's own deviation
+        if pair.smooth:
+            if self._held is None and pair.fixed is not None:
+                held = node_held(lay.V, pair.fixed)
+                self._held = (held[pair.slave.local], held[pair.master.local])
+            hs, hm = self._held if self._held is not None else (None, None)
+            master.bulge = bulges(master.x, vertex_normals(lay, pair.master, master, hm))
+            slave_normals = vertex_normals(lay, pair.slave, slave, hs)
+            own = dual_moments(slave.x, bulges(slave.x, slave_normals))
         near, pairs = pair.search(slave, master)
         assert pairs is not None  # searched with pairs
-        D, normals, (rows, cols, vals) = mortar_matrices(slave, near, pairs)
-        # nodal sums on the owners: D_j and sum of weighted normals
-        node_data = np.concatenate([D.reshape(-1, 1), normals.reshape(-1, gdim)], axis=1)
+        D, normals, (rows, cols, vals), corr = mortar_matrices(slave, near, pairs)
+        # nodal sums on the owners: D_j, the sum of weighted normals, int psi_j d_m over
+        # the overlaps and int psi_j d_s over the support
+        node_data = np.concatenate(
+            [D.reshape(-1, 1), normals.reshape(-1, gdim), corr.reshape(-1, 1), own.reshape(-1, 1)],
+            axis=1,
+        )
         j_nodes, (j_data,) = _to_owners(comm, self.ranges, nodes, [node_data])
         m_rows, (m_cols, m_vals) = _to_owners(comm, self.ranges, rows, [cols, vals])
         self._assemble(j_nodes, j_data, m_rows, m_cols, m_vals)
@@ -347,7 +385,7 @@ class MortarCoupling:
         slave, master = pair.slave.current(ub), pair.master.current(ub)
         near, pairs = pair.search(slave, master)
         assert pairs is not None  # searched with pairs
-        D, _, (rows, _, vals) = mortar_matrices(slave, near, pairs)
+        D, _, (rows, _, vals), _ = mortar_matrices(slave, near, pairs)
         uniq, Dj = self._node_sums(slave.nodes.reshape(-1), D)
         m_rows, (m_vals,) = _to_owners(comm, self.ranges, rows, [vals])
         Msum = np.bincount(np.searchsorted(uniq, m_rows), weights=m_vals, minlength=len(uniq))
@@ -367,10 +405,10 @@ class MortarCoupling:
         lay = self.layout
         gdim, bs = lay.gdim, lay.bs
         uniq, inv = np.unique(j_nodes, return_inverse=True)
-        data = np.zeros((len(uniq), 1 + gdim))
+        data = np.zeros((len(uniq), 3 + gdim))
         np.add.at(data, inv, j_data)
         Dj = data[:, 0]
-        nj = data[:, 1:] / np.linalg.norm(data[:, 1:], axis=1)[:, None]
+        nj = data[:, 1 : 1 + gdim] / np.linalg.norm(data[:, 1 : 1 + gdim], axis=1)[:, None]
         # M rows per slave node
         key = np.searchsorted(uniq, m_rows)
         Msum = np.zeros(len(uniq))
@@ -380,6 +418,10 @@ class MortarCoupling:
         self.covered = uniq[contact]  # what the next search is compared with (missed)
         scale = np.where(contact, Dj / np.where(Msum > 0, Msum, 1.0), 0.0)
         m_w = m_vals * scale[key] / Dj[key]  # M_jk / D_j, rescaled to sum to 1
+        # the smooth surfaces' deviations d along their normals, the master's weighted as M:
+        # the gap between the surfaces rather than their facets is
+        # g_j - (int psi_j d_m + int psi_j d_s) / D_j (:mod:`.smoothing`)
+        smooth = (data[:, -2] * scale + data[:, -1]) / Dj
         # frames on the free components (a Dirichlet row is overwritten by its condition)
         free = np.ones((len(uniq), gdim), dtype=bool)
         if self.pair.fixed is not None:
@@ -475,6 +517,9 @@ class MortarCoupling:
         self.T, self.G = T, G
         self.g0 = G.createVecLeft()
         G.mult(lay.X, self.g0)
+        #: the smoothing's correction of each contact node's gap (0: facets)
+        self.smoothed = smooth[contact]
+        self.g0.getArray()[self.normal_rows] -= self.smoothed
         if self.mu is not None:  # slip rows: - G u_prev (the increment from the last step)
             n = lay.n_owned * bs
             assert self.previous is not None  # set with mu
@@ -762,9 +807,15 @@ class MortarCoupling:
         out[hit] = values[pos[hit]]
         return out
 
-    def search_gaps(self) -> np.ndarray:
-        """The weighted nodal gaps g_j of this rank's contact nodes at the last search."""
-        return self.g0.getArray()[self.normal_rows] + 0.0 if self.g0 is not None else np.zeros(0)
+    def search_gaps(self, facets: bool = False) -> np.ndarray:
+        """The weighted nodal gaps g_j of this rank's contact nodes at the last search;
+        ``facets``: between the facets (without the smoothing's correction, which at a first
+        touch point of two convex surfaces reads -kappa h^2 / 6 from the dual weights: the
+        overlap check's)."""
+        if self.g0 is None:
+            return np.zeros(0)
+        gaps = self.g0.getArray()[self.normal_rows] + 0.0
+        return gaps + self.smoothed if facets else gaps
 
     def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Owned contact nodes: (global node, reference weight D0_j, nominal pressure

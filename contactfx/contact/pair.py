@@ -78,6 +78,9 @@ class Facets:
     X: np.ndarray | None = None
     open_vertex: np.ndarray | None = None
     open_edge: np.ndarray | None = None
+    #: (m, edges) the smooth surface's deviation from each facet
+    #: (:func:`contactfx.contact.smoothing.bulges`), or None: the facets are the surface
+    bulge: np.ndarray | None = None
 
     def subset(self, keep: np.ndarray) -> Facets:
         """The facets selected by ``keep`` (a mask or indices), with their fields."""
@@ -86,7 +89,12 @@ class Facets:
             return None if a is None else a[keep]
 
         return Facets(
-            self.x[keep], self.nodes[keep], sub(self.X), sub(self.open_vertex), sub(self.open_edge)
+            self.x[keep],
+            self.nodes[keep],
+            sub(self.X),
+            sub(self.open_vertex),
+            sub(self.open_edge),
+            sub(self.bulge),
         )
 
     def __len__(self) -> int:
@@ -354,25 +362,26 @@ def gather_near(comm: MPI.Comm, master: Facets, region: Facets, radius: float) -
     lo, hi = master.x.min(axis=1), master.x.max(axis=1)
     if comm.size == 1:
         return master.subset(_boxes_meet(lo, hi, boxes[0]))
-    ref = master.x if master.X is None else master.X
-    rim = master.open_vertex is not None and master.open_edge is not None
+    # the optional fields travel with their facets (None on every rank alike)
+    optional = [master.X, master.open_vertex, master.open_edge, master.bulge]
     sends = []
     for b in boxes:
         keep = _boxes_meet(lo, hi, b)
-        part = [master.x[keep], master.nodes[keep], ref[keep]]
-        if rim:
-            part += [master.open_vertex[keep], master.open_edge[keep]]  # type: ignore[index]
+        part = [master.x[keep], master.nodes[keep]]
+        part += [a[keep] for a in optional if a is not None]
         sends.append(tuple(part))
     received = comm.alltoall(sends)
-    d = master.x.shape[1]
 
-    def joined(i: int, *shape: int) -> np.ndarray:
-        return np.concatenate([r[i] for r in received]).reshape(-1, *shape)
+    def joined(i: int, like: np.ndarray) -> np.ndarray:
+        return np.concatenate([r[i] for r in received]).reshape(-1, *like.shape[1:])
 
-    x, nodes, X = joined(0, d, gdim), joined(1, d), joined(2, d, gdim)
-    if not rim:
-        return Facets(x, nodes, None if master.X is None else X)
-    return Facets(x, nodes, None if master.X is None else X, joined(3, d), joined(4, d))
+    x, nodes = joined(0, master.x), joined(1, master.nodes)
+    fields: list[np.ndarray | None] = []
+    i = 2
+    for a in optional:
+        fields.append(None if a is None else joined(i, a))
+        i += a is not None
+    return Facets(x, nodes, *fields)
 
 
 def facet_order(X: np.ndarray) -> np.ndarray:
@@ -438,6 +447,9 @@ class ContactPair:
     #: g + (1 - t) max(-g0, 0) for the gap g, t the load factor ``load`` (set by the problem)
     interference: bool = False
     load: float = 1.0
+    #: the surfaces smoothed by their nodal normals (:mod:`contactfx.contact.smoothing`):
+    #: the gap between the curved surfaces the facets approximate (mortar)
+    smooth: bool = False
 
     def hidden(self) -> float:
         """The fraction (1 - t) of the initial overlap still hidden at the load factor t

@@ -971,8 +971,9 @@ class PointCoupling:
             dr.overlap = np.where(p["paired"], np.maximum(-g0, 0.0), 0.0)
             p["overlap"] = dr.overlap
 
-    def search_gaps(self) -> np.ndarray:
-        """The gaps of this rank's paired Gauss points at the last search."""
+    def search_gaps(self, facets: bool = False) -> np.ndarray:
+        """The gaps of this rank's paired Gauss points at the last search (between the
+        facets: no smoothing here, ``facets`` is ignored)."""
         out = [-np.einsum("pi,pi->p", p["Jn"], p["x_search"])[p["paired"]] for p in self.points]
         return np.concatenate(out) if out else np.zeros(0)
 

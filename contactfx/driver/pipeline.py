@@ -394,7 +394,7 @@ class _Run:
                 else None
             ),
             memory_mib=peak_memory_mib(self.comm),
-            warnings=self.warnings(problem, steps),
+            warnings=self.warnings(problem, steps) + extra.pop("warnings", []),
             **extra,
         )
         if self.out is not None:

@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 from contactfx import _compat
 from contactfx.contact.coupling import NodeLayout
 from contactfx.contact.laws import Coulomb, Tresca
-from contactfx.contact.pair import ContactPair, Side, side_of
+from contactfx.contact.pair import ContactPair, Facets, Side, node_held, side_of
 from contactfx.contact.point_coupling import nitsche_finite_strain_refusal
 from contactfx.contact_edge import ContourMeasure, check_edge_rule, facet_dofs
 from contactfx.driver.fields import nodal_contact
@@ -131,6 +131,12 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
+        if scene.smoothing() != "none" and method.name != "mortar":
+            raise ValueError(
+                f'contact.0.smoothing = "{scene.smoothing()}" is mortar\'s (its weighted nodal '
+                f"gaps); {method.name} measures the gap between the facets at Gauss points: "
+                "remove the key or use --method mortar"
+            )
 
     def __init__(
         self,
@@ -207,6 +213,7 @@ class TwoBodyProblem(Problem):
             search_each_newton=self.num.search_update == "newton" or self.finite_strain,
             fixed=fixed,
             finite_strain=self.finite_strain,
+            smooth=scene.smoothing() == "normals",
         )
         if isinstance(self.friction, Coulomb):
             self.pair.mu = self.friction.mu
@@ -331,11 +338,11 @@ class TwoBodyProblem(Problem):
         """(the least gap of the pair at the start over all ranks, the overlap tolerated
         without ``contact.interference``: 1 % of the contact element size, since two
         polygonal approximations of touching curved surfaces cross by O(h^2 / R)): the
-        coupling searched at u = 0 (its gaps: the Gauss points' or the weighted nodal
-        gaps). Collective."""
+        coupling searched at u = 0 (its gaps between the facets: the Gauss points' or the
+        weighted nodal gaps). Collective."""
         coupling = self.coupling()
         coupling.update(np.zeros_like(self.state.x.array))
-        gaps = coupling.search_gaps()
+        gaps = coupling.search_gaps(facets=True)
         least = self.mesh.comm.allreduce(float(np.min(gaps, initial=np.inf)), op=MPI.MIN)
         return least, 1e-2 * self.scene.h_contact()
 
@@ -486,6 +493,7 @@ class TwoBodyPost:
             c_all = np.concatenate(self.comm.allgather(closed[local]))
             edge = self.scene.contact_edge(x_all, p_all, c_all)
         self.zone_size = self.contact_zone_size(closed)
+        self.closed = closed
         self.history.append((float(self.pb.tload.value), self.pair_force()))
         self.tangential.append(self.tangential_nodal_force(solver, local))
         return Quantities(
@@ -504,6 +512,19 @@ class TwoBodyPost:
         total = self.comm.allreduce(float(np.sum(self.facet_size[touching])), op=MPI.SUM)
         count = self.comm.allreduce(int(np.count_nonzero(touching)), op=MPI.SUM)
         return total / count if count else 0.0
+
+    def zone_warnings(self) -> list[str]:
+        """The warnings of the last step's closed set on the slave surface
+        (:func:`zone_warnings`): its rim here is the surface's end, not a symmetry plane (a
+        rim node holding some but not all components). Collective."""
+        side = self.pb.pair.slave
+        closed = self.closed[side.local]
+        rim = side.open_vertex if side.open_vertex is not None else np.zeros_like(closed)
+        if self.pb.pair.fixed is not None:
+            held = node_held(self.pb.V, self.pb.pair.fixed)[side.local]
+            rim = rim & ~(np.any(held, axis=2) & ~np.all(held, axis=2))
+        size = Facets(side.X, side.nodes).diameters()
+        return zone_warnings(self.comm, side.nodes, closed, rim, size)
 
     def friction(self) -> Friction | None:
         """Coulomb friction of the pair: the tangential force on the upper body (the last
@@ -608,7 +629,7 @@ class TwoBodyPost:
                     comments="",
                     header=header,
                 )
-        extra: dict[str, Any] = {}
+        extra: dict[str, Any] = {"warnings": self.zone_warnings()}
         if self.scene.h_contact_in_zone and self.zone_size > 0.0:
             extra["h_contact"] = self.zone_size
         return {
@@ -618,6 +639,38 @@ class TwoBodyPost:
             "errors": {},
             "plot": None if plot is None else str(plot),
         }
+
+
+def zone_warnings(
+    comm: MPI.Comm, nodes: np.ndarray, closed: np.ndarray, rim: np.ndarray, size: np.ndarray
+) -> list[str]:
+    """run.json's warnings on a contact zone, from the slave surface's facets of every rank
+    (``nodes`` (m, d) global node numbers, ``closed`` (m, d) their contact status, ``rim``
+    (m, d) the surface's end, ``size`` (m,) the facets' longest edges), the same on every
+    rank:
+
+    - the zone reaches the end of the slave surface (a closed rim node): the contact may go
+      on beyond the surface the pair declares;
+    - the zone's edge (the facets with a closed and an open node) lies on facets more than
+      twice the size of the finest facet it covers: the contact has grown out of the refined
+      region;
+    - the closed set breaks into many pieces along the surface (connected over the facets;
+      :data:`contactfx.results.PIECES`): the nodal pressure oscillates between closed and
+      open nodes (on a curved non-matching interface, mortar's slave nodes on the master's
+      chords: ``smoothing = "normals"``; Gauss-point spikes: a finer mesh). Collective."""
+    from contactfx.results import zone_messages
+
+    parts = comm.gather((nodes, closed, rim, size), root=0)
+    found: list[str] = []
+    if comm.rank == 0:
+        assert parts is not None
+        d = nodes.shape[1] if nodes.ndim == 2 else 2
+        n_all = np.concatenate([np.reshape(p[0], (-1, d)) for p in parts]).astype(np.int64)
+        c_all = np.concatenate([np.reshape(p[1], (-1, d)) for p in parts]).astype(bool)
+        r_all = np.concatenate([np.reshape(p[2], (-1, d)) for p in parts]).astype(bool)
+        s_all = np.concatenate([np.reshape(p[3], -1) for p in parts])
+        found = zone_messages(n_all, c_all, r_all, s_all)
+    return comm.bcast(found, root=0)
 
 
 def plot_pressure(

@@ -28,11 +28,18 @@ __all__ = [
     "contact_edge",
     "CONTACT_EDGES",
     "INTERFERENCES",
+    "SMOOTHINGS",
 ]
 
 #: what ``contact.interference`` may name: ``ramp`` removes an initial overlap of the pair
 #: progressively over the load program (:class:`contactfx.driver.two_body.TwoBodyProblem`)
 INTERFERENCES = ("ramp",)
+
+#: what ``contact.smoothing`` may name (mortar's, :mod:`contactfx.contact.smoothing`): the gap
+#: between the facets (``none``, the default), or between the curved surfaces the facets
+#: approximate, from the nodal normals (``normals``: conforming curved interfaces, fits,
+#: bearings, where the facets' chords make the nodal pressure oscillate)
+SMOOTHINGS = ("none", "normals")
 
 
 def two_elastic(E0: float, nu0: float) -> type:
@@ -143,6 +150,11 @@ class TwoBodyScene(Scene):
         program), or None: an overlap is refused."""
         return None
 
+    def smoothing(self) -> str:
+        """How mortar's gap sees curved surfaces (:data:`SMOOTHINGS`): ``none``, the facets;
+        ``normals``, the surfaces the facets approximate, smoothed by the nodal normals."""
+        return "none"
+
     def edge_ring(self) -> float | None:
         """The ring width of the ``radial`` edge rule (the slave element size)."""
         return None
@@ -190,6 +202,8 @@ class TwoBodyScene(Scene):
                 pair["edge_ring"] = float(self.edge_ring())
         if self.interference() is not None:
             pair["interference"] = self.interference()
+        if self.smoothing() != "none":
+            pair["smoothing"] = self.smoothing()
         output: dict = {"symmetry": float(self.symmetry)}
         if self.symmetry_planes:
             output["symmetry_planes"] = ["xyz"[k] for k in self.symmetry_planes]

@@ -34,7 +34,7 @@ def test_mortar_partition_of_unity(seed):
     assert np.allclose(facet_normals(slave.x), [0.0, -1.0])
     assert np.allclose(facet_normals(master.x), [0.0, 1.0])
     pairs = FacetTree(master.x, 0.1).collide(FacetTree(slave.x, 0.0))
-    D, normals, (rows, cols, vals) = mortar_matrices(slave, master, pairs)
+    D, normals, (rows, cols, vals), _ = mortar_matrices(slave, master, pairs)
     n_nodes = len(xs)
     D_node = np.zeros(n_nodes)
     np.add.at(D_node, slave.nodes.ravel(), D.ravel())
@@ -58,7 +58,7 @@ def test_mortar_off_master_is_uncovered():
     )
     master = Facets(np.array([[[0.0, 0.0], [1.0, 0.0]]]), np.array([[10, 11]]))
     pairs = FacetTree(master.x, 0.5).collide(FacetTree(slave.x, 0.0))
-    D, _, (rows, cols, vals) = mortar_matrices(slave, master, pairs)
+    D, _, (rows, cols, vals), _ = mortar_matrices(slave, master, pairs)
     M_sum = np.zeros(3)
     np.add.at(M_sum, rows, vals)
     assert M_sum == pytest.approx([0.5, 0.5, 0.0], abs=1e-14)
@@ -116,7 +116,7 @@ def test_mortar_partition_of_unity_3d(seed):
     assert np.allclose(facet_normals(slave.x), [0.0, 0.0, -1.0])
     assert np.allclose(facet_normals(master.x), [0.0, 0.0, 1.0])
     pairs = FacetTree(master.x, 0.3).collide(FacetTree(slave.x, 0.0))
-    D, normals, (rows, cols, vals) = mortar_matrices(slave, master, pairs)
+    D, normals, (rows, cols, vals), _ = mortar_matrices(slave, master, pairs)
     n_nodes = 36
     D_node = np.zeros(n_nodes)
     np.add.at(D_node, slave.nodes.ravel(), D.ravel())
@@ -221,7 +221,7 @@ def test_mortar_search_across_ranks_matches_serial():
     radius = max(np.ptp(slave.x[:, :, 0], axis=1).max(), np.ptp(master.x[:, :, 0], axis=1).max())
     near = gather_near(comm, mine_m, mine_s, radius)
     pairs = FacetTree(near.x, radius).collide(FacetTree(mine_s.x, 0.0))
-    _, _, triplets = mortar_matrices(mine_s, near, pairs)
+    _, _, triplets, _ = mortar_matrices(mine_s, near, pairs)
 
     def dense(rows, cols, vals) -> np.ndarray:
         M = np.zeros((len(xs), len(xm)))

@@ -520,6 +520,10 @@ class FileTwoBodyScene(_FileMesh, TwoBodyScene):
         """``contact.interference``: how an initial overlap of the pair is taken."""
         return self.spec.pair.interference
 
+    def smoothing(self) -> str:
+        """``contact.smoothing``: the gap between the smoothed surfaces or the facets."""
+        return self.spec.pair.smoothing
+
     def pair_modulus(self) -> float:
         """E* of the slave body and the master surface's body (the stiffest if it bounds
         several)."""

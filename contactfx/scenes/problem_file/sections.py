@@ -40,7 +40,7 @@ from contactfx.scenes.problem_file.specs import (
     PinSpec,
     ProblemFile,
 )
-from contactfx.scenes.two_body_base import CONTACT_EDGES, INTERFERENCES
+from contactfx.scenes.two_body_base import CONTACT_EDGES, INTERFERENCES, SMOOTHINGS
 
 __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read", "check_materials"]
 
@@ -83,7 +83,16 @@ KEYS = {
         "edge_radius",
         "h",
     ),
-    "contact": ("slave", "master", "h", "force_on", "edge", "edge_ring", "interference"),
+    "contact": (
+        "slave",
+        "master",
+        "h",
+        "force_on",
+        "edge",
+        "edge_ring",
+        "interference",
+        "smoothing",
+    ),
     "interface": (
         "group",
         "fluid_pressure",
@@ -417,7 +426,10 @@ def read_pair(r: Reader, data: dict, bodies: tuple[BodySpec, ...]) -> PairSpec:
     interference = None
     if "interference" in c:
         interference = r.string(c, "contact.0", "interference", INTERFERENCES)
-    return PairSpec(slave, master, h, force_on, edge, ring, interference)
+    smoothing = "none"
+    if "smoothing" in c:
+        smoothing = r.string(c, "contact.0", "smoothing", SMOOTHINGS)
+    return PairSpec(slave, master, h, force_on, edge, ring, interference, smoothing)
 
 
 def read_output(r: Reader, data: dict) -> OutputSpec:

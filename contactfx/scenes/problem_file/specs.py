@@ -137,6 +137,8 @@ class PairSpec:
     edge_ring: float | None = None
     #: an initial overlap of the pair: "ramp" (removed over the load program) or None
     interference: str | None = None
+    #: mortar's gap between the facets ("none") or the smoothed surfaces ("normals")
+    smoothing: str = "none"
 
 
 @dataclass(frozen=True)
