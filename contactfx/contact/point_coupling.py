@@ -26,27 +26,9 @@ derivatives are not linearised: for the closest-point projection they vanish in 
 first order (n_m is orthogonal to the master tangent and x - y is parallel to n_m), what is
 left out is the curvature (geometric) stiffness.
 
-Points whose projection falls off the master surface are not in contact: no candidate facet
-within the search radius, or the closest point of the master surface on its boundary. A
-point that projects inside no master facet is decided by the feature of the surface its
-closest point lies on: on an edge (3D) it is in contact if two master facets share that edge
-(an interior ridge), not on a boundary edge (one facet); at a vertex, if the vertex is
-interior to the surface (2D: shared by two segments, a convex kink; the end of the curve is
-not). Every vertex of a triangulated surface is shared by several triangles, also on its
-boundary, so the vertex alone cannot tell a point at a kink from one beyond the surface's
-edge. The boundary edges and vertices are those of the whole master surface, found once by
-global node numbers (:func:`contactfx.contact.pair.surface_rim`): the master facets a rank
-gathers near its slave points may lack a facet's neighbours, and 1 and 2 ranks pair the
-same points. In 3D an edge of one master facet on a symmetry plane is interior, not a
-boundary (:func:`contactfx.contact.pair.mirror_edges`: both its nodes hold the displacement
-component normal to a plane they lie on, and not every component): the mirror image
-continues the surface there, and a point past it, as near a curved master's symmetry plane
-where the facets' normals tilt, is in contact (docs/verification.md section 10). No
-tolerance beyond the 1e-10 of "inside": slave Gauss points lie inside their facets, so where
-flat slave and master surfaces end on the same plane (the edges of equal faces) the points
-project inside the master facets; the finite-strain hysteresis below keeps a point's facet
-past its edge, boundary or not. A point paired off its facet carries its force to the
-facet's vertex of the largest barycentric coordinate.
+Points whose projection falls off the master surface are not in contact, decided by the
+whole surface's rim; a point's master facet is kept while it stays on it or just past its
+edge at finite strain (:mod:`contactfx.contact.closest_point`).
 
 Finite strain (``ContactPair.finite_strain``, the two-body kind with a hyperelastic material;
 penalty, and Nitsche as below, each with or without friction; always searched at every Newton
@@ -121,10 +103,6 @@ master vertex) or recomputed (finite strain, inside a facet). A tie (the law's a
 the trial against the bound, at round-off) takes the closed and sticking branch on every
 partition.
 
-Finite strain keeps each point's master facet of the last search while the point stays on it
-or within 0.1 of its size past its edge (:meth:`PointCoupling._keep_facets`): the facet
-normal jumps at a kink of the master surface, and a point whose equilibrium lies at the kink
-would make Newton cycle between the two facets.
 """
 
 from __future__ import annotations
@@ -135,15 +113,13 @@ from typing import TYPE_CHECKING, TypeAlias
 import numpy as np
 from petsc4py import PETSc
 
+from contactfx.contact.closest_point import project
 from contactfx.contact.coupling import NodeLayout, blocked_rows
-from contactfx.contact.pair import Facets, Side, facet_normals, facet_order, facet_rim
+from contactfx.contact.pair import Side, facet_normals
+from contactfx.contact.point_readout import PointReadout, State
 from contactfx.contact.projection import (
-    TOL,
-    Pick,
-    closest_point_facets,
     gauss_segment,
     gauss_triangle,
-    pick_closest,
     transport,
 )
 from contactfx.mechanics.elasticity import basis_tractions
@@ -158,10 +134,6 @@ __all__ = ["PointCoupling", "Law"]
 
 #: the arrays of one direction's Gauss points (:meth:`PointCoupling._points`), by name
 _Points: TypeAlias = dict[str, np.ndarray]
-#: per direction at the last residual: P, g, and with friction t_T, the stick mask, the slip
-_State: TypeAlias = tuple[
-    np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray | None
-]
 
 
 @dataclass(frozen=True)
@@ -265,52 +237,12 @@ class _Directed:
         return self._history
 
 
-#: how far past its edge (a fraction of its size) a point keeps its facet within a Newton
-#: solve (:meth:`PointCoupling._keep_facets`)
-KEEP_BEYOND = 0.1
-
-
-def _candidates(xq: np.ndarray, near: Facets, padding: np.ndarray) -> np.ndarray:
-    """(n, width) the facets of ``near`` whose bounding box padded by ``padding`` (per facet)
-    holds each point of ``xq`` (-1: none)."""
-    from contactfx import _compat
-
-    tree = _compat.FacetTree(near.x, padding)  # type: ignore[arg-type]
-    rows, facets = tree.collide_points(xq)
-    counts = np.bincount(rows, minlength=len(xq))
-    width = max(int(counts.max(initial=0)), 1)
-    cand = -np.ones((len(xq), width), dtype=np.int64)
-    order = np.argsort(rows, kind="stable")
-    rows, facets = rows[order], facets[order]
-    slot = np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)
-    cand[rows, slot] = facets
-    return cand
-
-
-def _on_rim(closest: np.ndarray, index: np.ndarray, near: Facets) -> np.ndarray:
-    """(n,) bool: the closest points ``closest`` (n, gdim) on the master facets ``index`` (n,)
-    of ``near`` lie on the boundary of the master surface (a point beyond it, not in
-    contact): on an open edge of the facet (3D, the edge's barycentric coordinate within TOL
-    of 0) or at an open vertex (its coordinate within TOL of 1; 2D: the end of the curve).
-    The rim is that of the whole surface (:func:`contactfx.contact.pair.surface_rim`), or,
-    for facets built without it, of the ``near`` facets alone."""
-    if near.open_vertex is None or near.open_edge is None:
-        open_vertex, open_edge = facet_rim(near.nodes)
-    else:
-        open_vertex, open_edge = near.open_vertex, near.open_edge
-    # barycentric coordinates of the closest point (exact 0 and 1 at a vertex)
-    lam = closest_point_facets(closest, near.x[index]).bary
-    on_edge = (lam <= TOL) & open_edge[index]
-    at_vertex = (lam >= 1.0 - TOL) & open_vertex[index]
-    return np.any(on_edge | at_vertex, axis=1)
-
-
-class PointCoupling:
+class PointCoupling(PointReadout):
     """Penalty / Nitsche terms of a contact pair at Gauss points (module docstring)."""
 
     # set by the search (update) and by the residual
     points: list[_Points]
-    state: list[_State]
+    state: list[State]
     _local: PETSc.Vec
     _xvec: PETSc.Vec
 
@@ -408,9 +340,9 @@ class PointCoupling:
         w = (measure[:, None] * dr.qweight[None, :]).reshape(-1) * dr.weight
         facet = np.repeat(np.arange(m), nq)
         # finite strain (searched at every Newton iteration): the facets of the last search
-        # kept while their points stay on them (:meth:`_keep_facets`)
+        # kept while their points stay on them (:func:`.closest_point.keep_facets`)
         kept = dr.kept if self.pair.finite_strain and len(dr.kept) == len(xq) else None
-        pick = self._project(xq, near, kept)
+        pick = project(xq, near, kept)
         paired = pick.index >= 0
         # slave cell shape functions at the points: the facet's vertices carry qbary
         N = np.zeros((m, nq, d + 1))
@@ -498,92 +430,6 @@ class PointCoupling:
             Nm=Nm,
             facet_nodes=np.where(paired[:, None], np.sort(master_nodes, axis=1), -1),
         )
-
-    @staticmethod
-    def _project(xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pick:
-        """The master facet of each point (index -1: not in contact). ``kept``: (n, d)
-        the sorted global nodes of each point's facet at the last search (-1: none), kept
-        while the point projects inside it (:meth:`_keep_facets`)."""
-
-        n, d = xq.shape
-        if n == 0 or len(near) == 0:  # nothing to project, or nothing near: no contact
-            nan = np.full((n, d), np.nan)
-            return Pick(
-                -np.ones(n, dtype=np.int64),
-                np.zeros(n, dtype=bool),
-                nan,
-                nan,
-                np.full(n, np.nan),
-                np.full(n, np.nan),
-            )
-        # FacetTree takes a padding per facet too (its docstring; the annotation says float)
-        cand = _candidates(xq, near, near.diameters())
-        # ties (a point equally far from facets sharing an edge or a vertex, to round-off) go
-        # to the facet first in the order of the reference coordinates: the same choice on
-        # every partition (the candidates' order and the global numbers depend on it)
-        key = None if near.X is None else facet_order(near.X)
-        pick = pick_closest(xq, cand, near.x, fallback=True, key=key)
-        off = (pick.index >= 0) & ~pick.inside
-        if np.any(off):
-            # a point whose closest candidate is off its facet: its candidates are the facets
-            # within their own size, so the closest facet (a small one on the surface's rim)
-            # can be missing; the facets within the largest size decide (the same pick
-            # wherever the closest facet was a candidate)
-            wide = _candidates(xq[off], near, np.full(len(near), near.diameters().max()))
-            again = pick_closest(xq[off], wide, near.x, fallback=True, key=key)
-            for field, value in zip(pick, again, strict=True):
-                field[off] = value
-        if kept is not None:
-            PointCoupling._keep_facets(xq, near, pick, kept)
-        off = (pick.index >= 0) & ~pick.inside
-        if np.any(off):
-            # the closest point on an edge or at a vertex of the master surface: in contact
-            # unless that is on the surface's boundary (:func:`_on_rim`)
-            beyond = _on_rim(pick.closest[off], pick.index[off], near)
-            vertex = np.argmax(np.nan_to_num(pick.bary[off], nan=-1.0), axis=1)
-            bary = np.zeros_like(pick.bary[off])
-            bary[np.arange(len(vertex)), vertex] = 1.0
-            pick.bary[off] = bary
-            pick.index[np.flatnonzero(off)[beyond]] = -1
-        return pick
-
-    @staticmethod
-    def _keep_facets(xq: np.ndarray, near: Facets, pick: Pick, kept: np.ndarray) -> None:
-        """Keep each point's facet of the last search (``kept``, its sorted global nodes)
-        while the point's projection stays on it or beyond its edge by at most KEEP_BEYOND
-        of it, and it is no farther than the closest facet plus 1e-2 of its size: a
-        hysteresis of the node-to-segment projection. The facet normal jumps at a kink of
-        the master surface (Wriggers 2006, doi:10.1007/978-3-540-32609-0, section 9.1, on
-        this non-smoothness), and a point whose equilibrium lies at the kink makes Newton
-        cycle between the two facets with a residual that does not fall below the jump
-        (seen at the leading edge of a block dragged with friction over a foundation: a 2-cycle
-        at 0.16 with the point moving 0.008 h). Keeping the facet, the residual is smooth
-        and the point converges on the extended facet, at most KEEP_BEYOND h past the
-        vertex (a gap error of that times the kink's angle). Edits pick."""
-        has = np.flatnonzero(kept[:, 0] >= 0)
-        if len(has) == 0:
-            return
-        facets = np.sort(near.nodes, axis=1)
-        both = np.concatenate([facets, kept[has]])
-        _, inverse = np.unique(both, axis=0, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        first = np.full(inverse.max() + 1, -1, dtype=np.int64)
-        first[inverse[: len(facets)][::-1]] = np.arange(len(facets))[::-1]
-        j = first[inverse[len(facets) :]]
-        has, j = has[j >= 0], j[j >= 0]  # the last facet among the near ones
-        if len(has) == 0:
-            return
-        old = pick_closest(xq[has], j[:, None], near.x, fallback=True)
-        size = near.diameters()[j]
-        best = np.where(pick.index[has] >= 0, pick.distance[has], np.inf)
-        within = np.min(np.nan_to_num(old.bary, nan=-np.inf), axis=1) >= -KEEP_BEYOND
-        keep = (old.index >= 0) & within & (old.distance <= best + 1e-2 * size)
-        rows = has[keep]
-        for field, value in zip(pick, old, strict=True):
-            field[rows] = value[keep]
-        # on the facet's line / plane (extended by at most KEEP_BEYOND of it): the law and
-        # its Jacobian take the unclamped projection
-        pick.inside[rows] = True
 
     # -- communication of the involved dofs ----------------------------------------------
     def _scatter_setup(self, needed: np.ndarray) -> None:
@@ -976,121 +822,3 @@ class PointCoupling:
         facets: no smoothing here, ``facets`` is ignored)."""
         out = [-np.einsum("pi,pi->p", p["Jn"], p["x_search"])[p["paired"]] for p in self.points]
         return np.concatenate(out) if out else np.zeros(0)
-
-    # -- what the post-processing reads ----------------------------------------------------
-    def _lumped(self, columns: list[list[np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
-        """Owned contact nodes of the first direction's slave surface (those whose support
-        has a master on more than half of it) and the weighted nodal means of the point values
-        ``columns[k]`` of each direction k: the first direction's lumped with the slave facet's
-        shape functions; the unbiased variant's second direction (points on the other
-        surface, its pressure the same interface's) carried to the slave nodes by the
-        barycentric coordinates of the points' projections onto the slave facets, so that the
-        nodal value is the mean of both sides' laws, weighted by their halves (a side may hold
-        the whole contact alone: on a concave-convex interface the polygons of the convex
-        side's points stay apart from the concave one, the concave side's points close)."""
-        blocks = []
-        for k, (p, dr) in enumerate(zip(self.points, self.dirs, strict=True)):
-            paired = np.isfinite(self.state[k][1])
-            if k == 0:
-                N, nodes = p["N_facet"], p["slave_nodes"]
-            else:
-                N, nodes = p["Nm"], p["master_nodes"]
-            # the biased variant's weights as they are; the unbiased one's halves
-            Nw = N * (p["w"] / (dr.weight if len(self.dirs) == 1 else 1.0))[:, None]
-            blocks.append(
-                np.stack(
-                    [
-                        Nw.ravel(),
-                        (Nw * paired[:, None]).ravel(),
-                        *((Nw * c[:, None]).ravel() for c in columns[k]),
-                    ],
-                    axis=1,
-                )
-            )
-            blocks[-1] = (nodes.ravel(), blocks[-1])
-        nodes = np.concatenate([b[0] for b in blocks])
-        data = np.concatenate([b[1] for b in blocks])
-        sums = self.layout.node_sum(nodes, data, 2 + len(columns[0]))
-        on = (sums[:, 0] > 0.0) & (sums[:, 1] > 0.5 * sums[:, 0])
-        return on, sums[on]
-
-    def nodal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Owned slave nodes: (global node, weight D_j, pressure p_j, gap g_j), the
-        quadrature values of both directions lumped to the nodes of the first direction's
-        slave surface (:meth:`_lumped`)."""
-        on, sums = self._lumped(
-            [[s[0], np.where(np.isfinite(s[1]), s[1], 0.0)] for s in self.state]
-        )
-        D = sums[:, 0]
-        return np.flatnonzero(on) + self.layout.start, D, sums[:, 2] / D, sums[:, 3] / sums[:, 1]
-
-    def nodal_normals(self) -> np.ndarray:
-        """The unit normal of each node of :meth:`nodal`: the contact normal of the Gauss
-        points (the one their traction -P n acts along) lumped like the pressure (weights
-        N_j w; the unbiased variant's second direction with its normal reversed, the first
-        direction's slave normal), normalised."""
-        columns = [
-            [(1.0 if k == 0 else -1.0) * p["n"][:, i] for i in range(p["n"].shape[1])]
-            for k, p in enumerate(self.points)
-        ]
-        _, sums = self._lumped(columns)
-        mean = sums[:, 2:]
-        return mean / np.linalg.norm(mean, axis=1)[:, None]
-
-    def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per node of :meth:`nodal`: |t_T|, |slip increment of the step| and the stick
-        indicator (the fraction of the node's support in stick), lumped like the pressure."""
-        columns = []
-        for P, _, t, stick, slip in self.state:
-            assert t is not None and stick is not None and slip is not None  # with friction
-            closed_stick = (stick & (P > 0.0)).astype(float)
-            columns.append([np.linalg.norm(t, axis=1), np.linalg.norm(slip, axis=1), closed_stick])
-        _, sums = self._lumped(columns)
-        D = sums[:, 0]
-        return sums[:, 2] / D, sums[:, 3] / D, sums[:, 4] / D > 0.5
-
-    def slave_force(self) -> np.ndarray:
-        """The force vector of the pair on the (first direction's) slave body: the quadrature
-        sum of its traction -P n + t_T (minus that on the other body for the unbiased
-        variant). Collective."""
-        from mpi4py import MPI
-
-        total = np.zeros(self.layout.gdim)
-        for k, (p, s) in enumerate(zip(self.points, self.state, strict=True)):
-            traction = -s[0][:, None] * p["n"]
-            if s[2] is not None:
-                traction += s[2]
-            total += (1.0 if k == 0 else -1.0) * np.sum(p["w"][:, None] * traction, axis=0)
-        return self.comm.allreduce(total, op=MPI.SUM)
-
-    def friction_state(self) -> dict[str, float]:
-        """Sums over this rank's points of the first direction (weights without the unbiased
-        halving): the contact measure (P > 0), the stick measure, the friction bound mu P and
-        the excess of |t_T| over it, and the sum of |t_T|."""
-        p, s = self.points[0], self.state[0]
-        P, t, stick = s[0], s[2], s[3]
-        assert t is not None and stick is not None  # with friction
-        w = p["w"] / self.dirs[0].weight
-        closed = P > 0.0
-        if self.mu is not None:
-            bound = self.mu * P
-        else:
-            assert self.threshold is not None  # with friction: Coulomb or Tresca
-            bound = np.where(closed, self.threshold, 0.0)
-        excess = np.maximum(np.linalg.norm(t, axis=1) - bound, 0.0)
-        return {
-            "measure": float(np.sum(w[closed])),
-            "stick": float(np.sum(w[closed & stick])),
-            "bound": float(np.sum(w * bound)),
-            "excess": float(np.sum(w * excess)),
-            "tangential": float(np.sum(w * np.linalg.norm(t, axis=1))),
-        }
-
-    def force(self) -> float:
-        """The normal contact force (the quadrature sum of P over both directions)."""
-        local = sum(
-            float(np.sum(p["w"] * s[0])) for p, s in zip(self.points, self.state, strict=True)
-        )
-        from mpi4py import MPI
-
-        return self.comm.allreduce(local, op=MPI.SUM)

@@ -307,8 +307,8 @@ def test_symmetry_plane_edges_not_on_the_rim():
     surface ends there), its side x = 1 free. Over the ranks the same as on one rank."""
     from mpi4py import MPI
 
+    from contactfx.contact.closest_point import project
     from contactfx.contact.pair import facet_rim, mirror_edges, surface_rim
-    from contactfx.contact.point_coupling import PointCoupling
 
     n = 4
     roof = _pyramid(n)
@@ -352,7 +352,7 @@ def test_symmetry_plane_edges_not_on_the_rim():
             [-0.1, -0.1, -0.15],  # beyond the corner of the roller plane and y = 0
         ]
     )
-    pick = PointCoupling._project(points, roof)
+    pick = project(points, roof)
     assert not pick.inside.any()
     assert list(pick.index >= 0) == [True, True, False, False, False, False]
 
@@ -362,8 +362,8 @@ def test_points_beyond_the_master_rim_unpaired():
     master surface is on an interior ridge or at an interior vertex (a convex kink) is in
     contact, one whose closest point is on the surface's boundary (edge or vertex; 2D: the end
     of the curve) is beyond the surface and is not."""
+    from contactfx.contact.closest_point import project
     from contactfx.contact.pair import facet_rim
-    from contactfx.contact.point_coupling import PointCoupling
 
     roof = _pyramid(4)
     roof.open_vertex, roof.open_edge = facet_rim(roof.nodes)
@@ -377,12 +377,12 @@ def test_points_beyond_the_master_rim_unpaired():
             [0.6, 0.3, 0.5],  # above a facet (inside it)
         ]
     )
-    pick = PointCoupling._project(points, roof)
+    pick = project(points, roof)
     assert list(pick.inside) == [False] * 5 + [True]
     assert list(pick.index >= 0) == [True, True, False, False, False, True]
     # 2D: a convex kink (0, 0) -> (1, 0.5) -> (2, 0), normals up (right to left)
     x = np.array([[[2.0, 0.0], [1.0, 0.5]], [[1.0, 0.5], [0.0, 0.0]]])
     curve = Facets(x, np.array([[2, 1], [1, 0]]), x)
-    pick = PointCoupling._project(np.array([[1.0, 0.8], [-0.2, -0.05], [2.1, 0.1]]), curve)
+    pick = project(np.array([[1.0, 0.8], [-0.2, -0.05], [2.1, 0.1]]), curve)
     assert not pick.inside.any()
     assert list(pick.index >= 0) == [True, False, False]
