@@ -65,6 +65,7 @@ class Nitsche(TrialFriction, MethodBase):
         nodal_quadrature=True,
         interfaces=True,
         two_body=True,
+        two_body_tresca=True,
     )
 
     def __post_init__(self) -> None:

@@ -66,7 +66,7 @@ Nitsche friction): sigma_T(u) of the small-strain law becomes the tangential par
 traction, T_T(u) = (I - n n) P(F) N, and
 
     t = proj_{B(0, bound)}(T_T(u) - gamma slip),   bound = mu P (Coulomb; Tresca's threshold
-    where closed in the point law, not offered between two bodies),
+    where closed),
 
 with the penalty friction's frame-indifferent slip below (no traction history: the trial is
 the stress's); residual, over the reference slave surface,
@@ -478,16 +478,16 @@ class PointCoupling(PointReadout):
     def _friction(
         self, p: _Points, vals: np.ndarray, P: np.ndarray, dP: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Coulomb (Nitsche): t = proj_{B(0, mu P)}(sigma_T(u) - gamma P_T [u - u_prev]) and
-        its derivative (P, gdim, ndofs); the stick mask."""
-        assert self.mu is not None
+        """Nitsche's friction: t = proj_{B(0, s)}(sigma_T(u) - gamma P_T [u - u_prev]), s = mu P
+        (Coulomb) or Tresca's threshold where closed (P > 0), and its derivative (P, gdim,
+        ndofs); the stick mask."""
         u = vals[p["idx"]]
         gamma = p["scale"]
         Z = p["ST"] - gamma[:, None, None] * np.einsum("pig,pgh->pih", p["Jvec"], p["P_T"])
         z = np.einsum("pig,pi->pg", p["ST"], u) - gamma[:, None] * np.einsum(
             "pgh,pih,pi->pg", p["P_T"], p["Jvec"], u - p["u_prev"]
         )
-        s = self.mu * P
+        s = self.mu * P if self.mu is not None else np.where(P > 0.0, self.threshold, 0.0)
         nz = np.linalg.norm(z, axis=1)
         stick = nz <= s
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
@@ -500,7 +500,8 @@ class PointCoupling(PointReadout):
             ratio[:, None, None] * (np.eye(gdim)[None] - zhat[:, :, None] * zhat[:, None, :]),
         )
         dt = np.einsum("pgh,pih->pgi", proj, Z)
-        dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
+        if self.mu is not None:  # the bound's derivative (Tresca's is constant)
+            dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:

@@ -185,14 +185,9 @@ def test_distribution_keeps_the_contact_surfaces():
             Numerics(method="vi"),
             "not offered between two meshed bodies",
         ),
-        (
-            PatchTest(PatchTest.Params()),
-            Numerics(method="nitsche", friction="tresca", threshold=0.3),
-            "Tresca friction between two meshed bodies",
-        ),
         (PatchTest(PatchTest.Params()), Numerics(method="mortar", degree=2), "P1"),
     ],
-    ids=["vi", "tresca", "mortar-P2"],
+    ids=["vi", "mortar-P2"],
 )
 def test_two_body_refuses(scene, num, message):
     with pytest.raises(ValueError, match=message):

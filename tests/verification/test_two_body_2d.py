@@ -164,3 +164,28 @@ def test_cattaneo_cylinders_gross_slip(tmp_path):
     # the x component of the force against mu P: the contact normals are tilted by the
     # shear (the bodies rotate a little), 1.1 % measured
     assert res.reference["Q_over_bound"] == pytest.approx(1.0, abs=0.02)
+
+
+def _tresca_slide(method):
+    scene = SlidingContact(SlidingContact.Params(h_contact=0.02, h_far=0.3, refine=0.1, slide=0.1))
+    num = scene.default_numerics(method=method, friction="tresca", threshold=5.0, steps=6)
+    return scene.run(num, verbose=False)
+
+
+def test_sliding_contact_tresca_nitsche_against_penalty():
+    """Tresca friction between two bodies with Nitsche (t = proj_{B(0, s)}(sigma_T(u) -
+    gamma slip), s the threshold where closed): the rounded body dragged 0.1 over the block
+    slides at the threshold everywhere it touches. Nitsche's |t_T| integral over the bound's is
+    1 in the contact frame (the solver's tolerance), every closed point slips, and the
+    tangential force is the penalty's (the same Tresca law, another enforcement of the
+    contact: measured 6e-5 apart, the normal forces 0.8 %)."""
+    nitsche, penalty = _tresca_slide("nitsche"), _tresca_slide("penalty")
+    f = nitsche.quantities.friction
+    assert nitsche.scores["tangential_over_bound"] == pytest.approx(1.0, rel=1e-8)
+    assert f.slip_fraction == pytest.approx(1.0)
+    # the global x force against s times the closed length: the contact's tangents tilt
+    # off x on the rounded body (measured |Q| / bound = 1.0044)
+    assert abs(f.tangential_force[0]) / f.bound == pytest.approx(1.0, abs=0.01)
+    assert f.tangential_force[0] == pytest.approx(
+        penalty.quantities.friction.tangential_force[0], rel=1e-3
+    )
