@@ -487,7 +487,11 @@ class PointCoupling(PointReadout):
         z = np.einsum("pig,pi->pg", p["ST"], u) - gamma[:, None] * np.einsum(
             "pgh,pih,pi->pg", p["P_T"], p["Jvec"], u - p["u_prev"]
         )
-        s = self.mu * P if self.mu is not None else np.where(P > 0.0, self.threshold, 0.0)
+        if self.mu is not None:
+            s = self.mu * P
+        else:
+            assert self.threshold is not None  # frictional: Coulomb or Tresca
+            s = np.where(P > 0.0, self.threshold, 0.0)
         nz = np.linalg.norm(z, axis=1)
         stick = nz <= s
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
