@@ -92,7 +92,14 @@ from contactfx.contact.projection import (
     transport,
     triangle_overlaps,
 )
-from contactfx.contact.smoothing import bulges, deviation, dual_moments, vertex_normals
+from contactfx.contact.smoothing import (
+    bulges,
+    conforming,
+    deviation,
+    dual_moments,
+    mean_curvature,
+    vertex_normals,
+)
 from contactfx.params import param, validate
 
 if TYPE_CHECKING:
@@ -307,6 +314,8 @@ class MortarCoupling:
         #: the smooth surfaces' normals on symmetry planes (:mod:`.smoothing`); made at the
         #: first search
         self._held: tuple[np.ndarray, np.ndarray] | None = None
+        #: smoothing "auto": the slave's and the master's mean curvatures it decided on
+        self.curvatures: tuple[float, float] | None = None
         self.ranges = owners(self.layout.imap, self.comm)
         # the row operator T, the gap (and slip) rows G, T K and the gaps at the reference
         # configuration: made by the search (update), T K at the next Jacobian
@@ -346,14 +355,22 @@ class MortarCoupling:
         if self._reference is None:
             self._reference = self._node_sums(nodes, nodal_weights(pair.slave.X))
         own = np.zeros(slave.nodes.shape)  # int psi_j d_s: the slave's own deviation
-        if pair.smooth:
+        if pair.smooth is not False:
             if self._held is None and pair.fixed is not None:
                 held = node_held(lay.V, pair.fixed)
                 self._held = (held[pair.slave.local], held[pair.master.local])
             hs, hm = self._held if self._held is not None else (None, None)
-            master.bulge = bulges(master.x, vertex_normals(lay, pair.master, master, hm))
-            slave_normals = vertex_normals(lay, pair.slave, slave, hs)
-            own = dual_moments(slave.x, bulges(slave.x, slave_normals))
+            bulge_m = bulges(master.x, vertex_normals(lay, pair.master, master, hm))
+            bulge_s = bulges(slave.x, vertex_normals(lay, pair.slave, slave, hs))
+            if pair.smooth is None:  # "auto": decided once, at the first search
+                self.curvatures = (
+                    mean_curvature(comm, slave.x, bulge_s),
+                    mean_curvature(comm, master.x, bulge_m),
+                )
+                pair.smooth = conforming(*self.curvatures)
+            if pair.smooth:
+                master.bulge = bulge_m
+                own = dual_moments(slave.x, bulge_s)
         near, pairs = pair.search(slave, master)
         assert pairs is not None  # searched with pairs
         D, normals, (rows, cols, vals), corr = mortar_matrices(slave, near, pairs)

@@ -448,8 +448,9 @@ class ContactPair:
     interference: bool = False
     load: float = 1.0
     #: the surfaces smoothed by their nodal normals (:mod:`contactfx.contact.smoothing`):
-    #: the gap between the curved surfaces the facets approximate (mortar)
-    smooth: bool = False
+    #: the gap between the curved surfaces the facets approximate (mortar); None: decided
+    #: by the coupling's first search (``smoothing = "auto"``: conforming surfaces)
+    smooth: bool | None = False
 
     def hidden(self) -> float:
         """The fraction (1 - t) of the initial overlap still hidden at the load factor t

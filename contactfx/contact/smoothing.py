@@ -42,7 +42,7 @@ the mirror image continues the surface, and the normal is the mirrored average, 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from petsc4py import PETSc
@@ -53,12 +53,28 @@ if TYPE_CHECKING:
     from contactfx.contact.coupling import NodeLayout
     from contactfx.contact.pair import Facets, Side
 
-__all__ = ["FEATURE_ANGLE", "vertex_normals", "bulges", "deviation", "dual_moments"]
+__all__ = [
+    "FEATURE_ANGLE",
+    "CONFORMING",
+    "vertex_normals",
+    "bulges",
+    "deviation",
+    "dual_moments",
+    "mean_curvature",
+    "conforming",
+]
 
 #: the angle (degrees) between a facet's normal and a node's normal beyond which the node is a
 #: corner of the facet's surface (no smoothing there): 30 degrees, twice the turn of the
 #: coarsest curved meshes our scenes make (8 segments per quarter circle: 11.25 degrees)
 FEATURE_ANGLE = 30.0
+
+
+#: ``smoothing = "auto"``: a pair is conforming when its surfaces' mean curvatures (each > 0
+#: convex along its own outward normal) cancel to within this fraction of the larger: a fit,
+#: a pin in its hole (rings of radii b and b - delta: delta / b); Hertz's convex pairs add up
+#: (2), a curved body on a flat one does not reach it (1)
+CONFORMING = 0.25
 
 
 def _edges(d: int) -> list[tuple[int, int]]:
@@ -165,3 +181,26 @@ def dual_moments(x: np.ndarray, bulge: np.ndarray) -> np.ndarray:
         for i in range(3):
             out[:, i] += bulge[:, e] * area * (1.0 / 20.0 if i in (a, b) else -1.0 / 60.0)
     return out
+
+
+def mean_curvature(comm: Any, x: np.ndarray, bulge: np.ndarray) -> float:
+    """The mean curvature of a surface (this rank's facets x (m, d, gdim) and their bulges,
+    all ranks): each edge's 2 A / L^2 (a circle's 1 / R, > 0 convex) weighted by its length.
+    Collective."""
+    from mpi4py import MPI
+
+    total = weight = 0.0
+    for e, (i, j) in enumerate(_edges(x.shape[1]) if len(x) else []):
+        length = np.linalg.norm(x[:, j] - x[:, i], axis=1)
+        total += float(np.sum(2.0 * bulge[:, e] / length))
+        weight += float(np.sum(length))
+    total, weight = comm.allreduce(total, op=MPI.SUM), comm.allreduce(weight, op=MPI.SUM)
+    return total / weight if weight > 0.0 else 0.0
+
+
+def conforming(kappa_s: float, kappa_m: float) -> bool:
+    """Whether two surfaces of mean curvatures ``kappa_s``, ``kappa_m`` conform
+    (:data:`CONFORMING`): where the facets' chords, of relative size h kappa, are not small
+    against the relative curvature kappa_s + kappa_m that shapes the contact."""
+    larger = max(abs(kappa_s), abs(kappa_m))
+    return larger > 0.0 and abs(kappa_s + kappa_m) < CONFORMING * larger

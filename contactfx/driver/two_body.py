@@ -131,7 +131,7 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
-        if scene.smoothing() != "none" and method.name != "mortar":
+        if scene.smoothing() == "normals" and method.name != "mortar":
             raise ValueError(
                 f'contact.0.smoothing = "{scene.smoothing()}" is mortar\'s (its weighted nodal '
                 f"gaps); {method.name} measures the gap between the facets at Gauss points: "
@@ -213,7 +213,7 @@ class TwoBodyProblem(Problem):
             search_each_newton=self.num.search_update == "newton" or self.finite_strain,
             fixed=fixed,
             finite_strain=self.finite_strain,
-            smooth=scene.smoothing() == "normals",
+            smooth={"normals": True, "none": False}.get(scene.smoothing()),
         )
         if isinstance(self.friction, Coulomb):
             self.pair.mu = self.friction.mu
@@ -513,6 +513,19 @@ class TwoBodyPost:
         count = self.comm.allreduce(int(np.count_nonzero(touching)), op=MPI.SUM)
         return total / count if count else 0.0
 
+    def auto_smoothing(self) -> list[str]:
+        """The note of mortar's ``smoothing = "auto"`` choosing the smoothed surfaces (a
+        conforming pair), with the mean curvatures it read; [] otherwise."""
+        curvatures = getattr(self.pb.coupling(), "curvatures", None)
+        if curvatures is None or not self.pb.pair.smooth:
+            return []
+        ks, km = curvatures
+        return [
+            f"mortar's gap is the one between the smoothed surfaces (smoothing = auto: a "
+            f'conforming pair, mean curvatures {ks:.3g} and {km:.3g}); smoothing = "none" '
+            "on the pair for the facets'"
+        ]
+
     def zone_warnings(self) -> list[str]:
         """The warnings of the last step's closed set on the slave surface
         (:func:`zone_warnings`): its rim here is the surface's end, not a symmetry plane (a
@@ -629,7 +642,7 @@ class TwoBodyPost:
                     comments="",
                     header=header,
                 )
-        extra: dict[str, Any] = {"warnings": self.zone_warnings()}
+        extra: dict[str, Any] = {"warnings": self.auto_smoothing() + self.zone_warnings()}
         if self.scene.h_contact_in_zone and self.zone_size > 0.0:
             extra["h_contact"] = self.zone_size
         return {

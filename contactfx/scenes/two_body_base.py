@@ -36,10 +36,11 @@ __all__ = [
 INTERFERENCES = ("ramp",)
 
 #: what ``contact.smoothing`` may name (mortar's, :mod:`contactfx.contact.smoothing`): the gap
-#: between the facets (``none``, the default), or between the curved surfaces the facets
-#: approximate, from the nodal normals (``normals``: conforming curved interfaces, fits,
-#: bearings, where the facets' chords make the nodal pressure oscillate)
-SMOOTHINGS = ("none", "normals")
+#: between the curved surfaces the facets approximate, from the nodal normals (``normals``:
+#: conforming curved interfaces, fits, bearings, where the facets' chords make the nodal
+#: pressure oscillate), between the facets (``none``), or ``auto`` (the default): ``normals``
+#: for a conforming pair (its mean curvatures cancel), else ``none``
+SMOOTHINGS = ("auto", "none", "normals")
 
 
 def two_elastic(E0: float, nu0: float) -> type:
@@ -152,8 +153,9 @@ class TwoBodyScene(Scene):
 
     def smoothing(self) -> str:
         """How mortar's gap sees curved surfaces (:data:`SMOOTHINGS`): ``none``, the facets;
-        ``normals``, the surfaces the facets approximate, smoothed by the nodal normals."""
-        return "none"
+        ``normals``, the surfaces the facets approximate, smoothed by the nodal normals;
+        ``auto``, normals for a conforming pair."""
+        return "auto"
 
     def edge_ring(self) -> float | None:
         """The ring width of the ``radial`` edge rule (the slave element size)."""
@@ -202,7 +204,7 @@ class TwoBodyScene(Scene):
                 pair["edge_ring"] = float(self.edge_ring())
         if self.interference() is not None:
             pair["interference"] = self.interference()
-        if self.smoothing() != "none":
+        if self.smoothing() != "auto":
             pair["smoothing"] = self.smoothing()
         output: dict = {"symmetry": float(self.symmetry)}
         if self.symmetry_planes:

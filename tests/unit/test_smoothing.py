@@ -10,7 +10,7 @@ import pytest
 from contactfx.contact.mortar import dual_triangle
 from contactfx.contact.pair import facet_normals
 from contactfx.contact.projection import gauss_triangle
-from contactfx.contact.smoothing import bulges, deviation, dual_moments
+from contactfx.contact.smoothing import bulges, conforming, deviation, dual_moments, mean_curvature
 
 
 def _arc(R: float, n: int, turn: float = np.pi / 2):
@@ -97,3 +97,22 @@ def test_dual_moments_against_quadrature():
     d = deviation(A3[:, None, :], pts[None])
     ref3 = np.einsum("q,fq,qi->fi", wts, d, dual_triangle(pts)) * area[:, None]
     assert dual_moments(x3, A3) == pytest.approx(ref3, rel=1e-12)
+
+
+def test_mean_curvature_and_conforming_pairs():
+    """The mean curvature of an arc's chords is 1 / R (convex > 0, concave < 0); a fit (radii
+    1.5 and 1.495, opposite sides) conforms, two convex cylinders and a cylinder on a flat
+    face do not."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_SELF
+    x, normals = _arc(1.5, 32)
+    convex = mean_curvature(comm, x, bulges(x, normals))
+    # the chords' quadratic: 2 A / L^2 = 2 tan(theta / 2) / L = 1 / R (1 + O(theta^2))
+    assert convex == pytest.approx(1.0 / 1.5, rel=1e-3)
+    xb, nb = _arc(1.495, 32)
+    bore = mean_curvature(comm, xb[:, ::-1], bulges(xb[:, ::-1], -nb[:, ::-1]))
+    assert bore == pytest.approx(-1.0 / 1.495, rel=1e-3)
+    assert conforming(bore, convex) and conforming(convex, bore)
+    assert not conforming(convex, convex)
+    assert not conforming(convex, 0.0) and not conforming(0.0, 0.0)

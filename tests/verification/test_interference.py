@@ -163,8 +163,9 @@ def _rings(folder: Path, h: float, toml: str = RINGS_TOML) -> Path:
     return path
 
 
-#: mortar's gap between the smoothed surfaces (``contact.smoothing``)
+#: mortar's gap between the smoothed surfaces (``contact.smoothing``), and between the facets
 SMOOTH = ["contact.0.smoothing=normals"]
+FACETS = ["contact.0.smoothing=none"]
 
 
 def _solve(path: Path, sets=(), comm=MPI.COMM_WORLD):
@@ -186,7 +187,8 @@ def shared_tmp(tmp_path):
 #: 0.97 % above the closed form, and the errors from it fall by 4.0 to 4.9 per halving
 #: (O(h^2)). Mortar with the gap between the smoothed surfaces (``smoothing = "normals"``,
 #: :mod:`contactfx.contact.smoothing`): 0.055 % and 0.013 % from the meshed geometry's
-#: solution (2.50 / 1.34 % from the closed form with the facets' gap, the default)
+#: solution (2.50 / 1.34 % from the closed form with the facets' gap, ``smoothing = "none"``; the
+#: default, ``auto``, smooths this conforming pair)
 MEASURED = {"mortar": (0.0102, 0.0098), "nitsche": (0.0276, 0.0138), "penalty": (0.0271, 0.0135)}
 
 
@@ -243,7 +245,7 @@ def test_mortar_pressure_smooth_whichever_side_is_slave(shared_tmp, slave):
     pressure within 2 % of the meshed geometry's at h = 0.05 (measured -1.1 % .. +0.9 % with
     the bore as slave, -1.5 % .. +1.3 % with the inner ring; -0.4 % .. +0.4 % and -0.7 % ..
     +0.5 % at h = 0.025; the mean 0.055 % and 0.057 % from it, 0.013 % at h = 0.025), and with
-    the facets' gap (the default) the finer slave's nodal pressure swings from 0 to
+    the facets' gap (``smoothing = "none"``) the finer slave's nodal pressure swings from 0 to
     3.25 times p with 36 of 69 nodes open (0.07 to 2.6 p at h = 0.025), the coarser slave's
     within -3.6 % .. +7.7 % (its nodes do not resolve the finer master's kinks)."""
     h = 0.05
@@ -252,11 +254,17 @@ def test_mortar_pressure_smooth_whichever_side_is_slave(shared_tmp, slave):
     meshed = on_bore if slave == "bore" else on_inner
     scene, smooth = _solve(_rings(shared_tmp, h, toml), SMOOTH)
     assert smooth.warnings == []
+    # the default, smoothing = "auto", finds the pair conforming (mean curvatures 1 / b and
+    # -1 / (b - delta) cancel to delta / b): the same run, and a note saying so
+    auto, noted = _solve(_rings(shared_tmp, h, toml))
+    assert np.array_equal(auto.pressure, scene.pressure)
+    (note,) = noted.warnings
+    assert "smoothing = auto: a conforming pair" in note
     deviation = scene.pressure / meshed - 1.0
     assert np.all(np.abs(deviation) < 0.02)
     # the mean: the meshed geometry's to O(h^2) (measured 5.5e-4, 5.7e-4)
     assert scene.mean_pressure == pytest.approx(meshed, rel=1.5e-3)
-    facets, res = _solve(_rings(shared_tmp, h, toml))  # the default: the facets' gap
+    facets, res = _solve(_rings(shared_tmp, h, toml), FACETS)
     p = facets.pressure / meshed
     if slave == "inner":
         # the finer side's nodes on the coarser side's chords: a third or more open, and

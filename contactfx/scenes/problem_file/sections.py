@@ -426,7 +426,7 @@ def read_pair(r: Reader, data: dict, bodies: tuple[BodySpec, ...]) -> PairSpec:
     interference = None
     if "interference" in c:
         interference = r.string(c, "contact.0", "interference", INTERFERENCES)
-    smoothing = "none"
+    smoothing = "auto"
     if "smoothing" in c:
         smoothing = r.string(c, "contact.0", "smoothing", SMOOTHINGS)
     return PairSpec(slave, master, h, force_on, edge, ring, interference, smoothing)

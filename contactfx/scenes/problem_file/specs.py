@@ -137,8 +137,9 @@ class PairSpec:
     edge_ring: float | None = None
     #: an initial overlap of the pair: "ramp" (removed over the load program) or None
     interference: str | None = None
-    #: mortar's gap between the facets ("none") or the smoothed surfaces ("normals")
-    smoothing: str = "none"
+    #: mortar's gap between the facets ("none"), the smoothed surfaces ("normals") or, for
+    #: a conforming pair, the smoothed ones ("auto")
+    smoothing: str = "auto"
 
 
 @dataclass(frozen=True)
