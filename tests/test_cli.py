@@ -128,10 +128,6 @@ BAD = [
     ),
     (["run", "hertz2d", "--mu", "0.3"], "--mu needs --friction coulomb"),
     (["run", "sliding-block", "--method", "vi"], "not supported by method 'vi'"),
-    (
-        ["run", "cattaneo-cylinders", "--friction", "tresca", "--mu=0", "--threshold=0.3"],
-        "method nitsche has no Tresca friction between two meshed bodies",
-    ),
     # the press-then-drag scenes' press_fraction, checked once (contactfx/scenes/two_body_2d.py)
     (["run", "shallow-ironing", "--press-fraction", "1"], "--press-fraction must be < 1"),
     (["run", "cattaneo-cylinders", "--press-fraction", "1.5"], "--press-fraction must be < 1"),
