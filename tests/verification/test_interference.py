@@ -255,9 +255,10 @@ def test_mortar_pressure_smooth_whichever_side_is_slave(shared_tmp, slave):
     scene, smooth = _solve(_rings(shared_tmp, h, toml), SMOOTH)
     assert smooth.warnings == []
     # the default, smoothing = "auto", finds the pair conforming (mean curvatures 1 / b and
-    # -1 / (b - delta) cancel to delta / b): the same run, and a note saying so
+    # -1 / (b - delta) cancel to delta / b): the same run to the solver's tolerance (bit for
+    # bit on one rank; two meshings of the same file may partition differently), and a note
     auto, noted = _solve(_rings(shared_tmp, h, toml))
-    assert np.array_equal(auto.pressure, scene.pressure)
+    assert np.allclose(auto.pressure, scene.pressure, rtol=0.0, atol=1e-9 * meshed)
     (note,) = noted.warnings
     assert "smoothing = auto: a conforming pair" in note
     deviation = scene.pressure / meshed - 1.0
