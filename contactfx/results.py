@@ -327,7 +327,7 @@ def never_closed(steps: list[StepLog], what: str, gap: float | None = None) -> l
 PIECES = 5
 
 
-def _pieces(nodes: np.ndarray, closed: np.ndarray) -> int:
+def closed_pieces(nodes: np.ndarray, closed: np.ndarray) -> int:
     """The connected pieces of the closed nodes over the facets ``nodes`` (m, d)."""
     ids = np.unique(nodes[closed])
     if len(ids) == 0:
@@ -374,7 +374,7 @@ def zone_messages(
                 f"the contact zone's edge lies on facets {ratio:.2g} times the finest it "
                 "covers: the contact has grown out of the refined region (refine further out)"
             )
-    pieces = _pieces(nodes, closed)
+    pieces = closed_pieces(nodes, closed)
     if pieces >= PIECES:
         out.append(
             f"the closed set breaks into {pieces} pieces along the slave surface: the nodal "

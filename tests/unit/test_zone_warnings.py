@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from contactfx.results import PIECES, _pieces, zone_messages
+from contactfx.results import PIECES, closed_pieces, zone_messages
 
 N = 20
 NODES = np.stack([np.arange(N), np.arange(1, N + 1)], axis=1)  # a line of 21 nodes
@@ -21,7 +21,7 @@ def _facets(closed_nodes, sizes=None):
 
 def test_a_centred_zone_on_a_fine_mesh_warns_nothing():
     assert zone_messages(*_facets(np.arange(5, 15))) == []
-    assert _pieces(NODES, np.isin(NODES, np.arange(5, 15))) == 1
+    assert closed_pieces(NODES, np.isin(NODES, np.arange(5, 15))) == 1
 
 
 def test_the_zone_at_the_surface_end():
@@ -40,12 +40,12 @@ def test_the_zone_edge_on_coarse_facets():
 
 def test_a_closed_set_in_pieces():
     every_third = np.arange(2, 19, 3)  # 6 isolated closed nodes: 6 pieces
-    assert _pieces(NODES, np.isin(NODES, every_third)) == 6
+    assert closed_pieces(NODES, np.isin(NODES, every_third)) == 6
     (line,) = zone_messages(*_facets(every_third))
     assert "breaks into 6 pieces" in line and 'smoothing = "normals"' in line
     # two zones each with one node left open: 4 pieces, under PIECES
     four = np.setdiff1d(np.r_[2:8, 12:18], [4, 15])
-    assert _pieces(NODES, np.isin(NODES, four)) == 4 < PIECES
+    assert closed_pieces(NODES, np.isin(NODES, four)) == 4 < PIECES
     assert zone_messages(*_facets(four)) == []
 
 
@@ -53,4 +53,4 @@ def test_pieces_of_triangles():
     # two triangles sharing the edge (1, 2) and a third apart: closed 0, 1, 2 and 5
     nodes = np.array([[0, 1, 2], [1, 3, 2], [4, 5, 6]])
     closed = np.isin(nodes, [0, 1, 2, 5])
-    assert _pieces(nodes, closed) == 2
+    assert closed_pieces(nodes, closed) == 2
