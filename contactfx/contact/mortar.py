@@ -49,8 +49,8 @@ node's tangential equilibrium is lost while the reaction is forced to zero). The
 thus lives on the slave nodes only; no unknown is added. Frictionless, the Jacobian is exact
 for the mortar matrices and normals of the last search: J = diag(s) T K + diag(w) G with
 s = D_j dC/dlambda on the normal rows (1 elsewhere) and w = D_j c_j dC/d(cg). With
-``--search-update newton`` the search runs at every residual and the derivatives of D, M and
-n_j are not linearised.
+``--search-update newton`` (and at finite strain) the search runs at every residual, and the
+Jacobian adds the variation of D, M and n_j with the displacement (:mod:`.mortar_tangent`).
 
 Coulomb friction (``--friction coulomb``): the tangent rows carry the tangential multiplier
 lambda_T,jc = -t_jc . R_j / D_j (the master rows receive M_jk / D_j times the whole free part
@@ -85,6 +85,13 @@ from petsc4py import PETSc
 from contactfx.contact.coupling import NodeLayout, blocked_rows
 from contactfx.contact.method import MethodBase, Supports
 from contactfx.contact.mortar_integrals import dual_triangle, mortar_matrices, nodal_weights
+from contactfx.contact.mortar_tangent import (
+    Geometry,
+    NodeState,
+    frames,
+    geometry_derivatives,
+    tangent_entries,
+)
 from contactfx.contact.pair import node_held, owners
 from contactfx.contact.projection import (
     transport,
@@ -171,6 +178,10 @@ class MortarCoupling:
         self.layout: NodeLayout = pair.layout
         self.comm = self.layout.comm
         self.search_each_newton = pair.search_each_newton
+        #: searched at every residual: what the last search integrated, for the consistent
+        #: tangent (:mod:`.mortar_tangent`); the frame-indifferent slip's history there
+        self.geometry: Geometry | None = None
+        self._history: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         #: the held components of the slave and master facets' vertices (m, d, gdim), for
         #: the smooth surfaces' normals on symmetry planes (:mod:`.smoothing`); made at the
         #: first search
@@ -212,6 +223,10 @@ class MortarCoupling:
         gdim = lay.gdim
         ub = u.reshape(-1, lay.bs)[:, :gdim]
         slave, master = pair.slave.current(ub), pair.master.current(ub)
+        if self.search_each_newton and self.mu is not None:
+            assert self.previous is not None  # set with mu
+            prev = self.previous.x.array.reshape(-1, lay.bs)[:, :gdim]
+            master.shift = (ub - prev)[pair.master.local]
         nodes = slave.nodes.reshape(-1)
         if self._reference is None:
             self._reference = self._node_sums(nodes, nodal_weights(pair.slave.X))
@@ -234,6 +249,8 @@ class MortarCoupling:
                 own = dual_moments(slave.x, bulge_s)
         near, pairs = pair.search(slave, master)
         assert pairs is not None  # searched with pairs
+        #: what the consistent tangent differentiates (:mod:`.mortar_tangent`)
+        self.geometry = Geometry(slave, near, pairs) if self.search_each_newton else None
         D, normals, (rows, cols, vals), corr = mortar_matrices(slave, near, pairs)
         # nodal sums on the owners: D_j, the sum of weighted normals, int psi_j d_m over
         # the overlaps and int psi_j d_s over the support
@@ -305,7 +322,7 @@ class MortarCoupling:
         if self.pair.fixed is not None:
             local = (uniq - lay.start).astype(np.int64)
             free = ~self.pair.fixed.reshape(-1, bs)[local, :gdim]
-        n_free, comp, tangents = _frames(nj, free)
+        n_free, comp, tangents = frames(nj, free)
         # a normal nearly along the fixed components: the support carries the contact
         contact &= np.linalg.norm(n_free, axis=1) > 0.5
         keep = contact[key]
@@ -315,6 +332,10 @@ class MortarCoupling:
         self.D0 = D0[np.searchsorted(uniq0, self.nodes)]
         self.normal, self.comp = nj[contact], comp[contact]
         n_free, tangents, free = n_free[contact], tangents[contact], free[contact]
+        self.free = free
+        #: the contact nodes' M entries (slave node, master node, M_jk before the
+        #: rescaling): the consistent tangent's (:mod:`.mortar_tangent`)
+        self.m_entries = (m_rows[keep], m_cols[keep], m_vals[keep])
         self.h = self.D ** (1.0 / max(gdim - 1, 1))
         self.c = self.r0 * self.pair.E / self.h
         self.overlap = self._overlap_of(self.nodes)
@@ -475,11 +496,13 @@ class MortarCoupling:
         # d proj / d xi = zhat on slip, d xi = mu (d lambda - c d g) where lambda > c g
         dxi = np.where(~stick & (arg > 0.0), self.mu, 0.0)
         d_lam = -zhat * dxi[:, None]
-        self.stick, self.xi = stick, xi
+        self.stick, self.xi, self._bound = stick, xi, arg > 0.0
         return (lt - proj, eye - dproj, -dproj * c[:, :, None], d_lam, -d_lam * self.c[:, None])
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         lam, cg, C, self._da, self._db = self._state(x, F)
+        if self.geometry is not None:  # the bulk's residual at the contact nodes
+            self._R = F.getArray()[self.tangent_rows()]
         self.lam, self.gap = lam, cg / self.c
         self._y.copy(F)
         out = F.getArray()
@@ -502,10 +525,14 @@ class MortarCoupling:
         if bulk_changed and self.TK is not None:
             self.TK.destroy()
             self.TK = None
+        # searched at every residual: the geometry's variation (:mod:`.mortar_tangent`)
+        geo = self._geometric(x) if self.geometry is not None else None
         if self.TK is None:
             self.TK = self.T.matMult(K)
             union = self.TK.copy()
             union.axpy(1.0, self.G, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            if geo is not None:
+                union.axpy(1.0, geo, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             J.zeroEntries()
             J.axpy(1.0, union, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             union.destroy()
@@ -528,6 +555,53 @@ class MortarCoupling:
         J.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         A.destroy()
         B.destroy()
+        if geo is not None:
+            J.axpy(1.0, geo, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+            geo.destroy()
+
+    def _geometric(self, x: PETSc.Vec) -> PETSc.Mat:
+        """The variation of the mortar integrals and the nodal normals with the displacement
+        at x (the last residual's), as a matrix of the Jacobian's layout
+        (:mod:`.mortar_tangent`). Collective."""
+        assert self.geometry is not None
+        lay = self.layout
+        bs = lay.bs
+        records, m_records = geometry_derivatives(self.geometry, bs)
+        j, (col, val) = _to_owners(self.comm, self.ranges, records[0], list(records[1:]))
+        mj, (mk, mcol, dM) = _to_owners(self.comm, self.ranges, m_records[0], list(m_records[1:]))
+        rows = self.tangent_rows()
+        u = x.getArray()[rows]
+        du = np.zeros_like(u)
+        if self.mu is not None:
+            assert self.previous is not None  # set with mu
+            du = u - self.previous.x.array[rows]
+        state = NodeState(
+            R=self._R,
+            x=lay.X.getArray()[rows] + u,
+            du=du,
+            shift=self.smoothed - self.pair.hidden() * self.overlap,
+            free=self.free,
+            comp=self.comp,
+            tmask=self.tmask,
+            active=self._db > 0.5,
+            c0=self.r0 * self.pair.E,
+            ncp=self.ncp,
+            E=self.pair.E,
+            mu=self.mu,
+            stick=getattr(self, "stick", None),
+            bound=getattr(self, "_bound", None),
+            objective=self._history if self.objective else None,
+        )
+        own, master = tangent_entries(
+            self.nodes, state, (j, col, val), (mj, mk, mcol, dM), self.m_entries, bs
+        )
+        _, (m_r, m_c, m_v) = _to_owners(self.comm, self.ranges, master[0] // bs, list(master))
+        return _owned_matrix(
+            lay,
+            np.concatenate([own[0], m_r]),
+            np.concatenate([own[1], m_c]),
+            np.concatenate([own[2], m_v]),
+        )
 
     def _friction_blocks(self, da: np.ndarray, db: np.ndarray) -> tuple[PETSc.Mat, PETSc.Mat]:
         """(P T K, Q G): the nodal blocks P, Q (identity and zero away from the contact nodes)
@@ -603,26 +677,52 @@ class MortarCoupling:
         search's normal, as the rest of the rows. A node closed at the last step only."""
         assert self.g0 is not None
         nodes_old, b_kept, n_kept = self._b_old
+        self._history = None
         if len(nodes_old) == 0:
             return
         pos = np.minimum(np.searchsorted(nodes_old, self.nodes), len(nodes_old) - 1)
         has = nodes_old[pos] == self.nodes
         b_old, n_old = b_kept[pos[has]], n_kept[pos[has]]
         change = transport(n_old, self.normal[has], b_old) - b_old
+        self._history = (has, b_old, n_old)
         correction = np.zeros((len(self.nodes), self.layout.gdim))
         correction[has] = np.einsum("jci,ji->jc", self.tangents[has], change)
         rows = self.tangent_rows()[self.tmask]
         self.g0.getArray()[rows] += correction[self.tmask]
 
     def converged(self) -> None:
-        """The slip history is the problem's last converged state; with the frame-indifferent
-        slip also the weighted gap vectors of the closed nodes (:meth:`_objective_slip`)."""
+        """A step converged: the number of closed nodes (:meth:`lost`). The slip history is
+        the problem's last converged state; with the frame-indifferent slip also the weighted
+        gap vectors of the closed nodes (:meth:`_objective_slip`). Collective."""
+        from mpi4py import MPI
+
+        closed = self.lam - self.c * self.gap > 0.0
+        self.closed_before = self.comm.allreduce(int(np.sum(closed)), op=MPI.SUM)
         if not self.objective:
             return
         assert self.previous is not None  # set with mu
         b = self._gap_vectors(self.previous.x.array)
-        closed = self.lam - self.c * self.gap > 0.0
         self._b_old = (self.nodes[closed], b[closed], self.normal[closed])
+
+    #: the slave nodes closed at the last converged step (all ranks)
+    closed_before = 0
+
+    def lost(self) -> str | None:
+        """After a converged solve: why it is no solution of the contact problem, or None. A
+        solve whose last search found no contact node (no slave node's support over the master
+        surface), while nodes were closed at the last converged step, has lost the contact: a
+        Newton iterate carried one body through the other, and the solve converged with the
+        bodies overlapping and no contact force (seen on shallow-ironing as the die starts to
+        slide). Collective."""
+        from mpi4py import MPI
+
+        if self.closed_before > 0 and self.comm.allreduce(len(self.nodes), op=MPI.SUM) == 0:
+            return (
+                f"the contact was lost ({self.closed_before} slave nodes closed at the last "
+                "step, no contact node now: a Newton iterate carried one body through the "
+                "other)"
+            )
+        return None
 
     def force(self) -> float:
         """The normal contact force sum_j D_j lambda_j of the pair."""
@@ -730,31 +830,3 @@ def _owned_matrix(
     )
     M.assemble()
     return M
-
-
-def _frames(n: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Nodal frames restricted to the free (not Dirichlet) components.
-
-    n: (m, gdim) unit normals, free: (m, gdim) bool. Returns n_F = the normals' free part,
-    comp = the free component of largest |n_F| (the row of the complementarity), and
-    tangents (m, gdim, gdim): for every free component c != comp the unit vector of the free
-    subspace orthogonal to n_F and to the tangents of the lower components (Gram-Schmidt of
-    e_c; e_c and n_F span the free subspace because n_F is largest at comp), zero rows
-    elsewhere. Without fixed components these are tangent planes' orthonormal bases."""
-    m, gdim = n.shape
-    n_free = np.where(free, n, 0.0)
-    comp = np.argmax(np.abs(n_free), axis=1)
-    norm = np.linalg.norm(n_free, axis=1)
-    basis = [n_free / np.where(norm > 0, norm, 1.0)[:, None]]
-    tangents = np.zeros((m, gdim, gdim))
-    for c in range(gdim):
-        use = free[:, c] & (comp != c)
-        v = np.zeros((m, gdim))
-        v[:, c] = 1.0
-        for b in basis:
-            v -= np.sum(v * b, axis=1)[:, None] * b
-        length = np.linalg.norm(v, axis=1)
-        v = np.where(use[:, None], v / np.where(length > 0, length, 1.0)[:, None], 0.0)
-        tangents[:, c] = v
-        basis.append(v)
-    return n_free, comp, tangents

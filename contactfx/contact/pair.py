@@ -81,6 +81,9 @@ class Facets:
     #: (m, edges) the smooth surface's deviation from each facet
     #: (:func:`contactfx.contact.smoothing.bulges`), or None: the facets are the surface
     bulge: np.ndarray | None = None
+    #: (m, d, gdim) the vertices' displacement since the last converged step (the mortar's
+    #: consistent tangent with friction, :mod:`.mortar_tangent`), or None
+    shift: np.ndarray | None = None
 
     def subset(self, keep: np.ndarray) -> Facets:
         """The facets selected by ``keep`` (a mask or indices), with their fields."""
@@ -95,6 +98,7 @@ class Facets:
             sub(self.open_vertex),
             sub(self.open_edge),
             sub(self.bulge),
+            sub(self.shift),
         )
 
     def __len__(self) -> int:
@@ -363,7 +367,7 @@ def gather_near(comm: MPI.Comm, master: Facets, region: Facets, radius: float) -
     if comm.size == 1:
         return master.subset(_boxes_meet(lo, hi, boxes[0]))
     # the optional fields travel with their facets (None on every rank alike)
-    optional = [master.X, master.open_vertex, master.open_edge, master.bulge]
+    optional = [master.X, master.open_vertex, master.open_edge, master.bulge, master.shift]
     sends = []
     for b in boxes:
         keep = _boxes_meet(lo, hi, b)

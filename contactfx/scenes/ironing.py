@@ -244,20 +244,24 @@ class ShallowIroning(PressThenDrag):
         if len(on) < 2:
             return scores
         Pm, Qm = float(np.mean(P[on])), float(np.mean(Q[on]))
+
+        def per(value: float) -> float:  # no force on the plateau (lost): undefined
+            return value / Pm if Pm != 0.0 else float("nan")
+
         scores.update(
             P_plateau=Pm,
             Q_plateau=Qm,
             P_plateau_error=(Pm - PUBLISHED_P) / PUBLISHED_P,
-            Q_over_P=Qm / Pm,
-            P_jump=float(np.max(np.abs(np.diff(P[on])))) / Pm,
-            Q_jump=float(np.max(np.abs(np.diff(Q[on])))) / Pm,
+            Q_over_P=per(Qm),
+            P_jump=per(float(np.max(np.abs(np.diff(P[on]))))),
+            Q_jump=per(float(np.max(np.abs(np.diff(Q[on]))))),
             plateau_steps=float(len(on)),
         )
         published = self.published_Q()
         if published is not None:
             scores["Q_plateau_error"] = (Qm - published) / published
         if self.coulomb:
-            scores["Q_over_P_over_mu"] = Qm / Pm / self.mu
+            scores["Q_over_P_over_mu"] = per(Qm) / self.mu
         return scores
 
     def run(self, numerics, *, comm=MPI.COMM_WORLD, out=None, **kwargs):
