@@ -57,6 +57,7 @@ abscissae and weights were refined to 25 digits on the moment equations (residua
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -779,8 +780,18 @@ def gauss_segment(n: int) -> tuple[np.ndarray, np.ndarray]:
     for polynomials of degree 2n - 1. The integral over [x0, x1] is (x1 - x0) sum w f(x)."""
     if n < 1:
         raise ValueError(f"gauss_segment needs n >= 1, got {n}")
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = _leggauss(n)
     return 0.5 * (x + 1.0), 0.5 * w
+
+
+@functools.lru_cache(maxsize=16)
+def _leggauss(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's Gauss-Legendre rule on [-1, 1], computed once per n (the mortar integrals ask
+    for it at every search)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
 
 
 def _s21(a: float) -> list[tuple[float, float, float]]:
