@@ -570,7 +570,7 @@ class MortarCoupling:
         j, (col, val) = _to_owners(self.comm, self.ranges, records[0], list(records[1:]))
         mj, (mk, mcol, dM) = _to_owners(self.comm, self.ranges, m_records[0], list(m_records[1:]))
         rows = self.tangent_rows()
-        u = x.getArray()[rows]
+        u = x.getArray(readonly=True)[rows]
         du = np.zeros_like(u)
         if self.mu is not None:
             assert self.previous is not None  # set with mu
