@@ -14,6 +14,7 @@ import signal
 import sys
 
 from contactfx.cli.args import petsc_dict, split_petsc
+from contactfx.solvers.interrupt import Interrupted
 
 __all__ = ["main"]
 
@@ -130,6 +131,15 @@ def _main(argv: list[str] | None) -> int:
         raise
     except SystemExit as exc:  # argparse: --help (0) or a bad option (2, message printed)
         return int(exc.code or 0)
+    except Interrupted as stopped:  # SIGTERM / SIGINT: the complete steps are kept
+        if comm.rank == 0:
+            print(
+                f"contactfx: {stopped}: the output holds the complete steps, run.json says "
+                '"interrupted"',
+                file=sys.stderr,
+                flush=True,
+            )
+        return 128 + stopped.signum
     except Exception as exc:  # every error becomes one line and a status
         from contactfx.solvers.snes import ConvergenceError
 

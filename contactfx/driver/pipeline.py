@@ -26,6 +26,7 @@ from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
 from contactfx.results import RunSummary, StepLog, never_closed
+from contactfx.solvers.interrupt import Interrupted, StopRequest
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, ConvergenceError
 from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 
@@ -65,11 +66,46 @@ def run(
             time_limit=time_limit,
         )
         return run_.execute()
+    except Interrupted as stopped:
+        if folder is not None and comm.rank == 0:
+            write_interrupted(folder, stopped, scene, numerics, comm.size)
+        raise
     except Exception as error:
         if folder is not None:
             stage = "input" if run_ is None else run_.stage
             write_failed(folder, error, stage, comm, scene=scene, numerics=numerics)
         raise
+
+
+def write_interrupted(
+    out: Path, stopped: Interrupted, scene: Scene, numerics: Numerics, ranks: int
+) -> None:
+    """run.json of a run stopped by a signal (rank 0): ``"status": "interrupted"``, the
+    signal, the last complete step and its load factor, those steps' records (their fields
+    are in the ParaView files, whose index lists exactly them) and what a restart needs."""
+    data: dict[str, Any] = {
+        "status": "interrupted",
+        "stage": "solve",
+        "error": str(stopped),
+        "signal": stopped.signal,
+        "last_complete_step": stopped.step,
+        "load": stopped.load,
+        "scene": scene.name,
+        "parameters": dataclasses.asdict(scene.p),
+        "numerics": dataclasses.asdict(numerics),
+        "steps": [s.to_json() for s in stopped.records],
+        "restart": (
+            "no checkpoint is written yet: run the same command again to compute the whole "
+            "load program"
+        ),
+        "versions": versions(),
+        "ranks": ranks,
+    }
+    try:
+        Path(out).mkdir(parents=True, exist_ok=True)
+        write_json_local(Path(out) / "run.json", data)
+    except (OSError, TypeError, ValueError):
+        pass
 
 
 #: the stages a run.json of a failed run names: the request and its input, the mesh, the
@@ -354,7 +390,19 @@ class _Run:
                 max_increment=self.num.max_increment or None,
                 predictor=self.num.predictor,
             )
-            march(stepper, solver, problem.apply_load, on_step=on_step, diagnose=problem.diagnose)
+            with StopRequest(self.comm) as stop:
+                try:
+                    march(
+                        stepper,
+                        solver,
+                        problem.apply_load,
+                        on_step=on_step,
+                        diagnose=problem.diagnose,
+                        stop=stop,
+                    )
+                except Interrupted as err:
+                    err.records = steps  # the complete steps, with their quantities
+                    raise
             total = time.perf_counter() - t0
         self.timings["assembly"] = solver.timer.assembly + self.timings.pop("chain_assembly", 0.0)
         if problem.coupling() is not None:  # two bodies: the coupling's share of the assembly

@@ -26,6 +26,7 @@ from typing import Any, Protocol
 from petsc4py import PETSc
 
 from contactfx import _compat
+from contactfx.solvers.interrupt import Interrupted, StopRequest
 from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
 
 __all__ = ["StepRecord", "Snapshot", "Stepper", "QuasiStatic", "march", "run_load_program"]
@@ -242,13 +243,16 @@ def march(
     *,
     on_step: Callable[[StepRecord], None] | None = None,
     diagnose: Callable[[], str] | None = None,
+    stop: StopRequest | None = None,
 ) -> list[StepRecord]:
     """Run ``stepper``'s program with ``solver`` (any solver of the :class:`ContactSNES`
     shape: ``u``, ``assemble_load()``, ``solve()``); ``apply_load(t)`` sets the loads'
     constants (obstacle position, tractions) for time t, ``on_step`` sees each converged
     step. When the stepper gives up, ``ConvergenceError`` names the SNES reason, the step
     and the time, and what ``diagnose()`` (collective) finds in the failed iterate (e.g. an
-    inverted element), with the last converged state restored."""
+    inverted element), with the last converged state restored. ``stop``: asked at every step
+    boundary (collective); a signal received raises :class:`Interrupted` after the step in
+    progress (:mod:`contactfx.solvers.interrupt`)."""
     records: list[StepRecord] = []
     stepper.start(_compat.petsc_vec(solver.u))
     try:
@@ -272,6 +276,9 @@ def march(
             records.append(record)
             if on_step is not None:
                 on_step(record)
+            signum = stop.requested() if stop is not None else 0
+            if signum and not stepper.done():
+                raise Interrupted(signum, stepper.step, t, records)
     finally:
         stepper.destroy()
     return records

@@ -1,0 +1,76 @@
+"""A run stopped by SIGTERM (a batch scheduler's) finishes its step in progress, keeps the
+complete steps' output, writes run.json marked "interrupted", prints one line and exits
+non-zero: serially, and at 2 ranks with the signal sent to mpirun (which forwards it to every
+rank) or to one rank only (the others learn of it at the step boundary). No rank hangs: every
+process ends within the timeout."""
+
+import json
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import clean_env, contactfx_cmd
+from contactfx.io.vtk import read_pvd
+
+pytestmark = pytest.mark.serial_only
+
+#: hertz2d with a fine contact zone: about a second a load step, twelve steps
+SLOW = ["run", "hertz2d", "--h-contact", "0.0006", "--steps", "12"]
+
+
+def _children(pid: int) -> list[int]:
+    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True)
+    return [int(p) for p in out.stdout.split()]
+
+
+@pytest.mark.parametrize("target", ["serial", "mpirun", "one-rank"])
+def test_sigterm_marks_the_run_interrupted(tmp_path, target):
+    out = tmp_path / "out"
+    ranks = 1 if target == "serial" else 2
+    proc = subprocess.Popen(
+        contactfx_cmd(*SLOW, "--out", str(out), ranks=ranks),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=clean_env(),
+    )
+    assert proc.stdout is not None
+    seen = []
+    deadline = time.monotonic() + 240
+    for line in proc.stdout:  # wait for the second converged step
+        seen.append(line)
+        if line.lstrip().startswith("step   2") or time.monotonic() > deadline:
+            break
+    assert any(s.lstrip().startswith("step   2") for s in seen), "".join(seen)
+    if target == "one-rank":
+        os.kill(_children(proc.pid)[0], signal.SIGTERM)
+    else:
+        proc.send_signal(signal.SIGTERM)
+    rest, err = proc.communicate(timeout=120)
+    stdout = "".join(seen) + rest
+    # non-zero: 128 + 15 from the process itself; mpirun reports a rank's non-zero status
+    assert proc.returncode != 0
+    if target == "serial":
+        assert proc.returncode == 128 + signal.SIGTERM
+    said = [line for line in err.splitlines() if "interrupted by SIGTERM" in line]
+    assert len(said) == 1, err  # one line, from rank 0
+    assert "Traceback" not in err and "Traceback" not in stdout
+    data = json.loads((out / "run.json").read_text())
+    assert data["status"] == "interrupted" and data["signal"] == "SIGTERM"
+    done = data["last_complete_step"]
+    # stopped after the step in progress when the signal came (step 3 or a later one), not
+    # at the end of the program
+    assert 2 <= done < 12
+    assert len(data["steps"]) == done
+    assert data["load"] == pytest.approx(done / 12)
+    assert [s["step"] for s in data["steps"]] == list(range(1, done + 1))
+    assert data["ranks"] == ranks
+    # the ParaView index lists exactly the complete steps, each file present
+    series = read_pvd(out / "hertz2d.pvd")
+    assert [t for t, _ in series] == pytest.approx([s["load"] for s in data["steps"]])
+    assert all(Path(f).exists() for _, f in series)
+    assert f"step  {done + 1:2d}" not in stdout  # no step after the one in progress
