@@ -381,7 +381,11 @@ class _Run:
                         writer.write(rec.time, post.fields())
                 problem.converged()
                 solver.converged()
-                self.say(_progress(steps[-1], problem.method.multiplier.nodal))
+                elapsed = time.perf_counter() - t0
+                self.say(
+                    _progress(steps[-1], problem.method.multiplier.nodal)
+                    + _remaining(elapsed, rec.time)
+                )
 
             t0 = time.perf_counter()
             a0 = solver.timer.assembly
@@ -459,6 +463,13 @@ class _Run:
             local = float(np.min(coupling.search_gaps(), initial=np.inf))
             gap = self.comm.allreduce(local, op=MPI.MIN)
         return never_closed(steps, "pair" if pair else "obstacle", gap)
+
+
+def _remaining(elapsed: float, load: float) -> str:
+    """The wall time since the load program started and an estimate of the time left, from
+    the load factor reached (the steps' cost taken as even over the program)."""
+    left = elapsed * (1.0 - load) / load if load > 0.0 else float("nan")
+    return f"  time {elapsed:.1f} s  left ~{left:.0f} s"
 
 
 def _progress(step: StepLog, outer: bool) -> str:
