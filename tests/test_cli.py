@@ -473,3 +473,42 @@ def test_module_in_checkout_without_install_says_which_interpreter():
         "contactfx: error: contactfx is not installed for /usr/bin/python3: use the venv of "
         "scripts/install.sh (.venv/bin/python -m contactfx, or source .venv/bin/activate)"
     ]
+
+
+def test_progress_on_a_terminal_is_one_line():
+    """On a terminal the step lines rewrite one line in place (carriage return, erase to the
+    end of the line), closed by a newline before the summary; each ends with the load
+    program's wall time and an estimate of the time left. In a pipe: one line per step."""
+    import os
+    import pty
+
+    master, slave = pty.openpty()
+    proc = subprocess.Popen(
+        contactfx_cmd("run", "hertz2d", *FAST, "--steps", "3"),
+        stdout=slave,
+        stderr=subprocess.PIPE,
+        env=clean_env(),
+    )
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:  # the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    proc.wait(timeout=300)
+    os.close(master)
+    assert proc.returncode == 0
+    text = b"".join(chunks).decode().replace("\r\n", "\n")  # the terminal's newline
+    steps = [s for s in text.split("\r") if s.startswith("step ")]
+    assert [s.split()[1] for s in steps] == ["1", "2", "3"]
+    assert all(s.endswith("\x1b[K") for s in steps[:-1])
+    assert steps[-1].split("\n")[0].endswith("\x1b[K")
+    assert "\n  scene " in steps[-1]  # the summary starts on a line of its own
+    assert " left ~" in steps[0] and " time " in steps[0]
+    piped = run_cli("run", "hertz2d", *FAST, "--steps", "3")
+    lines = [s for s in piped.stdout.splitlines() if s.lstrip().startswith("step ")]
+    assert len(lines) == 3 and "\r" not in piped.stdout

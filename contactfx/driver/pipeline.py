@@ -11,6 +11,7 @@ post-processing; it has no copy of the pipeline.
 from __future__ import annotations
 
 import dataclasses
+import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager, nullcontext
@@ -251,9 +252,29 @@ class _Run:
         yield
         self.timings[phase] = self.timings.get(phase, 0.0) + time.perf_counter() - t0
 
+    #: a progress line is open on the terminal (:meth:`progress`)
+    _open_line = False
+
     def say(self, msg: str) -> None:
         if self.verbose and self.comm.rank == 0:
             print(msg, flush=True)
+
+    def progress(self, msg: str) -> None:
+        """A step's progress line: on a terminal one line rewritten in place (the steps are
+        in run.json), else one line per step (logs, pipes, batch jobs)."""
+        if not (self.verbose and self.comm.rank == 0):
+            return
+        if sys.stdout.isatty():
+            print("\r" + msg.strip() + "\x1b[K", end="", flush=True)
+            self._open_line = True
+        else:
+            print(msg, flush=True)
+
+    def end_progress(self) -> None:
+        """Close the terminal's progress line before anything else is printed."""
+        if self._open_line:
+            print(flush=True)
+            self._open_line = False
 
     def execute(self) -> RunSummary:
         reset_peak_memory()
@@ -264,7 +285,10 @@ class _Run:
         problem, post, solver = self.build()
         self.stage = "solve"
         try:
-            steps = self.load_program(problem, solver, post)
+            try:
+                steps = self.load_program(problem, solver, post)
+            finally:
+                self.end_progress()
             extra = post.finish(steps[-1].quantities, self.out)
         finally:
             solver.destroy()
@@ -382,7 +406,7 @@ class _Run:
                 problem.converged()
                 solver.converged()
                 elapsed = time.perf_counter() - t0
-                self.say(
+                self.progress(
                     _progress(steps[-1], problem.method.multiplier.nodal)
                     + _remaining(elapsed, rec.time)
                 )
