@@ -478,7 +478,8 @@ def test_module_in_checkout_without_install_says_which_interpreter():
 def test_progress_on_a_terminal_is_one_line():
     """On a terminal the step lines rewrite one line in place (carriage return, erase to the
     end of the line), closed by a newline before the summary; each ends with the load
-    program's wall time and an estimate of the time left. In a pipe: one line per step."""
+    program's wall time and an estimate of the time left. In a pipe and under mpirun: one
+    line per step."""
     import os
     import pty
 
@@ -509,6 +510,9 @@ def test_progress_on_a_terminal_is_one_line():
     assert steps[-1].split("\n")[0].endswith("\x1b[K")
     assert "\n  scene " in steps[-1]  # the summary starts on a line of its own
     assert " left ~" in steps[0] and " time " in steps[0]
-    piped = run_cli("run", "hertz2d", *FAST, "--steps", "3")
-    lines = [s for s in piped.stdout.splitlines() if s.lstrip().startswith("step ")]
-    assert len(lines) == 3 and "\r" not in piped.stdout
+    # in a pipe, and under mpirun (whose ranks write to a pseudo-terminal of Open MPI's
+    # whatever mpirun's output is): one line per step, no control characters
+    for ranks in (1, 2):
+        piped = run_cli("run", "hertz2d", *FAST, "--steps", "3", ranks=ranks)
+        lines = [s for s in piped.stdout.splitlines() if s.lstrip().startswith("step ")]
+        assert len(lines) == 3 and "\r" not in piped.stdout and "\x1b" not in piped.stdout

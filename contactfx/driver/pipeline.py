@@ -261,10 +261,12 @@ class _Run:
 
     def progress(self, msg: str) -> None:
         """A step's progress line: on a terminal one line rewritten in place (the steps are
-        in run.json), else one line per step (logs, pipes, batch jobs)."""
+        in run.json), else one line per step (logs, pipes, batch jobs). Under mpirun one line
+        per step always: Open MPI hands its ranks a pseudo-terminal whatever mpirun's own
+        output is (a file, a pipe)."""
         if not (self.verbose and self.comm.rank == 0):
             return
-        if sys.stdout.isatty():
+        if self.comm.size == 1 and sys.stdout.isatty():
             print("\r" + msg.strip() + "\x1b[K", end="", flush=True)
             self._open_line = True
         else:
