@@ -56,6 +56,7 @@ if TYPE_CHECKING:
 __all__ = [
     "FEATURE_ANGLE",
     "CONFORMING",
+    "FLAT",
     "vertex_normals",
     "bulges",
     "deviation",
@@ -75,6 +76,10 @@ FEATURE_ANGLE = 30.0
 #: a pin in its hole (rings of radii b and b - delta: delta / b); Hertz's convex pairs add up
 #: (2), a curved body on a flat one does not reach it (1)
 CONFORMING = 0.25
+
+#: a bulge (the smooth surface's deviation from an edge) below this fraction of the edge's
+#: length is round-off: the edge is straight (:func:`mean_curvature`)
+FLAT = 1e-12
 
 
 def _edges(d: int) -> list[tuple[int, int]]:
@@ -186,13 +191,17 @@ def dual_moments(x: np.ndarray, bulge: np.ndarray) -> np.ndarray:
 def mean_curvature(comm: Any, x: np.ndarray, bulge: np.ndarray) -> float:
     """The mean curvature of a surface (this rank's facets x (m, d, gdim) and their bulges,
     all ranks): each edge's 2 A / L^2 (a circle's 1 / R, > 0 convex) weighted by its length.
+    A bulge under :data:`FLAT` of its edge is round-off (a flat surface's nodal normals
+    computed in another order): it counts as 0, so that a flat surface's curvature is 0 on
+    every partition, not +-1e-17 (which :func:`conforming` would read either way).
     Collective."""
     from mpi4py import MPI
 
     total = weight = 0.0
     for e, (i, j) in enumerate(_edges(x.shape[1]) if len(x) else []):
         length = np.linalg.norm(x[:, j] - x[:, i], axis=1)
-        total += float(np.sum(2.0 * bulge[:, e] / length))
+        curved = np.where(np.abs(bulge[:, e]) > FLAT * length, bulge[:, e], 0.0)
+        total += float(np.sum(2.0 * curved / length))
         weight += float(np.sum(length))
     total, weight = comm.allreduce(total, op=MPI.SUM), comm.allreduce(weight, op=MPI.SUM)
     return total / weight if weight > 0.0 else 0.0

@@ -116,3 +116,25 @@ def test_mean_curvature_and_conforming_pairs():
     assert conforming(bore, convex) and conforming(convex, bore)
     assert not conforming(convex, convex)
     assert not conforming(convex, 0.0) and not conforming(0.0, 0.0)
+
+
+def test_flat_surface_is_flat_on_every_partition():
+    """Straight facets whose nodal normals carry round-off (1e-16, of either sign: the same
+    surface summed in another order on another partition) have a mean curvature of exactly
+    0, so two flat faces are never read as a conforming pair by the round-off's signs (a
+    problem file's patch test smoothed on one meshing and not on the other)."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_SELF
+    s = np.linspace(0.0, 1.0, 9)
+    x = np.stack([np.stack([s[:-1], np.zeros(8)], 1), np.stack([s[1:], np.zeros(8)], 1)], 1)
+    rng = np.random.default_rng(1)
+    for _ in range(5):
+        normals = np.zeros((8, 2, 2))
+        normals[..., 1] = -1.0
+        normals[..., 0] = 1e-16 * rng.standard_normal((8, 2))
+        normals /= np.linalg.norm(normals, axis=2)[..., None]
+        A = bulges(x, normals)
+        assert np.max(np.abs(A)) > 0.0  # the round-off is there
+        assert mean_curvature(comm, x, A) == 0.0
+        assert not conforming(mean_curvature(comm, x, A), -mean_curvature(comm, x, -A))
