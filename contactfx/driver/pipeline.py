@@ -102,6 +102,12 @@ def write_interrupted(
         "versions": versions(),
         "ranks": ranks,
     }
+    _write_run_json(out, data)
+
+
+def _write_run_json(out: Path, data: dict[str, Any]) -> None:
+    """run.json of a run that did not complete, from this rank; an unwritable folder is
+    passed over (the run's line is printed anyway)."""
     try:
         Path(out).mkdir(parents=True, exist_ok=True)
         write_json_local(Path(out) / "run.json", data)
@@ -149,11 +155,7 @@ def write_failed(
         data["numerics"] = dataclasses.asdict(numerics)
     data.update(fields)
     data.update(versions=versions(), ranks=comm.size)
-    try:
-        Path(out).mkdir(parents=True, exist_ok=True)
-        write_json_local(Path(out) / "run.json", data)
-    except (OSError, TypeError, ValueError):
-        pass
+    _write_run_json(out, data)
 
 
 def setup(scene: Scene, numerics: Numerics, comm: MPI.Comm = MPI.COMM_WORLD) -> Problem:
