@@ -7,7 +7,7 @@ from pathlib import Path
 
 from contactfx.cli.args import Parser, add_options
 from contactfx.contact.registry import method_class
-from contactfx.driver.pipeline import write_failed
+from contactfx.driver.pipeline import WRITERS, write_failed
 from contactfx.numerics import Numerics
 from contactfx.params import option_help
 from contactfx.results import RunSummary
@@ -22,10 +22,17 @@ __all__ = [
     "fields_of",
     "one_line",
     "QUIET_HELP",
+    "FORMATS",
+    "FORMAT_HELP",
 ]
 
 
 QUIET_HELP = "print one line, the result (no progress, no summary table)"
+FORMATS = tuple(WRITERS)
+FORMAT_HELP = (
+    "ParaView files: xdmf (<scene>.xdmf + .h5, written by every rank in parallel) or vtu "
+    "(<scene>.pvd, a VTU file per step gathered on rank 0)"
+)
 
 
 def scene_parser(scene_cls, command: str = "run") -> Parser:
@@ -37,6 +44,7 @@ def scene_parser(scene_cls, command: str = "run") -> Parser:
     add_options(parser.add_argument_group("scene parameters"), scene_cls.Params, {})
     add_options(parser.add_argument_group("numerics"), Numerics, scene_cls.numerics_defaults)
     parser.add_argument("--out", type=Path, default=None, help="output folder (ParaView, run.json)")
+    parser.add_argument("--format", choices=FORMATS, default="xdmf", help=FORMAT_HELP)
     parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     return parser
 
@@ -172,7 +180,12 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
         print(f"contactfx: {scene.name}, method {numerics.method}, {comm.size} rank(s)", flush=True)
     # a failure from here on writes run.json marked failed (contactfx.driver.pipeline.run)
     res = scene.run(
-        numerics, comm=comm, out=ns["out"], petsc_options=petsc_options, verbose=not ns["quiet"]
+        numerics,
+        comm=comm,
+        out=ns["out"],
+        petsc_options=petsc_options,
+        verbose=not ns["quiet"],
+        output_format=ns["format"],
     )
     if comm.rank == 0:
         if ns["quiet"]:

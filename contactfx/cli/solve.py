@@ -8,7 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import QUIET_HELP, one_line, print_outputs, table
+from contactfx.cli.run import FORMAT_HELP, FORMATS, QUIET_HELP, one_line, print_outputs, table
 from contactfx.driver.pipeline import write_failed
 from contactfx.scenes.problem_file import load_problem
 
@@ -42,6 +42,9 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         help="output folder (default: results/<title> beside the file)",
     )
     parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
+    parser.add_argument(
+        "--format", choices=FORMATS, default=None, help=FORMAT_HELP + " (default: output.format)"
+    )
     ns = parser.parse_args(argv)
     try:
         scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
@@ -58,7 +61,14 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
             flush=True,
         )
     # a failure from here on writes run.json marked failed (contactfx.driver.pipeline.run)
-    res = scene.run(numerics, comm=comm, out=out, petsc_options=options, verbose=not ns.quiet)
+    res = scene.run(
+        numerics,
+        comm=comm,
+        out=out,
+        petsc_options=options,
+        verbose=not ns.quiet,
+        output_format=ns.format or scene.spec.output.format,
+    )
     written = _write_reactions(scene, out, comm)
     if comm.rank == 0 and ns.quiet:
         print(one_line(res))

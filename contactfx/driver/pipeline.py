@@ -26,6 +26,7 @@ from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
+from contactfx.io.xdmf import XdmfWriter, h5py_mpi
 from contactfx.results import RunSummary, StepLog, never_closed
 from contactfx.solvers.interrupt import Interrupted, StopRequest
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, ConvergenceError
@@ -46,12 +47,15 @@ def run(
     petsc_options: dict[str, Any] | None = None,
     verbose: bool = True,
     time_limit: float | None = None,
+    output_format: str = "xdmf",
 ) -> RunSummary:
-    """Solve ``scene`` with ``numerics``; write the ParaView files, run.json (and the kind's
-    extra output) into ``out`` when given. Raises ValueError on a request the method or the
-    problem kind does not support (before any collective), ConvergenceError when the solve
-    fails, TimeLimitExceeded when the solves run past ``time_limit`` seconds of wall time
-    from the start of the first (checked collectively at every residual)."""
+    """Solve ``scene`` with ``numerics``; write the ParaView files (``output_format``: xdmf,
+    XDMF3 + HDF5 written in parallel, or vtu, a PVD series of VTU files gathered on rank 0),
+    run.json (and the kind's extra output) into ``out`` when given. Raises ValueError on a
+    request the method or the problem kind does not support (before any collective),
+    ConvergenceError when the solve fails, TimeLimitExceeded when the solves run past
+    ``time_limit`` seconds of wall time from the start of the first (checked collectively at
+    every residual)."""
     folder = None if out is None else Path(out)
     run_: _Run | None = None
     try:
@@ -65,6 +69,7 @@ def run(
             dict(petsc_options or {}),
             verbose,
             time_limit=time_limit,
+            output_format=output_format,
         )
         return run_.execute()
     except Interrupted as stopped:
@@ -118,6 +123,9 @@ def _write_run_json(out: Path, data: dict[str, Any]) -> None:
 #: the stages a run.json of a failed run names: the request and its input, the mesh, the
 #: set-up (unknowns, surfaces, forms, solver, the start and its geometry checks), the solve
 STAGES = ("input", "mesh", "set-up", "solve")
+
+#: --format -> the ParaView writer
+WRITERS: dict[str, Any] = {"xdmf": XdmfWriter, "vtu": ResultsWriter}
 
 
 def write_failed(
@@ -237,9 +245,15 @@ class _Run:
         petsc_options: dict[str, Any],
         verbose: bool,
         time_limit: float | None = None,
+        output_format: str = "xdmf",
     ) -> None:
+        if output_format not in WRITERS:
+            raise ValueError(f"output format '{output_format}': choose one of {', '.join(WRITERS)}")
         self.scene, self.num, self.method, self.comm = scene, numerics, method, comm
         self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
+        self.writer = WRITERS[output_format]
+        if out is not None and output_format == "xdmf":
+            h5py_mpi()  # refused before the mesh is built when h5py has no MPI
         self.timings: dict[str, float] = {}
         self.prefix = f"contactfx_{scene.name.replace('-', '_')}_"
         #: seconds of wall time the solves may take, or None (see run)
@@ -377,7 +391,7 @@ class _Run:
         steps: list[StepLog] = []
         writer = None
         if self.out is not None:
-            writer = ResultsWriter(
+            writer = self.writer(
                 self.out,
                 self.scene.name,
                 problem.mesh,
@@ -467,9 +481,9 @@ class _Run:
             steps=steps,
             timings=dict(self.timings),
             quantities=steps[-1].quantities,
-            paraview=self._output(".pvd"),
+            paraview=self._output(self.writer.suffix),
             paraview_surface=(
-                self._output("_surface.pvd")
+                self._output("_surface" + self.writer.suffix)
                 if getattr(problem, "contact_facets", None) is not None
                 else None
             ),

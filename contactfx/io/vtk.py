@@ -1,4 +1,6 @@
-"""ParaView output: a PVD time series of VTU files, one dataset per load step with every field.
+"""ParaView output as a PVD time series of VTU files (``--format vtu``; the default is XDMF,
+:mod:`contactfx.io.xdmf`), one dataset per load step with every field
+(:mod:`contactfx.io.series`).
 
 Per run (``name`` the scene's name) in the output folder:
 
@@ -15,7 +17,8 @@ A cracked body (``split``) is written with its crack faces as separate nodes: ea
 ``displacement`` is the displacement of each face and ``Warp By Vector`` opens the crack.
 
 Under MPI the ranks send their owned cells to rank 0, which writes one serial VTU per step
-(the meshes of contactfx are small; one file per step is what ParaView opens as one dataset).
+(one file per step is what ParaView opens as one dataset): rank 0 holds the whole mesh and
+every field of a step, which the XDMF writer avoids.
 The data are inline base64 (``binary``, UInt64 headers); :func:`read_vtu` reads them back
 without VTK.
 """
@@ -24,13 +27,11 @@ from __future__ import annotations
 
 import base64
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 
-import dolfinx
 import numpy as np
 
-from contactfx import _compat
+from contactfx.io.series import FieldSeries, Split
 
 __all__ = ["ResultsWriter", "Split", "read_pvd", "read_vtu", "VTK_CELLS"]
 
@@ -42,70 +43,30 @@ VTK_CELLS = {
     "tetrahedron": (10, [0, 1, 2, 3]),
     "hexahedron": (12, [0, 1, 3, 2, 4, 5, 7, 6]),
 }
-_FACET = {
-    "interval": "point",
-    "triangle": "interval",
-    "quadrilateral": "interval",
-    "tetrahedron": "triangle",
-    "hexahedron": "quadrilateral",
-}
 _VTK_VERTEX = 1
-
-
-@dataclass
-class Split:
-    """Duplicate the nodes of ``facets`` (a fitted interface) by the side of each cell: the
-    DG0 sign ``side`` (+1 / -1). The vector field ``field`` is written as field + side * jump
-    (the enriched displacement u + H a); a cell of the surface dataset takes the +side."""
-
-    side: dolfinx.fem.Function
-    facets: np.ndarray
-    field: str = "displacement"
-    jump: str = "enrichment"
 
 
 class _Local:
     """One rank's share of a dataset: owned cells as global node numbers, per cell-vertex
     coordinates and point values, per cell values."""
 
-    def __init__(self, nodes, x, point, cell, side=None):
-        self.nodes, self.x, self.point, self.cell, self.side = nodes, x, point, cell, side
+    def __init__(self, nodes, x, point, cell):
+        self.nodes, self.x, self.point, self.cell = nodes, x, point, cell
 
 
-class ResultsWriter:
-    """Context manager writing the named P1 / DG0 fields of each load step (see the module
-    docstring). ``facets``: the contact surface's facets (local indices), or None."""
+class ResultsWriter(FieldSeries):
+    """Context manager writing the named P1 / DG0 fields of each load step as a PVD series of
+    VTU files (see the module docstring). ``facets``: the contact surface's facets (local
+    indices), or None."""
+
+    format = "vtu"
+    suffix = ".pvd"
 
     def __init__(self, out: Path, name: str, mesh, facets=None, split: Split | None = None):
-        self.out, self.name, self.mesh = Path(out), name, mesh
-        self.comm = mesh.comm
-        self.facets = None if facets is None else np.asarray(facets, dtype=np.int32)
-        self.split = split
+        super().__init__(out, name, mesh, facets, split)
         self.path = self.out / f"{name}.pvd"
         self.surface_path = None if facets is None else self.out / f"{name}_surface.pvd"
-        self._out: dict[str, dolfinx.fem.Function] = {}
         self._steps: list[tuple[float, str, str | None]] = []
-        self._surface: tuple[np.ndarray, np.ndarray] | None = None  # the facets' cells, fixed
-        tdim = mesh.topology.dim
-        self.cell_name = mesh.topology.cell_type.name
-        if self.cell_name not in VTK_CELLS:
-            raise ValueError(f"no VTK output for {self.cell_name} cells")
-        mesh.topology.create_connectivity(tdim, 0)
-        mesh.topology.create_connectivity(tdim - 1, 0)
-        mesh.topology.create_connectivity(tdim - 1, tdim)
-        self.Q1 = _compat.function_space(mesh, "Lagrange", 1)
-        imap = self.Q1.dofmap.index_map
-        self.n_global = imap.size_global
-        self.q_dofs = _compat.cell_dofs(self.Q1)  # (cells incl. ghosts, vertices)
-        local = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32)
-        self.q_global = imap.local_to_global(local).astype(np.int64)
-        self.q_x = _compat.dof_coordinates(self.Q1)
-        self.n_owned_cells = mesh.topology.index_map(tdim).size_local
-        self.split_nodes = None
-        if split is not None:  # the global numbers of the interface's nodes, on every rank
-            qd = _cell_facet_vertices(mesh, split.facets, self.q_dofs)
-            mine = np.unique(self.q_global[qd]) if len(qd) else np.zeros(0, np.int64)
-            self.split_nodes = np.unique(np.concatenate(self.comm.allgather(mine)))
 
     def __enter__(self) -> ResultsWriter:
         if self.comm.rank == 0:  # a previous run's steps would linger next to the new ones
@@ -118,100 +79,34 @@ class ResultsWriter:
     def __exit__(self, *exc) -> None:
         pass
 
-    # -- fields ----------------------------------------------------------------------------
-    def _output_function(self, f: dolfinx.fem.Function) -> dolfinx.fem.Function:
-        if _compat.element_degree(f.function_space) <= 1:
-            return f
-        if f.name not in self._out:
-            shape = f.ufl_shape
-            V1 = _compat.function_space(self.mesh, "Lagrange", 1, shape if shape else None)
-            self._out[f.name] = dolfinx.fem.Function(V1, name=f.name)
-        g = self._out[f.name]
-        g.interpolate(f)
-        return g
-
-    def _values(self, functions) -> tuple[dict, dict]:
-        """Per (cell, vertex) values of the P1 fields (cells incl. ghosts, vertices, 3 or 1)
-        and per cell values of the DG0 fields, vectors padded to 3 components."""
-        point, cell = {}, {}
-        for f in functions:
-            g = self._output_function(f)
-            g.x.scatter_forward()
-            V = g.function_space
-            bs = V.dofmap.index_map_bs
-            dofs = _compat.cell_dofs(V)
-            arr = g.x.array.reshape(-1, bs)
-            if _compat.element_degree(V) == 0:
-                vals = arr[dofs[:, 0]]
-                cell[g.name] = _pad(vals)
-            else:
-                vals = arr[dofs]  # (cells, vertices, bs)
-                point[g.name] = _pad(vals)
-        if self.split is not None:
-            s = self.split
-            H = self.split.side.x.array[_compat.cell_dofs(s.side.function_space)[:, 0]]
-            if s.field in point and s.jump in point:
-                point[s.field] = point[s.field] + H[:, None, None] * point[s.jump]
-        return point, cell
-
     def write(self, t: float, functions) -> None:
         """Write the fields of the load step at load factor ``t``. Collective."""
-        point, cell = self._values(functions)
+        point, cell = self.values(functions)
+        point = self.split_values(point)
         step = len(self._steps) + 1
         body = f"{self.name}_{step:04d}.vtu"
         owned = np.arange(self.n_owned_cells)
-        side = None
-        if self.split is not None:
-            s = self.split.side
-            side = s.x.array[_compat.cell_dofs(s.function_space)[:, 0]]
-        self._write(self.out / body, self.cell_name, owned, None, point, cell, side)
+        self._write(self.out / body, self.cell_name, owned, None, point, cell, True)
         surface = None
         if self.facets is not None:
             surface = f"{self.name}_surface_{step:04d}.vtu"
-            if self._surface is None:
-                self._surface = self._surface_cells(side)
-            cells, local = self._surface
-            self._write(self.out / surface, _FACET[self.cell_name], cells, local, point, cell, None)
+            cells, local = self.surface_cells()
+            self._write(self.out / surface, self.facet_name, cells, local, point, cell, False)
         self._steps.append((t, body, surface))
         if self.comm.rank == 0:
             _write_pvd(self.path, [(t, b) for t, b, _ in self._steps])
             if self.surface_path is not None:
                 _write_pvd(self.surface_path, [(t, s) for t, _, s in self._steps])
 
-    def _surface_cells(self, side):
-        """For each owned contact facet: a local cell holding it (the +side's on a split
-        interface) and the positions of the facet's vertices in that cell."""
-        tdim = self.mesh.topology.dim
-        f2c = self.mesh.topology.connectivity(tdim - 1, tdim)
-        f2v = self.mesh.topology.connectivity(tdim - 1, 0)
-        c2v = self.mesh.topology.connectivity(tdim, 0)
-        n_owned = self.mesh.topology.index_map(tdim - 1).size_local
-        cells, local = [], []
-        for f in self.facets[self.facets < n_owned]:
-            cs = f2c.links(f)
-            c = cs[0]
-            if side is not None and len(cs) > 1 and side[cs[1]] > side[c]:
-                c = cs[1]
-            verts = list(c2v.links(c))
-            cells.append(c)
-            local.append([verts.index(v) for v in f2v.links(f)])
-        nv = {"point": 1, "interval": 2, "triangle": 3, "quadrilateral": 4}[_FACET[self.cell_name]]
-        return np.array(cells, dtype=np.int32), np.array(local, dtype=np.int32).reshape(-1, nv)
-
-    def _write(self, path, cell_name, cells, local, point, cell, side) -> None:
+    def _write(self, path, cell_name, cells, local, point, cell, split) -> None:
         """Gather the cells' data on rank 0 and write one VTU. ``local``: the vertices of
         each cell to keep (a facet of it), all when None."""
+        qd, nodes = self.cell_nodes(cells, local, split)
         if local is None:
             local = np.broadcast_to(
                 np.arange(self.q_dofs.shape[1]), (len(cells), self.q_dofs.shape[1])
             )
         rows = np.repeat(cells, local.shape[1]).reshape(local.shape)
-        qd = self.q_dofs[rows, local]
-        nodes = self.q_global[qd]
-        if side is not None and self.split_nodes is not None:
-            minus = (side[cells] < 0)[:, None] & np.isin(nodes, self.split_nodes)
-            dup = self.n_global + np.searchsorted(self.split_nodes, nodes)
-            nodes = np.where(minus, dup, nodes)
         mine = _Local(
             nodes,
             self.q_x[qd],
@@ -235,28 +130,6 @@ class ResultsWriter:
             pdata[k] = a
         cdata = {k: np.concatenate([p.cell[k] for p in parts]) for k in cell}
         write_vtu(path, x, conn, cell_name, pdata, cdata)
-
-
-def _pad(vals: np.ndarray) -> np.ndarray:
-    """Vectors of 2 components padded to 3 (ParaView's vectors); scalars keep 1."""
-    if vals.shape[-1] == 2:
-        pad = np.zeros(vals.shape[:-1] + (1,))
-        return np.concatenate([vals, pad], axis=-1)
-    return vals
-
-
-def _cell_facet_vertices(mesh, facets, q_dofs) -> np.ndarray:
-    """The local Q1 dofs of the vertices of ``facets`` (through a cell holding each)."""
-    tdim = mesh.topology.dim
-    f2c = mesh.topology.connectivity(tdim - 1, tdim)
-    f2v = mesh.topology.connectivity(tdim - 1, 0)
-    c2v = mesh.topology.connectivity(tdim, 0)
-    out = []
-    for f in np.asarray(facets, dtype=np.int32):
-        c = f2c.links(f)[0]
-        verts = list(c2v.links(c))
-        out.extend(q_dofs[c, verts.index(v)] for v in f2v.links(f))
-    return np.array(out, dtype=np.int32)
 
 
 # -- VTK XML ---------------------------------------------------------------------------------

@@ -161,6 +161,7 @@ class Scene:
         petsc_options: dict | None = None,
         verbose: bool = True,
         time_limit: float | None = None,
+        output_format: str = "xdmf",
     ) -> RunSummary:
         """Solve with ``numerics`` (see :func:`contactfx.driver.run`)."""
         from contactfx.driver import run
@@ -173,6 +174,7 @@ class Scene:
             petsc_options=petsc_options,
             verbose=verbose,
             time_limit=time_limit,
+            output_format=output_format,
         )
 
 

@@ -49,7 +49,7 @@ from mpi4py import MPI
 from conftest import grad_error, psi
 from contactfx import _compat
 from contactfx.driver import setup as build_problem
-from contactfx.io.vtk import read_vtu
+from contactfx.io.xdmf import read_xdmf
 from contactfx.meshes import RectangleFacets
 from contactfx.scenes import Numerics
 from contactfx.scenes._common import fix_component
@@ -171,8 +171,8 @@ def test_finite_strain_fields(tmp_path):
     scene = UniaxialBlock(PARAMS)
     scene.run(num, comm=comm, out=out, verbose=False)
     l1, l2 = homogeneous_stretches("neo-hookean", scene.material_used, P)
-    body = read_vtu(out / f"{scene.name}_0002.vtu")["cell_data"]
-    surface = read_vtu(out / f"{scene.name}_surface_0002.vtu")["point_data"]
+    body = read_xdmf(out / f"{scene.name}.xdmf", step=1)["cell_data"]
+    surface = read_xdmf(out / f"{scene.name}_surface.xdmf", step=1)["point_data"]
     # the homogeneous state, exact in P1 (to the solver's tolerance, 1e-10): J = l1 l2, the
     # Cauchy stress sigma_yy = P22 l2 / J = -p / l1 (sigma_xx = 0), the nominal pressure p
     # and the Cauchy pressure on the deformed face p / l1 (its length grew by l1)

@@ -111,8 +111,11 @@ KEYS = {
         "symmetry_planes",
         "contact_size",
         "mean_displacement",
+        "format",
     ),
 }
+#: output.format: XDMF3 + HDF5 (written in parallel) or a PVD series of VTU files
+OUTPUT_FORMATS = ("xdmf", "vtu")
 SHAPES = (
     "plane",
     "circle",
@@ -488,6 +491,7 @@ def read_output(r: Reader, data: dict) -> OutputSpec:
     size = None
     if "contact_size" in output:
         size = r.string(output, "output", "contact_size", CONTACT_SIZES)
+    fmt = r.string(output, "output", "format", OUTPUT_FORMATS, default="xdmf")
     return OutputSpec(
         tuple(reactions),
         tuple(tuple(float(v) for v in q) for q in probes),
@@ -495,6 +499,7 @@ def read_output(r: Reader, data: dict) -> OutputSpec:
         tuple(AXES.index(a) for a in planes),
         size,
         {name: (v[0], v[1]) for name, v in mean.items()},
+        fmt,
     )
 
 

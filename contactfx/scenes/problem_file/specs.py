@@ -160,7 +160,7 @@ class InterfaceSpec:
 class OutputSpec:
     """``[output]``: reactions per group, probe points, the model's symmetry multiplicity and
     its mirror planes (the axes normal to them), the contact size rule, mean displacements
-    over facet groups."""
+    over facet groups, the ParaView files' format (xdmf or vtu)."""
 
     reactions: tuple[str, ...] = ()
     probes: tuple[tuple[float, ...], ...] = ()
@@ -168,6 +168,7 @@ class OutputSpec:
     symmetry_planes: tuple[int, ...] = ()
     contact_size: str | None = None
     mean_displacement: dict[str, tuple[str, str]] = field(default_factory=dict)
+    format: str = "xdmf"
 
 
 @dataclass(frozen=True)
