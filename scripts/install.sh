@@ -17,6 +17,7 @@ SYSPY=/usr/bin/python3
 
 APT_PACKAGES=(
     python3-dolfinx python3-gmsh python3-pytest python3-matplotlib
+    python3-h5py-mpi            # the XDMF output: every rank writes its rows of the HDF5 file
     python3-pytest-xdist        # the serial test session on every core (make test)
     python3-venv python3-pip python3-setuptools python3-wheel
     openmpi-bin openssh-client  # mpirun refuses to start without an rsh/ssh agent on PATH
@@ -104,8 +105,11 @@ fi
 # --- 3. check (from / so that contactfx comes from the editable install, not the cwd) ------
 if ! versions=$(cd / && "$VENV/bin/python" -c '
 import dolfinx, gmsh, contactfx
-print(f"dolfinx {dolfinx.__version__}, gmsh {gmsh.__version__}, contactfx from {contactfx.__path__[0]}")'); then
+from contactfx.io.xdmf import h5py_mpi
+h5py = h5py_mpi()
+print(f"dolfinx {dolfinx.__version__}, gmsh {gmsh.__version__}, h5py {h5py.__version__} (MPI), "
+      f"contactfx from {contactfx.__path__[0]}")'); then
     rm -f "$STAMP"  # the next run reinstalls
-    die "the check 'import dolfinx, gmsh, contactfx' failed in $VENV"
+    die "the check 'import dolfinx, gmsh, contactfx, h5py (MPI)' failed in $VENV"
 fi
 say "ok ($os_name): $versions"
