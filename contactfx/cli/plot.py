@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from contactfx.io.vtk import read_pvd, read_vtu
+from contactfx.io.xdmf import read_xdmf
 
 __all__ = ["cmd_plot", "plot_run"]
 
@@ -51,9 +52,9 @@ def cmd_plot(argv: list[str], comm) -> int:
     return 0
 
 
-def _pvd_of(run: Path) -> Path:
-    """The body's PVD of a run folder or run.json (next to run.json if the recorded path,
-    possibly relative to where the run was started, does not exist)."""
+def series_of(run: Path) -> Path:
+    """The body's series (XDMF or PVD) of a run folder or run.json (next to run.json if the
+    recorded path, possibly relative to where the run was started, does not exist)."""
     run_json = run / "run.json" if run.is_dir() else run
     if not run_json.exists():
         raise ValueError(f"no run.json at {run_json}")
@@ -62,7 +63,7 @@ def _pvd_of(run: Path) -> Path:
         raise ValueError(f"{run_json}: the run did not complete ({data.get('error', '?')})")
     recorded = data.get("paraview")
     candidates = [Path(recorded)] if recorded else []
-    candidates.append(run_json.parent / f"{data['scene']}.pvd")
+    candidates += [run_json.parent / f"{data['scene']}{s}" for s in (".xdmf", ".pvd")]
     for c in candidates:
         if c.exists():
             return c
@@ -82,18 +83,14 @@ def plot_run(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    pvd = _pvd_of(Path(run))
-    steps = read_pvd(pvd)
-    if not (-len(steps) <= step <= len(steps)) or step == 0:
-        raise ValueError(f"--step {step}: the run has steps 1..{len(steps)}")
-    t, vtu = steps[step - 1 if step > 0 else step]
-    grid = read_vtu(vtu)
+    series = series_of(Path(run))
+    t, grid = read_step(series, step)
     pdata, cdata = grid["point_data"], grid["cell_data"]
     names = [*pdata, *cdata]
     if field is None:
         field = next((f for f in DEFAULT_FIELDS if f in names), names[0])
     if field not in names:
-        raise ValueError(f"no field '{field}' in {vtu.name}; fields: {', '.join(names)}")
+        raise ValueError(f"no field '{field}' in {series.name}; fields: {', '.join(names)}")
     on_points = field in pdata
     values = pdata[field] if on_points else cdata[field]
     label = field
@@ -150,11 +147,32 @@ def plot_run(
         ax.set_zlim(lo[2], hi[2])
         ax.set_box_aspect(np.maximum(hi - lo, 1e-12 * size))
         fig.colorbar(matplotlib.cm.ScalarMappable(norm, cmap), ax=ax, label=label, shrink=0.7)
-    ax.set_title(f"{pvd.stem}: {label}, load {t:g}, displacement x {scale:.3g}")
-    out = Path(out) if out is not None else pvd.parent / f"{field}.png"
+    ax.set_title(f"{series.stem}: {label}, load {t:g}, displacement x {scale:.3g}")
+    out = Path(out) if out is not None else series.parent / f"{field}.png"
     fig.savefig(out, dpi=150, bbox_inches="tight")
     plt.close(fig)
     return out, field, scale
+
+
+#: XDMF topology type -> VTK cell type (the writers order the vertices alike)
+_XDMF_VTK = {"Polyline": 3, "Triangle": 5, "Quadrilateral": 9, "Tetrahedron": 10, "Hexahedron": 12}
+
+
+def read_step(series: Path, step: int) -> tuple[float, dict]:
+    """(load factor, grid as :func:`read_vtu` gives it) of a step (1-based, or from the
+    end when negative) of an XDMF or PVD series."""
+    if series.suffix == ".xdmf":
+        times = read_xdmf(series)["times"]
+    else:
+        steps = read_pvd(series)
+        times = [t for t, _ in steps]
+    if not (-len(times) <= step <= len(times)) or step == 0:
+        raise ValueError(f"--step {step}: the run has steps 1..{len(times)}")
+    k = step - 1 if step > 0 else step
+    if series.suffix != ".xdmf":
+        return times[k], read_vtu(steps[k][1])
+    grid = read_xdmf(series, k)
+    return times[k], {**grid, "type": _XDMF_VTK[grid["type"]]}
 
 
 #: the faces of a tetrahedron and a hexahedron (VTK vertex order)
