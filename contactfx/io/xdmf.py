@@ -51,15 +51,20 @@ _TAIL = b"    </Grid>\n  </Domain>\n</Xdmf>\n"
 
 
 def h5py_mpi():
-    """h5py built against parallel HDF5. Debian ships it as ``python3-h5py-mpi``, whose
-    ``h5py`` picks the MPI build only under mpirun unless ``H5PY_ALWAYS_USE_MPI`` is set (the
-    serial build would load a second libhdf5 beside dolfinx's parallel one)."""
+    """h5py built against parallel HDF5. Debian ships it as ``python3-h5py-mpi``, the module
+    ``h5py._debian_h5py_mpi``; Debian 12's ``h5py`` wrapper (of python3-h5py-serial) would
+    pick it only under mpirun unless ``H5PY_ALWAYS_USE_MPI`` is set, and the serial build
+    would load a second libhdf5 beside dolfinx's parallel one; Debian 13's python3-h5py-mpi
+    comes without the wrapper. Elsewhere: an ``h5py`` built with MPI."""
     os.environ.setdefault("H5PY_ALWAYS_USE_MPI", "1")
     try:
-        import h5py
+        from h5py import _debian_h5py_mpi as h5py
     except ImportError:
-        h5py = None
-    if h5py is None or not h5py.get_config().mpi:
+        try:
+            import h5py
+        except ImportError:
+            h5py = None
+    if h5py is None or not getattr(h5py, "get_config", None) or not h5py.get_config().mpi:
         raise RuntimeError(
             "XDMF output needs h5py with MPI (Debian: apt-get install python3-h5py-mpi); "
             "or write VTU with --format vtu"
