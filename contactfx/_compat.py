@@ -6,10 +6,12 @@ No other module of contactfx checks a version; they call the functions below.
 
 from __future__ import annotations
 
+import functools
 from types import SimpleNamespace
 
 import dolfinx
 import dolfinx.fem.petsc
+import dolfinx.graph
 import dolfinx.mesh
 import numpy as np
 import ufl
@@ -77,6 +79,7 @@ def petsc_vec(u: dolfinx.fem.Function) -> PETSc.Vec:
 def model_to_mesh(model, comm, rank: int, gdim: int):
     """gmsh model (built on ``rank``) -> (mesh, cell_tags, facet_tags) on ``comm``.
 
+    The cells are distributed by :func:`partition_graph` (the same partition at every run).
     Ghost mode ``shared_facet`` on both stacks, so that interior-facet integrals (``dS``) include
     the facets on partition boundaries. dolfinx 0.5's ``model_to_mesh`` has no ``partitioner``
     argument, but its ``create_mesh`` defaults to ``GhostMode.shared_facet``; dolfinx >= 0.8
@@ -86,13 +89,82 @@ def model_to_mesh(model, comm, rank: int, gdim: int):
     from dolfinx.io import gmshio
 
     if _NEW:
-        partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet)
+        partitioner = dolfinx.mesh.create_cell_partitioner(
+            partition_graph, dolfinx.mesh.GhostMode.shared_facet
+        )
         out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim, partitioner=partitioner)
-    else:
-        out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    else:  # 0.5: model_to_mesh calls create_mesh without a partitioner: give it ours
+        create_mesh = gmshio.create_mesh
+        partitioner = dolfinx.mesh.create_cell_partitioner(partition_graph)
+        gmshio.create_mesh = functools.partial(create_mesh, partitioner=partitioner)
+        try:
+            out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+        finally:
+            gmshio.create_mesh = create_mesh
     if hasattr(out, "mesh"):  # dolfinx >= 0.10 returns a MeshData named tuple
         return out.mesh, out.cell_tags, out.facet_tags
     return out[0], out[1], out[2]
+
+
+def partition_graph(comm, nparts: int, graph, ghosting: bool):
+    """A deterministic partition of the cells' dual graph into ``nparts`` parts: the reverse
+    Cuthill-McKee order of the whole graph (on rank 0) cut into parts of equal size, so that
+    each part is a band of neighbouring cells. SCOTCH, dolfinx's default, gives another
+    partition at each run of the same input (Debian's threaded build), so a run on several
+    ranks could not be repeated to the last bit, nor continued from a checkpoint; a band
+    partition is as good for the few ranks of contactfx's runs. With ``ghosting`` each
+    cell's destinations are its part and then the parts of its neighbours across a facet
+    (the ``shared_facet`` halo). Returns the destinations of this rank's cells."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    offsets = np.asarray(graph.offsets, dtype=np.int64)
+    n_local = len(offsets) - 1
+    parts = comm.gather((n_local, np.asarray(graph.array, dtype=np.int64), offsets), root=0)
+    dest = None
+    if comm.rank == 0:
+        counts = [p[0] for p in parts]
+        n = sum(counts)
+        adj = np.concatenate([p[1] for p in parts])
+        rows = np.concatenate(
+            [
+                np.repeat(np.arange(p[0]) + sum(counts[:r]), np.diff(p[2]))
+                for r, p in enumerate(parts)
+            ]
+        )
+        A = csr_matrix((np.ones(len(adj), dtype=np.int8), (rows, adj)), shape=(n, n))
+        order = reverse_cuthill_mckee(A, symmetric_mode=True)
+        part = np.empty(n, dtype=np.int32)
+        part[order] = (np.arange(n, dtype=np.int64) * nparts // max(n, 1)).astype(np.int32)
+        if ghosting:
+            other = part[adj] != part[rows]
+            pairs = np.unique(np.column_stack([rows[other], part[adj][other]]), axis=0)
+            extra = np.bincount(pairs[:, 0], minlength=n)
+            data_offsets = np.zeros(n + 1, dtype=np.int64)
+            data_offsets[1:] = np.cumsum(1 + extra)
+            data = np.empty(data_offsets[-1], dtype=np.int32)
+            data[data_offsets[:-1]] = part
+            # the ghost parts after the owner, in increasing order (pairs are sorted)
+            first = np.searchsorted(pairs[:, 0], pairs[:, 0], side="left")
+            data[data_offsets[pairs[:, 0]] + 1 + np.arange(len(pairs)) - first] = pairs[:, 1]
+        else:
+            data_offsets = np.arange(n + 1, dtype=np.int64)
+            data = part
+        starts = np.concatenate([[0], np.cumsum(counts)])
+        dest = [
+            (
+                data[data_offsets[starts[r]] : data_offsets[starts[r + 1]]],
+                (data_offsets[starts[r] : starts[r + 1] + 1] - data_offsets[starts[r]]),
+            )
+            for r in range(comm.size)
+        ]
+    data, offs = comm.scatter(dest, root=0)
+    return _adjacency_int32(data.astype(np.int32), offs.astype(np.int32))
+
+
+def _adjacency_int32(data: np.ndarray, offsets: np.ndarray):
+    make = getattr(dolfinx.graph, "adjacencylist", None) or dolfinx.graph.create_adjacencylist
+    return make(data, offsets)
 
 
 def create_interval(comm, n: int, length: float):

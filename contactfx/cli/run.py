@@ -24,6 +24,7 @@ __all__ = [
     "QUIET_HELP",
     "FORMATS",
     "FORMAT_HELP",
+    "add_restart_options",
 ]
 
 
@@ -45,8 +46,29 @@ def scene_parser(scene_cls, command: str = "run") -> Parser:
     add_options(parser.add_argument_group("numerics"), Numerics, scene_cls.numerics_defaults)
     parser.add_argument("--out", type=Path, default=None, help="output folder (ParaView, run.json)")
     parser.add_argument("--format", choices=FORMATS, default="xdmf", help=FORMAT_HELP)
+    add_restart_options(parser)
     parser.add_argument("--quiet", action="store_true", help=QUIET_HELP)
     return parser
+
+
+def add_restart_options(parser) -> None:
+    """--restart DIR and --checkpoint-every N (run and solve)."""
+    parser.add_argument(
+        "--restart",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="continue the run whose output folder is DIR from its last checkpoint (same "
+        "options, ranks and mesh), appending to its ParaView series and run.json",
+    )
+    parser.add_argument(
+        "--checkpoint-every",
+        type=int,
+        default=1,
+        metavar="N",
+        help="with --out: write a checkpoint (DIR/checkpoint) after every N converged steps "
+        "and the last (0: none)",
+    )
 
 
 def fields_of(cls, values: dict) -> dict:
@@ -186,6 +208,8 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
         petsc_options=petsc_options,
         verbose=not ns["quiet"],
         output_format=ns["format"],
+        restart=ns["restart"],
+        checkpoint_every=ns["checkpoint_every"],
     )
     if comm.rank == 0:
         if ns["quiet"]:

@@ -8,7 +8,15 @@ import dataclasses
 from pathlib import Path
 
 from contactfx.cli.args import Parser
-from contactfx.cli.run import FORMAT_HELP, FORMATS, QUIET_HELP, one_line, print_outputs, table
+from contactfx.cli.run import (
+    FORMAT_HELP,
+    FORMATS,
+    QUIET_HELP,
+    add_restart_options,
+    one_line,
+    print_outputs,
+    table,
+)
 from contactfx.driver.pipeline import write_failed
 from contactfx.scenes.problem_file import load_problem
 
@@ -45,6 +53,7 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
     parser.add_argument(
         "--format", choices=FORMATS, default=None, help=FORMAT_HELP + " (default: output.format)"
     )
+    add_restart_options(parser)
     ns = parser.parse_args(argv)
     try:
         scene, numerics, file_petsc = load_problem(ns.problem, ns.set)
@@ -52,7 +61,8 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         if ns.out is not None:  # else the folder is named by the file's title
             write_failed(ns.out, error, "input", comm, problem=str(ns.problem))
         raise
-    out = ns.out if ns.out is not None else ns.problem.parent / "results" / scene.name
+    out = ns.out if ns.out is not None else ns.restart
+    out = out if out is not None else ns.problem.parent / "results" / scene.name
     options = {**file_petsc, **petsc_options}
     if comm.rank == 0 and not ns.quiet:
         print(
@@ -68,6 +78,8 @@ def cmd_solve(argv: list[str], petsc_options: dict, comm) -> int:
         petsc_options=options,
         verbose=not ns.quiet,
         output_format=ns.format or scene.spec.output.format,
+        restart=ns.restart,
+        checkpoint_every=ns.checkpoint_every,
     )
     written = _write_reactions(scene, out, comm)
     if comm.rank == 0 and ns.quiet:

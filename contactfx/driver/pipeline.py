@@ -11,6 +11,7 @@ post-processing; it has no copy of the pipeline.
 from __future__ import annotations
 
 import dataclasses
+import json
 import sys
 import time
 from collections.abc import Iterator
@@ -23,6 +24,8 @@ from mpi4py import MPI
 
 from contactfx.contact.registry import methods_supporting
 from contactfx.driver.nested import NestedSolver, nested_levels
+from contactfx.driver.restart import Checkpoints, Restart, run_identity
+from contactfx.io.checkpoint import CHECKPOINT
 from contactfx.io.process import peak_memory_mib, reset_peak_memory
 from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
@@ -48,6 +51,8 @@ def run(
     verbose: bool = True,
     time_limit: float | None = None,
     output_format: str = "xdmf",
+    restart: str | Path | None = None,
+    checkpoint_every: int = 1,
 ) -> RunSummary:
     """Solve ``scene`` with ``numerics``; write the ParaView files (``output_format``: xdmf,
     XDMF3 + HDF5 written in parallel, or vtu, a PVD series of VTU files gathered on rank 0),
@@ -55,8 +60,12 @@ def run(
     request the method or the problem kind does not support (before any collective),
     ConvergenceError when the solve fails, TimeLimitExceeded when the solves run past
     ``time_limit`` seconds of wall time from the start of the first (checked collectively at
-    every residual)."""
-    folder = None if out is None else Path(out)
+    every residual). With ``out``, a checkpoint is written after every ``checkpoint_every``
+    converged steps (0: none); ``restart``: the folder of a run to continue from its last
+    checkpoint, appending to its ParaView series and run.json (``out`` must be that folder
+    or None)."""
+    folder = Path(restart) if out is None and restart is not None else out
+    folder = None if folder is None else Path(folder)
     run_: _Run | None = None
     try:
         method = _checked_method(scene, numerics)
@@ -70,6 +79,8 @@ def run(
             verbose,
             time_limit=time_limit,
             output_format=output_format,
+            restart=None if restart is None else Path(restart),
+            checkpoint_every=checkpoint_every,
         )
         return run_.execute()
     except Interrupted as stopped:
@@ -100,14 +111,24 @@ def write_interrupted(
         "parameters": dataclasses.asdict(scene.p),
         "numerics": dataclasses.asdict(numerics),
         "steps": [s.to_json() for s in stopped.records],
-        "restart": (
-            "no checkpoint is written yet: run the same command again to compute the whole "
-            "load program"
-        ),
+        "restart": _restart_hint(out),
         "versions": versions(),
         "ranks": ranks,
     }
     _write_run_json(out, data)
+
+
+def _restart_hint(out: Path) -> str:
+    """How to continue a stopped run: from its last checkpoint, if it has one."""
+    latest = Path(out) / CHECKPOINT / "latest.json"
+    try:
+        step = json.loads(latest.read_text())["step"]
+    except (OSError, ValueError, KeyError):
+        return "no checkpoint was written (--checkpoint-every 0): run the same command again"
+    return (
+        f"the same command with --restart {out} (and without --out) continues after step "
+        f"{step}, the last checkpoint"
+    )
 
 
 def _write_run_json(out: Path, data: dict[str, Any]) -> None:
@@ -246,12 +267,25 @@ class _Run:
         verbose: bool,
         time_limit: float | None = None,
         output_format: str = "xdmf",
+        restart: Path | None = None,
+        checkpoint_every: int = 1,
     ) -> None:
         if output_format not in WRITERS:
             raise ValueError(f"output format '{output_format}': choose one of {', '.join(WRITERS)}")
         self.scene, self.num, self.method, self.comm = scene, numerics, method, comm
         self.out, self.petsc_options, self.verbose = out, petsc_options, verbose
         self.writer = WRITERS[output_format]
+        if checkpoint_every < 0:
+            raise ValueError(f"--checkpoint-every must be >= 0, got {checkpoint_every}")
+        if restart is not None and out is not None and Path(out).resolve() != restart.resolve():
+            raise ValueError(
+                f"--restart {restart} continues the run in its own folder: leave out --out "
+                f"(given: {out})"
+            )
+        self.checkpoint_every = checkpoint_every if out is not None else 0
+        self.identity = run_identity(scene, numerics, output_format, comm)
+        #: the checkpoint to continue from, read and checked (scene, numerics) at once
+        self.restart = None if restart is None else Restart(restart, self.identity, comm)
         if out is not None and output_format == "xdmf":
             h5py_mpi()  # refused before the mesh is built when h5py has no MPI
         self.timings: dict[str, float] = {}
@@ -301,6 +335,8 @@ class _Run:
         if self.out is not None:
             prepare_output(self.out, self.comm)
         problem, post, solver = self.build()
+        if self.restart is not None:
+            self.restart.check_mesh(problem.mesh)
         self.stage = "solve"
         try:
             try:
@@ -389,6 +425,9 @@ class _Run:
         """Solve at the load factors of the program; at each converged step evaluate the
         contact quantities, write the fields and keep the step as the history of the next."""
         steps: list[StepLog] = []
+        restart = self.restart
+        if restart is not None:
+            steps = list(restart.state["steps"])
         writer = None
         if self.out is not None:
             writer = self.writer(
@@ -397,6 +436,12 @@ class _Run:
                 problem.mesh,
                 facets=getattr(problem, "contact_facets", None),
                 split=problem.output_split(),
+                resume=None if restart is None else restart.state["writer"],
+            )
+        checkpoints = None
+        if self.out is not None and self.checkpoint_every:
+            checkpoints = Checkpoints(
+                self.out, self.checkpoint_every, self.identity, problem.mesh, self.comm
             )
         with writer or nullcontext():
 
@@ -423,13 +468,33 @@ class _Run:
                         writer.write(rec.time, post.fields())
                 problem.converged()
                 solver.converged()
+                if checkpoints is not None and checkpoints.due(rec.step, stepper.done()):
+                    with self.timed("checkpoint"):
+                        checkpoints.write(rec.step, rec.time, roots(), steps, writer)
                 elapsed = time.perf_counter() - t0
                 self.progress(
                     _progress(steps[-1], problem.method.multiplier.nodal)
-                    + _remaining(elapsed, rec.time)
+                    + _remaining(elapsed, rec.time - t_start, 1.0 - t_start)
                 )
 
+            def roots() -> dict[str, Any]:
+                """The objects that hold the run's state (contactfx.io.checkpoint)."""
+                return {
+                    "stepper": stepper,
+                    "problem": problem,
+                    "post": post,
+                    "solver": solver,
+                    "scene": self.scene,
+                }
+
+            def resume() -> None:
+                assert restart is not None
+                restart.resume(roots())
+                solver_deadline(solver, self.deadline)
+                self.say(f"  restarted after step {restart.step} (load {restart.load:.6g})")
+
             t0 = time.perf_counter()
+            t_start = 0.0 if restart is None else restart.load
             a0 = solver.timer.assembly
             stepper = QuasiStatic(
                 self.num.steps,
@@ -445,6 +510,7 @@ class _Run:
                         on_step=on_step,
                         diagnose=problem.diagnose,
                         stop=stop,
+                        resume=None if restart is None else resume,
                     )
                 except Interrupted as err:
                     err.records = steps  # the complete steps, with their quantities
@@ -507,10 +573,19 @@ class _Run:
         return never_closed(steps, "pair" if pair else "obstacle", gap)
 
 
-def _remaining(elapsed: float, load: float) -> str:
+def solver_deadline(solver: Any, deadline: float | None) -> None:
+    """Set the wall-time deadline of the ContactSNES inside ``solver``'s wrappers (a
+    restored state carries the checkpointed run's)."""
+    while solver is not None:
+        if hasattr(solver, "deadline"):
+            solver.deadline = deadline
+        solver = getattr(solver, "inner", None)
+
+
+def _remaining(elapsed: float, load: float, total: float = 1.0) -> str:
     """The wall time since the load program started and an estimate of the time left, from
-    the load factor reached (the steps' cost taken as even over the program)."""
-    left = elapsed * (1.0 - load) / load if load > 0.0 else float("nan")
+    the share ``load`` of the program's ``total`` done (the steps' cost taken as even)."""
+    left = elapsed * (total - load) / load if load > 0.0 else float("nan")
     return f"  time {elapsed:.1f} s  left ~{left:.0f} s"
 
 

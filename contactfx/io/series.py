@@ -52,13 +52,18 @@ class FieldSeries:
     """The body and surface of one run on this rank: the mesh's P1 nodes and their global
     numbers, the split of the crack faces, the surface's facets, and each step's values per
     (cell, vertex) and per cell. ``facets``: the contact surface's facets (local indices), or
-    None. The writers add the files (``path``, ``surface_path``) and ``write``."""
+    None. The writers add the files (``path``, ``surface_path``), ``write``, and ``state`` /
+    ``resume``: what a checkpoint keeps of the series, and a series continued from it (the
+    steps after the checkpoint's dropped)."""
 
     path: Path
     surface_path: Path | None
 
-    def __init__(self, out: Path, name: str, mesh, facets=None, split: Split | None = None):
+    def __init__(
+        self, out: Path, name: str, mesh, facets=None, split: Split | None = None, resume=None
+    ):
         self.out, self.name, self.mesh = Path(out), name, mesh
+        self.resume = resume
         self.comm = mesh.comm
         self.facets = None if facets is None else np.asarray(facets, dtype=np.int32)
         self.split = split

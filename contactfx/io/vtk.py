@@ -62,19 +62,30 @@ class ResultsWriter(FieldSeries):
     format = "vtu"
     suffix = ".pvd"
 
-    def __init__(self, out: Path, name: str, mesh, facets=None, split: Split | None = None):
-        super().__init__(out, name, mesh, facets, split)
+    def __init__(
+        self, out: Path, name: str, mesh, facets=None, split: Split | None = None, resume=None
+    ):
+        super().__init__(out, name, mesh, facets, split, resume)
         self.path = self.out / f"{name}.pvd"
         self.surface_path = None if facets is None else self.out / f"{name}_surface.pvd"
         self._steps: list[tuple[float, str, str | None]] = []
 
     def __enter__(self) -> ResultsWriter:
+        if self.resume is not None:
+            self._steps = list(self.resume["steps"])
         if self.comm.rank == 0:  # a previous run's steps would linger next to the new ones
             self.out.mkdir(parents=True, exist_ok=True)
+            keep = {f for step in self._steps for f in step[1:] if f is not None}
             for pattern in ("_[0-9][0-9][0-9][0-9].vtu", "_surface_[0-9][0-9][0-9][0-9].vtu"):
                 for old in self.out.glob(self.name + pattern):
-                    old.unlink()
+                    if old.name not in keep:
+                        old.unlink()
+            if self._steps:
+                self._index()
         return self
+
+    def state(self) -> dict:
+        return {"steps": list(self._steps)}
 
     def __exit__(self, *exc) -> None:
         pass
@@ -94,9 +105,12 @@ class ResultsWriter(FieldSeries):
             self._write(self.out / surface, self.facet_name, cells, local, point, cell, False)
         self._steps.append((t, body, surface))
         if self.comm.rank == 0:
-            _write_pvd(self.path, [(t, b) for t, b, _ in self._steps])
-            if self.surface_path is not None:
-                _write_pvd(self.surface_path, [(t, s) for t, _, s in self._steps])
+            self._index()
+
+    def _index(self) -> None:
+        _write_pvd(self.path, [(t, b) for t, b, _ in self._steps])
+        if self.surface_path is not None:
+            _write_pvd(self.surface_path, [(t, s) for t, _, s in self._steps])
 
     def _write(self, path, cell_name, cells, local, point, cell, split) -> None:
         """Gather the cells' data on rank 0 and write one VTU. ``local``: the vertices of

@@ -136,13 +136,17 @@ class XdmfWriter(FieldSeries):
     format = "xdmf"
     suffix = ".xdmf"
 
-    def __init__(self, out: Path, name: str, mesh, facets=None, split: Split | None = None):
-        super().__init__(out, name, mesh, facets, split)
+    def __init__(
+        self, out: Path, name: str, mesh, facets=None, split: Split | None = None, resume=None
+    ):
+        super().__init__(out, name, mesh, facets, split, resume)
         self.h5py = h5py_mpi()
         self.path = self.out / f"{name}.xdmf"
         self.surface_path = None if facets is None else self.out / f"{name}_surface.xdmf"
         self.h5 = self.out / f"{name}.h5"
         self.steps = 0
+        #: each step's (time, name, point field sizes, cell field sizes): the index's grids
+        self.grids: list[tuple[float, str, dict, dict]] = []
         imap = self.Q1.dofmap.index_map
         self.r0 = int(imap.local_range[0])
         self.r1 = self.r0 + imap.size_local
@@ -189,6 +193,8 @@ class XdmfWriter(FieldSeries):
 
     # -- files -----------------------------------------------------------------------------
     def __enter__(self) -> XdmfWriter:
+        if self.resume is not None:
+            return self._resume(self.resume)
         if self.comm.rank == 0:  # a previous run's series would be appended to
             self.out.mkdir(parents=True, exist_ok=True)
             for old in (self.path, self.surface_path, self.h5):
@@ -207,6 +213,35 @@ class XdmfWriter(FieldSeries):
 
     def __exit__(self, *exc) -> None:
         pass
+
+    def state(self) -> dict:
+        return {"steps": self.steps, "grids": list(self.grids)}
+
+    def _resume(self, state: dict) -> XdmfWriter:
+        """Continue the series after the checkpoint's steps: later steps' datasets (written
+        before the run stopped) are deleted, the indexes rewritten with the kept steps."""
+        self.steps, self.grids = int(state["steps"]), list(state["grids"])
+        kept = {name for _, name, _, _ in self.grids}
+        with self._open("a") as f:
+            for group in ("body", "surface"):
+                if group in f:
+                    for name in sorted(set(f[group]) - {"geometry", "topology"} - kept):
+                        del f[group][name]  # collective: the same on every rank
+        if self.comm.rank == 0:
+            for path, group, layout, cell_name in self._indexes():
+                text = "".join(
+                    _grid(self.h5.name, group, layout, cell_name, *g) for g in self.grids
+                )
+                path.write_bytes(_HEAD + text.encode() + _TAIL)
+        self.comm.barrier()
+        return self
+
+    def _indexes(self) -> list:
+        """(XDMF file, HDF5 group, layout, cell name) of the body and the surface."""
+        out = [(self.path, "body", self.body, self.cell_name)]
+        if self.surface_path is not None:
+            out.append((self.surface_path, "surface", self.surface, self.facet_name))
+        return out
 
     def node_coordinates(self) -> np.ndarray:
         """(local Q1 dofs, 3): the mesh's own coordinates of the nodes (the same bits on
@@ -264,17 +299,12 @@ class XdmfWriter(FieldSeries):
             self._step(f["body"].create_group(step), self.body, nodal, minus, cell)
             if self.surface is not None:
                 self._step(f["surface"].create_group(step), self.surface, nodal, nodal, cell)
+        point_sizes = {k: v.shape[-1] for k, v in point.items()}
+        cell_sizes = {k: v.shape[-1] for k, v in cell.items()}
+        self.grids.append((float(t), step, point_sizes, cell_sizes))
         if self.comm.rank == 0:
-            point_sizes = {k: v.shape[-1] for k, v in point.items()}
-            cell_sizes = {k: v.shape[-1] for k, v in cell.items()}
-            grids = [(self.path, "body", self.body, self.cell_name)]
-            if self.surface_path is not None:
-                grids.append((self.surface_path, "surface", self.surface, self.facet_name))
-            for path, group, layout, cell_name in grids:
-                grid = _grid(
-                    self.h5.name, group, layout, cell_name, t, step, point_sizes, cell_sizes
-                )
-                _append(path, grid)
+            for path, group, layout, cell_name in self._indexes():
+                _append(path, _grid(self.h5.name, group, layout, cell_name, *self.grids[-1]))
 
     def _step(self, group, layout: _Layout, nodal: dict, minus: dict, cell: dict) -> None:
         """One step's fields (scalars as 1D datasets, as the index declares them)."""

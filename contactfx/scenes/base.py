@@ -162,6 +162,8 @@ class Scene:
         verbose: bool = True,
         time_limit: float | None = None,
         output_format: str = "xdmf",
+        restart: Path | None = None,
+        checkpoint_every: int = 1,
     ) -> RunSummary:
         """Solve with ``numerics`` (see :func:`contactfx.driver.run`)."""
         from contactfx.driver import run
@@ -175,6 +177,8 @@ class Scene:
             verbose=verbose,
             time_limit=time_limit,
             output_format=output_format,
+            restart=restart,
+            checkpoint_every=checkpoint_every,
         )
 
 

@@ -244,6 +244,7 @@ def march(
     on_step: Callable[[StepRecord], None] | None = None,
     diagnose: Callable[[], str] | None = None,
     stop: StopRequest | None = None,
+    resume: Callable[[], None] | None = None,
 ) -> list[StepRecord]:
     """Run ``stepper``'s program with ``solver`` (any solver of the :class:`ContactSNES`
     shape: ``u``, ``assemble_load()``, ``solve()``); ``apply_load(t)`` sets the loads'
@@ -252,9 +253,13 @@ def march(
     and the time, and what ``diagnose()`` (collective) finds in the failed iterate (e.g. an
     inverted element), with the last converged state restored. ``stop``: asked at every step
     boundary (collective); a signal received raises :class:`Interrupted` after the step in
-    progress (:mod:`contactfx.solvers.interrupt`)."""
+    progress (:mod:`contactfx.solvers.interrupt`). ``resume``: called once the stepper has
+    started, to put a checkpoint's state back (the stepper's among it: a restart continues
+    after the checkpoint's step)."""
     records: list[StepRecord] = []
     stepper.start(_compat.petsc_vec(solver.u))
+    if resume is not None:
+        resume()
     try:
         while not stepper.done():
             t = stepper.next_time()
