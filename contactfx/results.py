@@ -202,6 +202,9 @@ class RunSummary:
     #: what the run's numbers do not say on their own, one line each (e.g. a contact pair or
     #: obstacle that never closed over the run); run.json's ``warnings``, [] for a run without
     warnings: list[str] = field(default_factory=list)
+    #: a run continued from a checkpoint: {"step": its step, "load": its load factor}; the
+    #: steps before are the checkpoint's (their timings not in ``timings``)
+    restarted: dict[str, Any] | None = None
 
     # -- named views of the final state ---------------------------------------------------
     @property
@@ -301,6 +304,8 @@ class RunSummary:
         )
         if self.interface is not None or self.plot is not None:
             out["plot"] = self.plot
+        if self.restarted is not None:
+            out["restarted"] = dict(self.restarted)
         return out
 
 

@@ -4,7 +4,8 @@ non-zero: serially, and at 2 ranks with the signal sent to every rank (as Slurm'
 does) or to one rank only (the others learn of it at the step boundary). No rank hangs: every
 process ends within the timeout. (A SIGTERM to mpirun itself is the launcher's business: Open
 MPI 4.1, Debian 12's, forwards it to the ranks and the run stops the same way; Open MPI 5,
-Debian 13's, ends the ranks at once.)"""
+Debian 13's, ends the ranks at once.) The same command with ``--restart`` then completes the
+run from its last checkpoint."""
 
 import json
 import os
@@ -82,3 +83,22 @@ def test_sigterm_marks_the_run_interrupted(tmp_path, target):
     for step in range(done):
         assert len(read_xdmf(out / "hertz2d.xdmf", step)["point_data"]["displacement"])
     assert f"step  {done + 1:2d}" not in stdout  # no step after the one in progress
+    assert f"--restart {out}" in data["restart"] and f"after step {done}" in data["restart"]
+    if target == "one-rank":
+        return
+    # the run continued from its checkpoint (the same command with --restart): the complete
+    # steps kept as they were, the others appended, to run.json and the XDMF series
+    res = subprocess.run(
+        contactfx_cmd(*SLOW, "--restart", str(out), "--quiet", ranks=ranks),
+        capture_output=True,
+        text=True,
+        env=clean_env(),
+        timeout=300,
+    )
+    assert res.returncode == 0, res.stderr
+    final = json.loads((out / "run.json").read_text())
+    assert final["status"] == "completed" and len(final["steps"]) == 12
+    assert final["steps"][:done] == data["steps"]
+    assert read_xdmf(out / "hertz2d.xdmf")["times"] == pytest.approx(
+        [s["load"] for s in final["steps"]]
+    )

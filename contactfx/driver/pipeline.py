@@ -88,7 +88,8 @@ def run(
             write_interrupted(folder, stopped, scene, numerics, comm.size)
         raise
     except Exception as error:
-        if folder is not None:
+        # a refused restart leaves the folder's run.json (the stopped run's) as it is
+        if folder is not None and not (restart is not None and run_ is None):
             stage = "input" if run_ is None else run_.stage
             write_failed(folder, error, stage, comm, scene=scene, numerics=numerics)
         raise
@@ -555,6 +556,11 @@ class _Run:
             ),
             memory_mib=peak_memory_mib(self.comm),
             warnings=self.warnings(problem, steps) + extra.pop("warnings", []),
+            restarted=(
+                None
+                if self.restart is None
+                else {"step": self.restart.step, "load": self.restart.load}
+            ),
             **extra,
         )
         if self.out is not None:

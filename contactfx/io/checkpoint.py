@@ -69,7 +69,7 @@ def _item(v: Any, seen: set[int]) -> tuple[str, Any] | None:
         return ("C", np.array(v.value, copy=True))
     if isinstance(v, PETSc.Vec):
         return ("V", v.getArray(readonly=True).copy())
-    if isinstance(v, PETSc.Mat) and v.getType() in ("seqaij", "mpiaij"):
+    if isinstance(v, PETSc.Mat) and v.getType() in ("seqaij", "mpiaij") and v.isAssembled():
         return ("M", _pattern(v))
     if _plain(v):
         return ("P", copy.deepcopy(v))
@@ -141,18 +141,16 @@ def _restore(obj: Any, saved: dict[str, Any], grows: list) -> None:
 
 
 def _same(a: Any, b: Any) -> bool:
-    try:
-        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-            return (
-                isinstance(a, np.ndarray)
-                and isinstance(b, np.ndarray)
-                and a.shape == b.shape
-                and a.dtype == b.dtype
-                and np.array_equal(a, b)
-            )
-        return type(a) is type(b) and bool(a == b)
-    except (ValueError, TypeError):
+    """Plain data equal to the last bit (arrays by shape, type and values)."""
+    if type(a) is not type(b):
         return False
+    if isinstance(a, np.ndarray):
+        return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b, equal_nan=True)
+    if isinstance(a, list | tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    return bool(a == b) or (a != a and b != b)  # NaN
 
 
 def _pattern(A: PETSc.Mat) -> tuple[tuple, np.ndarray, np.ndarray]:
@@ -172,8 +170,9 @@ def _grow(A: PETSc.Mat, saved: tuple[tuple, np.ndarray, np.ndarray]) -> None:
     same_rows = (A.getOwnershipRange()[0], A.getSize()) == (start, tuple(shape)) and (
         A.getLocalSize()[0] == len(indptr) - 1
     )
-    # a matrix of other rows is built by a contact search, again at the next
-    if not comm.allreduce(same_rows, op=MPI.LAND):
+    # a matrix of other rows is built by a contact search, again at the next; one not yet
+    # assembled takes its pattern from its form's sparsity at its first assembly
+    if not comm.allreduce(same_rows and A.isAssembled(), op=MPI.LAND):
         return
     now = _pattern(A)
     same = np.array_equal(now[1], indptr) and np.array_equal(now[2], indices)
