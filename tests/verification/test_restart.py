@@ -8,12 +8,17 @@ reference is the same run without the stop, in the same process.
 - Obstacle with Coulomb friction (hertz2d, Nitsche, 4 steps, stopped after 2): the friction
   history and the secant predictor's two states are state. Bit for bit at 1 and 2 ranks
   (measured); asserted to 1e-12 relative, the issue's bound.
+- Two bodies (hertz-cylinders, mortar, 4 steps, stopped after 2): the closed set and the
+  Jacobian's grown pattern are state. Bit for bit serially, 1.1e-13 at 2 ranks (measured);
+  asserted to 1e-12.
 - Two bodies with Coulomb friction (cattaneo-cylinders, mortar, 6 steps, stopped after 3):
-  the slip history, the closed set and the Jacobian's grown pattern are state. Bit for bit
-  serially (measured). At 2 ranks two uninterrupted two-body runs in one job already differ
-  (4e-10 relative in the tangential force of the first step, measured: round-off of the
-  parallel coupling, not of the restart), so there the restart is asserted to be as close
-  to the uninterrupted run as a second uninterrupted run is (plus 1e-12).
+  the slip history too. Bit for bit serially (measured), asserted to 1e-12. At 2 ranks two
+  uninterrupted runs already differ, by the round-off of the parallel factorisation, which
+  the friction carries from step to step (1.7e-10 to 4.2e-10 relative in the tangential force,
+  measured in four pairs of runs, Debian 12 and 13): asserted to 1e-8 there, 25 times the
+  largest; a state a restart loses shows at 1e-3 and above (the Jacobian's pattern, the
+  subtlest, moved the tangential force by 4e-9 in the serial penalty run, where the bound is
+  1e-12).
 
 Also: a restart refuses other numerics in one line, and a folder without a checkpoint.
 """
@@ -76,7 +81,7 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) / max(abs(a[k]), 1e-300) for k in a)
 
 
-def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, full_twice=False):
+def _runs(tmp_path, monkeypatch, name, k, numerics, params=None):
     comm = MPI.COMM_WORLD
     base = Path(comm.bcast(str(tmp_path), root=0))
     cls = get_scene(name)
@@ -86,8 +91,6 @@ def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, full_twice=Fals
         return cls(cls.Params(**(params or {})))
 
     scene().run(num, out=base / "full", verbose=False)
-    if full_twice:
-        scene().run(num, out=base / "again", verbose=False, checkpoint_every=0)
     _StopAt.k = k
     monkeypatch.setattr(pipeline, "StopRequest", _StopAt)
     with pytest.raises(Interrupted):
@@ -96,8 +99,6 @@ def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, full_twice=Fals
     scene().run(num, restart=base / "cut", verbose=False)
     comm.barrier()
     read = {d: json.loads((base / d / "run.json").read_text()) for d in ("full", "cut")}
-    if full_twice:
-        read["again"] = json.loads((base / "again" / "run.json").read_text())
     return base, read
 
 
@@ -129,26 +130,27 @@ def test_restart_obstacle_with_friction(tmp_path, monkeypatch):
     _same_fields(base, "hertz2d", 1e-12)
 
 
+def test_restart_two_bodies(tmp_path, monkeypatch):
+    base, run = _runs(tmp_path, monkeypatch, "hertz-cylinders", 2, {"method": "mortar", "steps": 4})
+    full, cut = run["full"], run["cut"]
+    assert cut["status"] == "completed" and len(cut["steps"]) == len(full["steps"]) == 4
+    assert cut["restarted"]["step"] == 2
+    # 0 serially, 1.1e-13 at 2 ranks (measured)
+    assert _worst(_numbers(full["steps"]), _numbers(cut["steps"])) <= 1e-12
+    _same_fields(base, "hertz-cylinders", 1e-12)
+
+
 def test_restart_two_bodies_with_friction(tmp_path, monkeypatch):
-    parallel = MPI.COMM_WORLD.size > 1
     base, run = _runs(
-        tmp_path,
-        monkeypatch,
-        "cattaneo-cylinders",
-        3,
-        {"method": "mortar", "steps": 6},
-        full_twice=parallel,
+        tmp_path, monkeypatch, "cattaneo-cylinders", 3, {"method": "mortar", "steps": 6}
     )
     full, cut = run["full"], run["cut"]
     assert cut["status"] == "completed" and len(cut["steps"]) == len(full["steps"]) == 6
     assert cut["restarted"]["step"] == 3
-    worst = _worst(_numbers(full["steps"]), _numbers(cut["steps"]))
-    if not parallel:
-        assert worst <= 1e-12  # 0 measured
-        _same_fields(base, "cattaneo-cylinders", 1e-12)
-    else:  # no closer than a second uninterrupted run (see the module docstring)
-        noise = _worst(_numbers(full["steps"]), _numbers(run["again"]["steps"]))
-        assert worst <= noise + 1e-12, (worst, noise)
+    # see the module docstring: 0 serially (measured); at 2 ranks the run-to-run round-off
+    bound = 1e-12 if MPI.COMM_WORLD.size == 1 else 1e-8
+    assert _worst(_numbers(full["steps"]), _numbers(cut["steps"])) <= bound
+    _same_fields(base, "cattaneo-cylinders", bound)
 
 
 def test_restart_refuses_other_numerics_and_no_checkpoint(tmp_path):
