@@ -66,8 +66,9 @@ class Restart:
         errors = [e for e in comm.allgather(error) if e is not None]
         if errors:
             raise ValueError(errors[0])
-        assert meta is not None
-        self.meta, self.state = meta, state
+        assert meta is not None and state is not None
+        self.meta: dict[str, Any] = meta
+        self.state: dict[str, Any] = state
         self.step, self.load = int(meta["step"]), float(meta["load"])
         different = _difference(meta, identity)
         if different:
