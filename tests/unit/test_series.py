@@ -1,7 +1,8 @@
-"""The XDMF writer (contactfx.io.xdmf) on a unit square, serial and under MPI: one grid per
-step with every field at the right points, the surface dataset, the split of the nodes along
-an interface (each side's cells carry u + H a), and the same values written by one rank and
-by every rank (to the last bit, after sorting the nodes and cells by their coordinates)."""
+"""The ParaView writers on a unit square, serial and under MPI. XDMF (contactfx.io.xdmf): one
+grid per step with every field at the right points, the surface dataset, the split of the
+nodes along an interface (each side's cells carry u + H a), and the same values written by
+one rank and by every rank (to the last bit, after sorting the nodes and cells by their
+coordinates). VTU (contactfx.io.vtk, --format vtu): the same fields, split and surface."""
 
 from pathlib import Path
 
@@ -12,6 +13,7 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.io.series import Split
+from contactfx.io.vtk import ResultsWriter, read_pvd, read_vtu
 from contactfx.io.xdmf import XdmfWriter, read_xdmf
 
 N = 4  # cells per side; the interface y = 1/2 is a row of facets
@@ -26,8 +28,9 @@ def _function(space, name, f):
     return u
 
 
-def _write(comm, out: Path, times=(0.5, 1.0)) -> None:
-    """The square's fields at ``times`` (the same functions of x at every step)."""
+def _write(comm, out: Path, times=(0.5, 1.0), writer=XdmfWriter) -> None:
+    """The square's fields at ``times`` (the same functions of x at every step) with
+    ``writer`` (the XDMF or the VTU writer)."""
     mesh = dolfinx.mesh.create_unit_square(comm, N, N)
     fdim = mesh.topology.dim - 1
     mesh.topology.create_connectivity(fdim, mesh.topology.dim)
@@ -45,9 +48,9 @@ def _write(comm, out: Path, times=(0.5, 1.0)) -> None:
     side = _function(DG0, "side", lambda x: np.where(x[1] > 0.5, 1.0, -1.0))
     cellwise = _function(DG0, "stress", lambda x: 3.0 + x[0] / 7)
     tensor = _function(T0, "cauchy_stress", lambda x: np.vstack([x[0] + k for k in range(9)]))
-    with XdmfWriter(out, "square", mesh, facets=bottom, split=Split(side, middle)) as writer:
+    with writer(out, "square", mesh, facets=bottom, split=Split(side, middle)) as w:
         for t in times:
-            writer.write(t, [u, a, scalar, quadratic, cellwise, tensor])
+            w.write(t, [u, a, scalar, quadratic, cellwise, tensor])
 
 
 def _sorted(grid: dict) -> dict:
@@ -137,3 +140,42 @@ def test_xdmf_one_rank_and_every_rank_write_the_same_bits(tmp_path):
             assert one[key].keys() == every[key].keys()
             for k in one[key]:
                 assert np.array_equal(one[key][k], every[key][k]), (name, k)
+
+
+def test_vtu_every_field_surface_and_split(tmp_path):
+    """The same square through the VTU writer (--format vtu): one VTU per step, gathered on
+    rank 0, with the same fields, split and surface."""
+    comm = MPI.COMM_WORLD
+    out = Path(comm.bcast(str(tmp_path), root=0))
+    stale = out / "square_0009.vtu"  # a previous run's step: removed
+    if comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+        stale.write_text("")
+    comm.barrier()
+    _write(comm, out, writer=ResultsWriter)
+    comm.barrier()
+    if comm.rank != 0:
+        return
+    assert not stale.exists()
+    steps = read_pvd(out / "square.pvd")
+    assert [t for t, _ in steps] == [0.5, 1.0]
+    grid = read_vtu(steps[-1][1])
+    x, pd = grid["points"], grid["point_data"]
+    assert len(x) == (N + 1) ** 2 + N + 1 and grid["cells"].shape == (2 * N * N, 3)
+    assert set(pd) == {"displacement", "enrichment", "pressure", "quadratic"}
+    centroid = x[grid["cells"]].mean(axis=1)
+    assert grid["cell_data"]["stress"] == pytest.approx(3.0 + centroid[:, 0] / 7, abs=1e-14)
+    assert pd["pressure"] == pytest.approx(1.0 + x[:, 0] + 2.0 * x[:, 1])
+    assert pd["quadratic"][:, :2] == pytest.approx(np.column_stack([x[:, 0] ** 2, x[:, 1]]))
+    on = np.isclose(x[:, 1], 0.5)
+    y = pd["displacement"][:, 1]
+    assert y[~on] == pytest.approx(x[~on, 1])
+    for cell in grid["cells"]:
+        above = x[cell, 1].mean() > 0.5
+        for k in cell[on[cell]]:
+            assert y[k] == pytest.approx(1.5 if above else -0.5)
+    assert pd["displacement"].shape[1] == 3 and not pd["displacement"][:, 2].any()
+    surface = read_vtu(read_pvd(out / "square_surface.pvd")[-1][1])
+    assert surface["cells"].shape == (N, 2) and len(surface["points"]) == N + 1
+    assert surface["points"][:, 1] == pytest.approx(0.0)
+    assert surface["point_data"]["pressure"] == pytest.approx(1.0 + surface["points"][:, 0])
