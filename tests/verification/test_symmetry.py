@@ -204,6 +204,12 @@ def test_built_in_scenes_mirror_planes():
             lambda t: t.replace('symmetry_planes = ["x"]', 'symmetry_planes = ["z"]'),
             "output.symmetry_planes: 'z' is no axis of a 2D mesh",
         ),
+        (  # the [output] table's other keys: the ParaView files' format
+            lambda t: t.replace(
+                'symmetry_planes = ["x"]', 'symmetry_planes = ["x"]\nformat = "csv"'
+            ),
+            "output.format: must be one of xdmf, vtu, got 'csv'",
+        ),
     ],
 )
 def test_bad_symmetry_keys(tmp_path, edit, message):
@@ -225,3 +231,15 @@ def test_check_names_the_convention(shared_tmp, capsys):
             "symmetry   forces of the full model: 2 times the model's, 0 along x (normal to "
             "the mirror planes)" in capsys.readouterr().out
         )
+
+
+def test_output_format_key(tmp_path):
+    """``output.format``: xdmf by default, vtu when asked (what ``solve`` writes unless
+    ``--format`` overrides it)."""
+    path = tmp_path / "half.toml"
+    path.write_text(HALF)
+    assert load_problem(path)[0].spec.output.format == "xdmf"
+    path.write_text(
+        HALF.replace('symmetry_planes = ["x"]', 'symmetry_planes = ["x"]\nformat = "vtu"')
+    )
+    assert load_problem(path)[0].spec.output.format == "vtu"
