@@ -8,8 +8,9 @@ removed after. A run stopped while writing keeps the last complete checkpoint.
 
 The state is captured from the run's objects (the problem, its post-processor, the solver
 and its wrappers, the stepper, the scene) by :func:`capture`: every dolfinx Function's
-values, every Constant's, every PETSc vector's owned values, every AIJ matrix's nonzero
-pattern (:func:`_grow`), and the plain data (numbers,
+values, every Constant's, every PETSc vector's owned values, the nonzero pattern of the
+matrices an object names in its ``checkpoint_patterns`` (:func:`_grow`: a two-body
+Jacobian's), and the plain data (numbers,
 arrays, tuples, lists and dicts of them) of every contactfx object they hold, by attribute
 path. :func:`restore` puts them back into the same objects of a run built again from the
 same input, so a restarted run continues with the same bits: the unknowns, multipliers,
@@ -69,8 +70,6 @@ def _item(v: Any, seen: set[int]) -> tuple[str, Any] | None:
         return ("C", np.array(v.value, copy=True))
     if isinstance(v, PETSc.Vec):
         return ("V", v.getArray(readonly=True).copy())
-    if isinstance(v, PETSc.Mat) and v.getType() in ("seqaij", "mpiaij") and v.isAssembled():
-        return ("M", _pattern(v))
     if _plain(v):
         return ("P", copy.deepcopy(v))
     if isinstance(v, list | tuple) and v and not all(_plain(x) for x in v):
@@ -86,7 +85,11 @@ def _item(v: Any, seen: set[int]) -> tuple[str, Any] | None:
 
 def _capture(obj: Any, seen: set[int]) -> dict[str, Any]:
     out = {}
+    grown = getattr(obj, "checkpoint_patterns", ())
     for name, v in vars(obj).items():
+        if name in grown and isinstance(v, PETSc.Mat) and v.isAssembled():
+            out[name] = ("M", _pattern(v))
+            continue
         item = _item(v, seen)
         if item is not None:
             out[name] = item

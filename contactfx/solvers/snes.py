@@ -437,6 +437,13 @@ class ContactSNES:
         prefix), with or without this solver's prefix."""
         return self.options.user_sets(key)
 
+    @property
+    def checkpoint_patterns(self) -> tuple[str, ...]:
+        """The matrices whose nonzero pattern a checkpoint keeps (contactfx.io.checkpoint):
+        with a two-body coupling the Jacobian gains the entries of every search and keeps
+        them, and the factorisation's ordering follows the pattern."""
+        return ("J",) if self.coupling is not None else ()
+
     def tolerances(self) -> dict[str, float]:
         """SNES's tolerances: ``rtol``, ``atol``, ``stol``, ``max_it``."""
         return dict(zip(("rtol", "atol", "stol", "max_it"), self.snes.getTolerances(), strict=True))
