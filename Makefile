@@ -31,8 +31,8 @@ demo: install
 # alone; the tests of an xdist_group, the ParaView probes, on one worker); the MPI session runs
 # every test on NP ranks together.
 test: install
-	$(PY) -m pytest -q -n $(NP) --dist loadgroup tests
-	mpirun -n $(NP) $(PY) -m mpi4py -m pytest -q -m "not serial_only" tests
+	$(PY) -m pytest -q -n $(NP) --dist loadgroup --durations=15 tests
+	mpirun -n $(NP) $(PY) -m mpi4py -m pytest -q -m "not serial_only" --durations=15 tests
 
 # The committed results page docs/results.md (over an hour on 2 cores: up to 850 runs): error against run time
 # for every case and method, and the robustness matrix.

@@ -520,7 +520,7 @@ class _Run:
         self.timings["assembly"] = solver.timer.assembly + self.timings.pop("chain_assembly", 0.0)
         if problem.coupling() is not None:  # two bodies: the coupling's share of the assembly
             self.timings["contact"] = solver.timer.contact
-        output = self.timings.get("output", 0.0)
+        output = self.timings.get("output", 0.0) + self.timings.get("checkpoint", 0.0)
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
         self.timings.update(solver.phase_timings())  # within the solve (nested: the coarse chain)
         return steps
