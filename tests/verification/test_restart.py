@@ -36,6 +36,7 @@ from mpi4py import MPI
 import contactfx.driver.pipeline as pipeline
 from contactfx.io.xdmf import read_xdmf
 from contactfx.scenes import get_scene
+from contactfx.scenes.problem_file import load_problem
 from contactfx.solvers.interrupt import Interrupted
 
 
@@ -81,14 +82,22 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) / max(abs(a[k]), 1e-300) for k in a)
 
 
-def _runs(tmp_path, monkeypatch, name, k, numerics, params=None):
+def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, make=None):
+    """(folder, run.json of the full run and of the stopped and restarted one); ``make``:
+    () -> (scene, numerics) instead of a built-in scene ``name``."""
     comm = MPI.COMM_WORLD
     base = Path(comm.bcast(str(tmp_path), root=0))
-    cls = get_scene(name)
-    num = cls.default_numerics(**numerics)
+    if make is None:
+        cls = get_scene(name)
+        num = cls.default_numerics(**numerics)
 
-    def scene():
-        return cls(cls.Params(**(params or {})))
+        def scene():
+            return cls(cls.Params(**(params or {})))
+    else:
+        num = make()[1]
+
+        def scene():
+            return make()[0]
 
     scene().run(num, out=base / "full", verbose=False)
     _StopAt.k = k
@@ -151,6 +160,27 @@ def test_restart_two_bodies_with_friction(tmp_path, monkeypatch):
     bound = 1e-12 if MPI.COMM_WORLD.size == 1 else 1e-8
     assert _worst(_numbers(full["steps"]), _numbers(cut["steps"])) <= bound
     _same_fields(base, "cattaneo-cylinders", bound)
+
+
+def test_restart_problem_file_with_reactions(tmp_path, monkeypatch):
+    """A problem file's scene keeps its reaction rows (history.csv) in its state: the
+    restarted run has every step's, as the uninterrupted run."""
+    path = Path(__file__).parents[2] / "demos" / "problems" / "block-on-plinth.toml"
+    scenes = []
+
+    def make():
+        scene, numerics, _ = load_problem(path, ["numerics.steps=4"])
+        scenes.append(scene)
+        return scene, numerics
+
+    _, run = _runs(tmp_path, monkeypatch, "", 2, {}, make=make)
+    full, cut = run["full"], run["cut"]
+    assert cut["restarted"]["step"] == 2 and len(cut["steps"]) == 4
+    # 0 serially (measured); a frictionless pair: round-off at 2 ranks
+    assert _worst(_numbers(full["steps"]), _numbers(cut["steps"])) <= 1e-12
+    rows = [s.reaction_rows for s in scenes]  # make(): the numerics, full, cut, restart
+    assert len(rows[1]) == len(rows[3]) == 4
+    assert _worst(_numbers(rows[1]), _numbers(rows[3])) <= 1e-12
 
 
 def test_restart_refuses_other_numerics_and_no_checkpoint(tmp_path):
