@@ -88,8 +88,10 @@ def run(
             write_interrupted(folder, stopped, scene, numerics, comm.size)
         raise
     except Exception as error:
-        # a refused restart leaves the folder's run.json (the stopped run's) as it is
-        if folder is not None and not (restart is not None and run_ is None):
+        # a refused restart (another identity, another mesh) leaves the folder's run.json,
+        # the stopped run's, as it is
+        refused = restart is not None and (run_ is None or run_.stage != "solve")
+        if folder is not None and not refused:
             stage = "input" if run_ is None else run_.stage
             write_failed(folder, error, stage, comm, scene=scene, numerics=numerics)
         raise
@@ -239,8 +241,9 @@ def _checked_method(scene: Scene, numerics: Numerics) -> Method:
     return method
 
 
-def prepare_output(out: Path, comm: MPI.Comm) -> None:
-    """Create the output folder and remove a previous run.json; fail on every rank alike."""
+def prepare_output(out: Path, comm: MPI.Comm, keep: bool = False) -> None:
+    """Create the output folder and remove a previous run.json (``keep``: a restart's,
+    replaced when the run ends); fail on every rank alike."""
     error = None
     if comm.rank == 0:
         try:
@@ -248,7 +251,8 @@ def prepare_output(out: Path, comm: MPI.Comm) -> None:
             probe = out / ".write-test"
             probe.write_text("")
             probe.unlink()
-            (out / "run.json").unlink(missing_ok=True)
+            if not keep:
+                (out / "run.json").unlink(missing_ok=True)
         except OSError as err:
             error = f"output folder {out} is not writable: {err.strerror or err}"
     error = comm.bcast(error, root=0)
@@ -334,7 +338,7 @@ class _Run:
         if self.time_limit is not None:
             self.deadline = time.perf_counter() + self.time_limit
         if self.out is not None:
-            prepare_output(self.out, self.comm)
+            prepare_output(self.out, self.comm, keep=self.restart is not None)
         problem, post, solver = self.build()
         if self.restart is not None:
             self.restart.check_mesh(problem.mesh)

@@ -183,13 +183,34 @@ def test_restart_problem_file_with_reactions(tmp_path, monkeypatch):
     assert _worst(_numbers(rows[1]), _numbers(rows[3])) <= 1e-12
 
 
-def test_restart_refuses_other_numerics_and_no_checkpoint(tmp_path):
+def test_restart_refuses_other_numerics_mesh_and_no_checkpoint(tmp_path):
+    """One line naming what differs; the run's folder (its run.json) left as it was."""
     comm = MPI.COMM_WORLD
     base = Path(comm.bcast(str(tmp_path), root=0))
     cls = get_scene("hertz2d")
     params = cls.Params(h_contact=0.02, h_far=0.3)
     cls(params).run(cls.default_numerics(steps=2), out=base / "a", verbose=False)
+    before = (base / "a" / "run.json").read_text()
     with pytest.raises(ValueError, match="numerics method is 'penalty' here, 'nitsche' in the"):
         cls(params).run(cls.default_numerics(steps=2, method="penalty"), restart=base / "a")
     with pytest.raises(ValueError, match="no checkpoint there"):
         cls(params).run(cls.default_numerics(steps=2), restart=base / "nothing")
+    # a problem file whose mesh file changed: the same parameters, another mesh
+    demo = Path(__file__).parents[2] / "demos" / "problems"
+    if comm.rank == 0:
+        for name in ("block-on-plinth.toml", "block-on-plinth.geo"):
+            (base / name).write_text((demo / name).read_text())
+    comm.barrier()
+    scene, numerics, _ = load_problem(base / "block-on-plinth.toml")
+    scene.run(numerics, out=base / "b", verbose=False)
+    comm.barrier()
+    if comm.rank == 0:
+        geo = base / "block-on-plinth.geo"
+        geo.write_text(geo.read_text().replace("hu = 0.035;", "hu = 0.03;"))
+    comm.barrier()
+    scene, numerics, _ = load_problem(base / "block-on-plinth.toml")
+    with pytest.raises(ValueError, match="the mesh differs from the checkpoint's"):
+        scene.run(numerics, restart=base / "b", verbose=False)
+    comm.barrier()
+    assert (base / "a" / "run.json").read_text() == before
+    assert json.loads((base / "b" / "run.json").read_text())["status"] == "completed"
