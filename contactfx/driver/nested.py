@@ -167,6 +167,9 @@ class NestedSolver(SolverWrapper):
         #: wall time of the coarse chain's solves
         self.coarse_time = 0.0
 
+    #: not state (contactfx.io.checkpoint): this run's timing
+    checkpoint_skip = ("coarse_time",)
+
     def solve(self) -> SolveStats:
         t0 = time.perf_counter()
         self._restore()

@@ -495,7 +495,6 @@ class _Run:
             def resume() -> None:
                 assert restart is not None
                 restart.resume(roots())
-                solver_deadline(solver, self.deadline)
                 self.say(f"  restarted after step {restart.step} (load {restart.load:.6g})")
 
             t0 = time.perf_counter()
@@ -581,15 +580,6 @@ class _Run:
             local = float(np.min(coupling.search_gaps(), initial=np.inf))
             gap = self.comm.allreduce(local, op=MPI.MIN)
         return never_closed(steps, "pair" if pair else "obstacle", gap)
-
-
-def solver_deadline(solver: Any, deadline: float | None) -> None:
-    """Set the wall-time deadline of the ContactSNES inside ``solver``'s wrappers (a
-    restored state carries the checkpointed run's)."""
-    while solver is not None:
-        if hasattr(solver, "deadline"):
-            solver.deadline = deadline
-        solver = getattr(solver, "inner", None)
 
 
 def _remaining(elapsed: float, load: float, total: float = 1.0) -> str:

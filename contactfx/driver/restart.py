@@ -97,14 +97,14 @@ class Restart:
 
 def _difference(meta: dict, identity: dict) -> str:
     """The first difference between the checkpoint's run and this one, as a phrase."""
-    for key in ("scene", "format", "ranks"):
+    for key in ("scene", "format"):  # the ranks: read_checkpoint
         if meta.get(key) != identity[key]:
-            what = {"format": "output format", "ranks": "number of ranks"}.get(key, key)
+            what = {"format": "output format"}.get(key, key)
             return f"the {what} is {identity[key]} here, {meta.get(key)} in the checkpoint"
     for group in ("parameters", "numerics"):
         theirs, ours = meta.get(group, {}), identity[group]
         for key in sorted(set(theirs) | set(ours)):
-            if theirs.get(key) != ours.get(key) and not _equal(theirs.get(key), ours.get(key)):
+            if not _equal(theirs.get(key), ours.get(key)):
                 return (
                     f"{group} {key} is {ours.get(key)!r} here, {theirs.get(key)!r} in the "
                     "checkpoint"

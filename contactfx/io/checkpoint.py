@@ -10,7 +10,8 @@ The state is captured from the run's objects (the problem, its post-processor, t
 and its wrappers, the stepper, the scene) by :func:`capture`: every dolfinx Function's
 values, every Constant's, every PETSc vector's owned values, the nonzero pattern of the
 matrices an object names in its ``checkpoint_patterns`` (:func:`_grow`: a two-body
-Jacobian's), and the plain data (numbers,
+Jacobian's), and the plain data (but the attributes it names in ``checkpoint_skip``: this
+run's clock, not state) (numbers,
 arrays, tuples, lists and dicts of them) of every contactfx object they hold, by attribute
 path. :func:`restore` puts them back into the same objects of a run built again from the
 same input, so a restarted run continues with the same bits: the unknowns, multipliers,
@@ -86,7 +87,10 @@ def _item(v: Any, seen: set[int]) -> tuple[str, Any] | None:
 def _capture(obj: Any, seen: set[int]) -> dict[str, Any]:
     out = {}
     grown = getattr(obj, "checkpoint_patterns", ())
+    skip = getattr(obj, "checkpoint_skip", ())
     for name, v in vars(obj).items():
+        if name in skip:
+            continue
         if name in grown and isinstance(v, PETSc.Mat) and v.isAssembled():
             out[name] = ("M", _pattern(v))
             continue

@@ -144,7 +144,6 @@ class XdmfWriter(FieldSeries):
         self.path = self.out / f"{name}.xdmf"
         self.surface_path = None if facets is None else self.out / f"{name}_surface.xdmf"
         self.h5 = self.out / f"{name}.h5"
-        self.steps = 0
         #: each step's (time, name, point field sizes, cell field sizes): the index's grids
         self.grids: list[tuple[float, str, dict, dict]] = []
         imap = self.Q1.dofmap.index_map
@@ -215,12 +214,12 @@ class XdmfWriter(FieldSeries):
         pass
 
     def state(self) -> dict:
-        return {"steps": self.steps, "grids": list(self.grids)}
+        return {"grids": list(self.grids)}
 
     def _resume(self, state: dict) -> XdmfWriter:
         """Continue the series after the checkpoint's steps: later steps' datasets (written
         before the run stopped) are deleted, the indexes rewritten with the kept steps."""
-        self.steps, self.grids = int(state["steps"]), list(state["grids"])
+        self.grids = list(state["grids"])
         kept = {name for _, name, _, _ in self.grids}
         with self._open("a") as f:
             for group in ("body", "surface"):
@@ -293,8 +292,7 @@ class XdmfWriter(FieldSeries):
         """Write the fields of the load step at load factor ``t``. Collective."""
         point, cell = self.values(functions, vertex_dofs=True)
         nodal, minus = self.nodal(point)
-        self.steps += 1
-        step = f"step_{self.steps:04d}"
+        step = f"step_{len(self.grids) + 1:04d}"
         with self._open("a") as f:
             self._step(f["body"].create_group(step), self.body, nodal, minus, cell)
             if self.surface is not None:

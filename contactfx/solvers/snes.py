@@ -437,6 +437,9 @@ class ContactSNES:
         prefix), with or without this solver's prefix."""
         return self.options.user_sets(key)
 
+    #: not state (contactfx.io.checkpoint): this run's wall-time deadline and timings
+    checkpoint_skip = ("deadline", "timer")
+
     @property
     def checkpoint_patterns(self) -> tuple[str, ...]:
         """The matrices whose nonzero pattern a checkpoint keeps (contactfx.io.checkpoint):
