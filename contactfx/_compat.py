@@ -44,7 +44,6 @@ __all__ = [
     "cell_coordinates",
     "numpy_math",
     "ufl_math",
-    "FacetTree",
     "PointLocator",
     "point_values",
 ]
@@ -334,78 +333,6 @@ ufl_math = SimpleNamespace(
     sin=ufl.sin,
     maximum=ufl.max_value,
 )
-
-
-class FacetTree:
-    """A bounding-box tree over loose facets (segments in 2D, triangles in 3D) given by their
-    vertex coordinates ``(m, d, gdim)``: a serial dolfinx manifold mesh of them carries
-    ``dolfinx.geometry``'s tree. ``padding`` enlarges every box (the search radius): a number,
-    or one per facet (m,), then every box is represented by a simplex spanning it (the tree
-    reads only the boxes).
-
-    ``collide_points(points)`` and ``collide(other)`` give candidate pairs (point or facet of
-    ``other``, facet of this tree) as two index arrays, in the caller's facet numbering.
-    """
-
-    def __init__(self, coords: np.ndarray, padding: float) -> None:
-        import dolfinx.geometry as geo
-        from mpi4py import MPI
-
-        m, d, gdim = coords.shape
-        self.size = m
-        if m == 0:
-            return
-        if np.ndim(padding) == 1:
-            pad = np.asarray(padding, dtype=np.float64)[:, None]
-            lo, hi = coords.min(axis=1) - pad, coords.max(axis=1) + pad
-            # a simplex whose box is [lo, hi]: (lo), (hi in the first gdim - 1 coordinates,
-            # lo in the last), (lo, with hi in the last coordinate)
-            spanning = np.repeat(lo[:, None, :], d, axis=1)
-            spanning[:, 1, : gdim - 1] = hi[:, : gdim - 1]
-            spanning[:, -1, gdim - 1] = hi[:, gdim - 1]
-            if d == 3:
-                spanning[:, 1, gdim - 1] = lo[:, gdim - 1]
-            coords, padding = spanning, 0.0
-        name = "interval" if d == 2 else "triangle"
-        cells = np.arange(m * d, dtype=np.int64).reshape(m, d)
-        x = np.ascontiguousarray(coords.reshape(m * d, gdim), dtype=np.float64)
-        if _NEW:
-            import basix.ufl
-
-            domain = ufl.Mesh(basix.ufl.element("Lagrange", name, 1, shape=(gdim,)))
-        else:
-            domain = ufl.Mesh(
-                ufl.VectorElement("Lagrange", ufl.Cell(name, geometric_dimension=gdim), 1)
-            )
-        mesh = dolfinx.mesh.create_mesh(MPI.COMM_SELF, cells, x, domain)
-        self._original = np.asarray(mesh.topology.original_cell_index, dtype=np.int64)
-        tdim = d - 1
-        self.tree = _bb_tree(mesh, tdim, np.arange(m, dtype=np.int32), padding)
-        self._geo = geo
-
-    def collide_points(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        n = len(points)
-        if self.size == 0 or n == 0:
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        pts = np.zeros((n, 3))
-        pts[:, : points.shape[1]] = points
-        if _NEW:
-            adj = self._geo.compute_collisions_points(self.tree, pts)
-        else:
-            adj = self._geo.compute_collisions(self.tree, pts)
-        counts = np.diff(adj.offsets)
-        rows = np.repeat(np.arange(n, dtype=np.int64), counts)
-        return rows, self._original[adj.array]
-
-    def collide(self, other: FacetTree) -> tuple[np.ndarray, np.ndarray]:
-        if self.size == 0 or other.size == 0:
-            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        if _NEW:
-            pairs = self._geo.compute_collisions_trees(other.tree, self.tree)
-        else:
-            pairs = self._geo.compute_collisions(other.tree, self.tree)
-        pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
-        return other._original[pairs[:, 0]], self._original[pairs[:, 1]]
 
 
 def _bb_tree(mesh, tdim: int, entities: np.ndarray, padding: float = 0.0):

@@ -18,6 +18,7 @@ SYSPY=/usr/bin/python3
 APT_PACKAGES=(
     python3-dolfinx python3-gmsh python3-pytest python3-matplotlib
     python3-h5py-mpi            # the XDMF output: every rank writes its rows of the HDF5 file
+    python3-scipy               # the contact search (k-d trees) and the mesh partition (RCM)
     python3-pytest-xdist        # the serial test session on every core (make test)
     python3-venv python3-pip python3-setuptools python3-wheel
     openmpi-bin openssh-client  # mpirun refuses to start without an rsh/ssh agent on PATH

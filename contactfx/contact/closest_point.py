@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from contactfx.contact.boxes import FacetTree
 from contactfx.contact.pair import Facets, facet_order, facet_rim
 from contactfx.contact.projection import TOL, Pick, closest_point_facets, pick_closest
 
@@ -49,9 +50,7 @@ KEEP_BEYOND = 0.1
 def candidates(xq: np.ndarray, near: Facets, padding: np.ndarray) -> np.ndarray:
     """(n, width) the facets of ``near`` whose bounding box padded by ``padding`` (per facet)
     holds each point of ``xq`` (-1: none)."""
-    from contactfx import _compat
-
-    tree = _compat.FacetTree(near.x, padding)  # type: ignore[arg-type]
+    tree = FacetTree(near.x, padding)
     rows, facets = tree.collide_points(xq)
     counts = np.bincount(rows, minlength=len(xq))
     width = max(int(counts.max(initial=0)), 1)
@@ -97,7 +96,6 @@ def project(xq: np.ndarray, near: Facets, kept: np.ndarray | None = None) -> Pic
             np.full(n, np.nan),
             np.full(n, np.nan),
         )
-    # FacetTree takes a padding per facet too (its docstring; the annotation says float)
     cand = candidates(xq, near, near.diameters())
     # ties (a point equally far from facets sharing an edge or a vertex, to round-off) go
     # to the facet first in the order of the reference coordinates: the same choice on

@@ -10,7 +10,7 @@ Search across ranks (:func:`gather_near`): every rank publishes the bounding box
 region it searches (its slave facets in the current configuration, enlarged by the search
 radius); every rank sends each other rank the master facets (current coordinates and global
 node indices) that meet that box; candidates are then found in a bounding-box tree of the
-received facets (:class:`contactfx._compat.FacetTree`, dolfinx.geometry), every facet's box
+received facets (:class:`contactfx.contact.boxes.FacetTree`), every facet's box
 enlarged by its own diameter (a uniform padding by the largest facet would give thousands of
 candidates per facet on a graded mesh). The cost is one
 ``alltoall`` of the facets near each rank's slave region: at 1 rank nothing is sent, at p
@@ -38,6 +38,7 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx import _compat
+from contactfx.contact.boxes import FacetTree
 
 if TYPE_CHECKING:
     import dolfinx
@@ -477,11 +478,8 @@ class ContactPair:
         near = gather_near(comm, master, slave, self.radius)
         found = None
         if pairs:
-            # FacetTree takes a padding per facet too (its docstring; the annotation says float)
-            tree = _compat.FacetTree(near.x, near.diameters())  # type: ignore[arg-type]
-            found = tree.collide(
-                _compat.FacetTree(slave.x, slave.diameters())  # type: ignore[arg-type]
-            )
+            tree = FacetTree(near.x, near.diameters())
+            found = tree.collide(FacetTree(slave.x, slave.diameters()))
         self.searches += 1
         self.search_time += time.perf_counter() - t0
         return near, found

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from contactfx._compat import FacetTree
+from contactfx.contact.boxes import FacetTree
 from contactfx.contact.mortar import mortar_matrices
 from contactfx.contact.pair import Facets, facet_normals
 
