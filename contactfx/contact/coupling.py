@@ -62,10 +62,11 @@ class PairCoupling(Coupling, Protocol):
     """A two-body coupling also gives the two-body kind's post-processing its nodal state at
     the last converged solve: ``nodal()`` (the slave contact nodes, their weights, pressure
     and gap), ``nodal_friction()`` and ``friction_state()`` (with friction), ``force()`` (the
-    total normal force), ``slave_force()`` (the force vector on the slave body) and
-    ``search_gaps()`` (the gaps the last search measured) and ``nodal_normals()`` (a unit
-    normal per node of ``nodal()``); ``record_start()`` takes the last search's gaps (at the
-    start) as an interference fit's initial overlaps (hidden by ``pair.hidden()``).
+    total normal force), ``slave_force()`` (the force vector on the slave body;
+    ``force_parts()`` its normal and tangential parts), ``search_gaps()`` (the gaps the last
+    search measured) and ``nodal_normals()`` (a unit normal per node of ``nodal()``);
+    ``record_start()`` takes the last search's gaps (at the start) as an interference fit's
+    initial overlaps (hidden by ``pair.hidden()``).
     ``converged()`` is called when a load step converged (a coupling that keeps a history,
     penalty friction's, moves it on)."""
 
@@ -82,6 +83,8 @@ class PairCoupling(Coupling, Protocol):
     def force(self) -> float: ...
 
     def slave_force(self) -> np.ndarray: ...
+
+    def force_parts(self) -> tuple[np.ndarray, np.ndarray]: ...
 
     def search_gaps(self, facets: bool = False) -> np.ndarray:
         """The gaps of the last search; ``facets``: between the facets, without a smoothing

@@ -741,6 +741,21 @@ class MortarCoupling:
         local = -np.sum(self.D[:, None] * traction, axis=0)
         return self.comm.allreduce(np.asarray(local, dtype=float).reshape(-1), op=MPI.SUM)
 
+    def force_parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """The normal and tangential parts of :meth:`slave_force` (whose sum they are to
+        round-off): -sum_j D_j lambda_j n_j and -sum_j D_j sum_c lambda_T,jc t_jc (zero
+        without friction). Collective."""
+        from mpi4py import MPI
+
+        normal = -np.sum(self.D[:, None] * self.lam[:, None] * self.normal, axis=0)
+        tangential = np.zeros_like(normal)
+        if self.mu is not None:
+            traction = np.einsum("jc,jci->ji", self.lam_t, self.tangents)
+            tangential = -np.sum(self.D[:, None] * traction, axis=0)
+        local = np.stack([normal, tangential]).astype(float)
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return total[0], total[1]
+
     def friction_state(self) -> dict[str, float]:
         """Sums over this rank's contact nodes: the contact measure (the nodes where the
         friction bound is positive) and the stick measure on the reference surface (weights

@@ -120,6 +120,21 @@ class PointReadout:
             total += (1.0 if k == 0 else -1.0) * np.sum(p["w"][:, None] * traction, axis=0)
         return self.comm.allreduce(total, op=MPI.SUM)
 
+    def force_parts(self) -> tuple[np.ndarray, np.ndarray]:
+        """The normal and tangential parts of :meth:`slave_force` (whose sum they are to
+        round-off): the quadrature sums of -P n and of t_T (zero without friction).
+        Collective."""
+        from mpi4py import MPI
+
+        total = np.zeros((2, self.layout.gdim))
+        for k, (p, s) in enumerate(zip(self.points, self.state, strict=True)):
+            sign = 1.0 if k == 0 else -1.0
+            total[0] += sign * np.sum(p["w"][:, None] * (-s[0][:, None] * p["n"]), axis=0)
+            if s[2] is not None:
+                total[1] += sign * np.sum(p["w"][:, None] * s[2], axis=0)
+        total = self.comm.allreduce(total, op=MPI.SUM)
+        return total[0], total[1]
+
     def friction_state(self) -> dict[str, float]:
         """Sums over this rank's points of the first direction (weights without the unbiased
         halving): the contact measure (P > 0), the stick measure, the friction bound mu P and

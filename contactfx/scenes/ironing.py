@@ -60,7 +60,9 @@ positive with friction). Scores over the plateau (the steps whose slide is withi
 [plateau_from, plateau_to] of ``slide``: the die far from both ends of the block, where the
 published curves are flat): ``P_plateau`` and ``Q_plateau`` (means), their relative errors
 against the published plateaus (``P_plateau_error``; ``Q_plateau_error`` with Coulomb mu = 0.3
-only), ``Q_over_P`` = Q_plateau / P_plateau (and ``Q_over_P_over_mu`` with friction),
+only), ``Q_over_P`` = Q_plateau / P_plateau (and ``Q_over_P_over_mu`` with friction) and
+its two parts, ``Q_pressure_over_P`` (the contact pressure's x component: the ploughing, the
+pressure leaning on the die's front) and ``Q_friction_over_P`` (the friction traction's),
 ``P_jump`` and ``Q_jump``: the largest change of P or Q between consecutive plateau steps over
 P_plateau; ``P_pressed``: P at the end of the pressing (interpolated at the load factor
 press_fraction), and with the published press depth 0.8 its error against 2.71e8
@@ -205,6 +207,18 @@ class ShallowIroning(PressThenDrag):
     clamped = (DieOnBlockFacets.BLOCK_BOTTOM, "block_bottom")
     driven = (DieOnBlockFacets.DIE_TOP, "die_top")
 
+    def configure(self, numerics) -> None:
+        super().configure(numerics)
+        #: per converged load factor: the pair's force on the die split into the part of the
+        #: contact pressure (along the contact normals) and that of the friction traction
+        self.force_split: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+    def on_step(self, problem, solver, load, quantities) -> None:
+        """Record the force on the die's parts (:attr:`force_split`). Collective."""
+        sign = 1.0 if self.slave_is_upper else -1.0
+        normal, tangential = problem.coupling().force_parts()
+        self.force_split[float(load)] = (sign * normal, sign * tangential)
+
     def published_Q(self) -> float | None:
         """The published horizontal plateau: with Coulomb mu = 0.3 only."""
         coulomb = self.friction == "coulomb" and abs(self.mu - PUBLISHED_MU) < 1e-12
@@ -257,6 +271,12 @@ class ShallowIroning(PressThenDrag):
             Q_jump=per(float(np.max(np.abs(np.diff(Q[on]))))),
             plateau_steps=float(len(on)),
         )
+        split = [self.force_split.get(float(t)) for t in loads[on]]
+        if split and all(part is not None for part in split):
+            # Q = Q_pressure + Q_friction: the pressure's part is the ploughing (the pressure
+            # leaning on the die's front), the friction's is mu P on a flat contact
+            scores["Q_pressure_over_P"] = per(float(np.mean([-n[0] for n, _ in split])))
+            scores["Q_friction_over_P"] = per(float(np.mean([-t[0] for _, t in split])))
         published = self.published_Q()
         if published is not None:
             scores["Q_plateau_error"] = (Qm - published) / published

@@ -368,3 +368,26 @@ def test_shallow_ironing_pressing_against_published():
         errors[section] = res.scores["P_pressed_error"]
     assert abs(errors["plane-stress"]) < 0.03
     assert 0.08 < errors["plane-strain"] < 0.20
+
+
+def test_shallow_ironing_drag_splits_into_ploughing_and_friction():
+    """shallow-ironing with Coulomb mu = 0.3, dragged 1.5 (20 steps, about 4 s): the die's
+    horizontal force Q is the x part of the contact pressure (the ploughing: the pressure
+    leaning on the die's front) plus that of the friction traction (docs/verification.md,
+    "Shallow ironing"). The two parts add up to Q (the same quadrature sums as the pair's
+    force, in another order: round-off). At gross slip the friction traction is mu P along the
+    contact surface, so its x part over P is mu up to the surface's slope (the friction's
+    vertical part, mu P n_x, over P): measured 0.3026, within 2 % of mu = 0.3; the excess of
+    Q / P over mu (0.331) is the ploughing (0.0285 on this short drag, 0.0123 on the full
+    run's plateau, 0.0076 with the track's elements halved)."""
+    from contactfx.scenes.ironing import ShallowIroning
+
+    params = ShallowIroning.Params(slide=1.5, press_fraction=0.5)
+    num = ShallowIroning.default_numerics(steps=20, friction="coulomb", mu=0.3)
+    s = ShallowIroning(params).run(num, verbose=False).scores
+    assert s["Q_pressure_over_P"] + s["Q_friction_over_P"] == pytest.approx(
+        s["Q_over_P"], rel=1e-12
+    )
+    assert s["Q_friction_over_P"] == pytest.approx(0.3, rel=0.02)
+    # the ploughing pushes Q / P above mu on a die that dents the block
+    assert s["Q_pressure_over_P"] > 0.0
