@@ -436,9 +436,10 @@ class PointCoupling(PointReadout):
         if self.scatter is not None:
             for obj in (self.scatter, self._local):
                 obj.destroy()
+        else:  # the scatter's source layout: the same at every search
+            self._xvec = self.layout.X.duplicate()
         self._local = PETSc.Vec().createSeq(len(needed))
         idx = PETSc.IS().createGeneral(needed.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
-        self._xvec = self.layout.X.duplicate()
         self.scatter = PETSc.Scatter().create(self._xvec, idx, self._local, None)
         idx.destroy()
 
