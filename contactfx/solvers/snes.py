@@ -137,6 +137,11 @@ def rigid_body_modes(V: dolfinx.fem.FunctionSpace) -> PETSc.NullSpace:
     return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)
 
 
+def _nonzeros(A: PETSc.Mat) -> float:
+    """The nonzeros of A's pattern over all ranks (explicit zeros included). Collective."""
+    return float(A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_used"])
+
+
 class _KeptPreconditioner:
     """A preconditioner kept across Newton iterations: its own matrix P, refreshed from the
     Jacobian J only at the first iteration of a solve, after a failed Krylov solve and after
@@ -346,6 +351,11 @@ class ContactSNES:
     #: converging continuation takes a few; a cycling one is solved again from the step's
     #: start)
     CONTINUE_MAX_IT = 15
+    #: a two-body coupling's Jacobian keeps the entries of every search (couplings the
+    #: contact has left stay as explicit zeros, which the factorisation fills from); at the
+    #: start of a solve whose Jacobian holds more than this factor times the bulk's nonzeros
+    #: it is rebuilt on the bulk's pattern (:meth:`_compact`)
+    COMPACT_GROWTH = 1.5
 
     def __init__(
         self,
@@ -382,6 +392,7 @@ class ContactSNES:
         self.J = K.duplicate(copy=True)
         if coupling is not None:  # couplings between the bodies' dofs appear with the search
             self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        self._bulk_nonzeros = _nonzeros(K)
         self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
         self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
         self.timer.assembly += time.perf_counter() - t0
@@ -425,6 +436,8 @@ class ContactSNES:
         self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
         self.halving: _StepHalving | None = None
+        #: how often the Jacobian was rebuilt on the bulk's pattern (_compact)
+        self.compactions = 0
         self._full: PETSc.Vec | None = None
 
     # -- options -------------------------------------------------------------------------
@@ -701,6 +714,7 @@ class ContactSNES:
         x = _compat.petsc_vec(self.u)
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
+        self._compact()
         self._late = False
         self._remember()
         stats = SolveStats(newton=0, ksp=0, reason="")
@@ -715,6 +729,27 @@ class ContactSNES:
         if why is not None:
             raise ConvergenceError(why, stats=stats)
         return stats
+
+    def _compact(self) -> None:
+        """Rebuild the Jacobian on the bulk's pattern when a two-body coupling's searches have
+        grown it past COMPACT_GROWTH times the bulk's nonzeros (a body sliding over many
+        elements pairs every node along its track; the pattern keeps them all). The next
+        Jacobian adds the current couplings again. Decided from the pattern alone, so a
+        restart (which restores the pattern) decides the same. Collective."""
+        if self.coupling is None or _nonzeros(self.J) <= self.COMPACT_GROWTH * self._bulk_nonzeros:
+            return
+        K = self.bulk.jacobian(_compat.petsc_vec(self.u))
+        J = K.duplicate(copy=True)
+        J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        if self.nullspace is not None:
+            J.setNearNullSpace(self.nullspace)
+        self.J.destroy()
+        self.J = J
+        self.compactions += 1
+        if self.kept is not None:
+            self._keep_preconditioner(self.kept.rebuild_it)
+        else:
+            self.snes.setJacobian(self._jacobian, self.J, self.J)
 
     def _search_rounds(self, x: PETSc.Vec, stats: SolveStats) -> SolveStats:
         """Newton with a search at the step's start and again at each solution (solve())."""
