@@ -69,10 +69,11 @@ class _General:
     )
     line_search: str = param(
         "basic",
-        "Newton's line search: basic (full steps), bt (backtracking on the residual norm) or "
+        "Newton's line search: basic (full steps), bt (backtracking on the residual norm), "
         "cp (the step length where the residual is orthogonal to the step: a minimum of the "
-        "energy along it; the penalty and hyperelastic problems are energy minimisations)",
-        choices=("basic", "bt", "cp"),
+        "energy along it; the penalty and hyperelastic problems are energy minimisations) or "
+        "auto (cp with penalty and compliance, basic with the multiplier methods)",
+        choices=("basic", "bt", "cp", "auto"),
     )
     inversion_check: str = param(
         "halve",

@@ -38,6 +38,7 @@ class NormalCompliance(MethodBase):
     nodal_size: ClassVar[bool] = True
     tip_continued: ClassVar[bool] = True  # as the penalty's
     name = "compliance"
+    line_search = "cp"  # the penalised energy's minimum along a step
     sweep = ("exponent", (1.0, 1.5, 2.0))
     supports = Supports(
         mixed_up=True,

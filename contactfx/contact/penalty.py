@@ -49,6 +49,7 @@ class Penalty(TrialFriction, MethodBase):
         10.0, "penalty parameter, kappa = penalty E / h", positive=True, option="penalty"
     )
     name = "penalty"
+    line_search = "cp"  # the penalised energy's minimum along a step
     sweep = ("penalty", (10.0, 100.0, 1000.0))
     supports = Supports(
         axisymmetric=True,

@@ -38,7 +38,7 @@ from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
 if TYPE_CHECKING:
     from contactfx.driver.problem import Forms, Method, Numerics, Problem, Scene, Solver
 
-__all__ = ["STAGES", "run", "setup", "prepare_output", "write_failed"]
+__all__ = ["STAGES", "run", "setup", "prepare_output", "write_failed", "line_search_type"]
 
 
 def run(
@@ -398,7 +398,7 @@ class _Run:
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem: Problem, forms: Forms) -> ContactSNES:
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
-        options["snes_linesearch_type"] = self.num.line_search
+        options["snes_linesearch_type"] = line_search_type(self.num.line_search, self.method)
         options.update(self.method.snes_options())
         t0 = time.perf_counter()
         bulk = forms.bulk()
@@ -600,3 +600,12 @@ def _progress(step: StepLog, outer: bool) -> str:
         )
     tangential = "" if q.friction is None else f"  Q {q.friction.tangential_force[0]:.6g}"
     return f"{head}  ksp {step.ksp:4d}  force {q.force:.6g}  a {q.contact_size:.6g}{tangential}"
+
+
+def line_search_type(asked: str, method: object) -> str:
+    """PETSc's line search type for ``--line-search`` ``asked``: ``auto`` is the method's
+    (:attr:`contactfx.contact.method.MethodBase.line_search`: cp for the penalised methods,
+    basic for the multiplier methods), any other value itself."""
+    if asked != "auto":
+        return asked
+    return str(getattr(method, "line_search", "basic"))

@@ -191,7 +191,7 @@ class ShallowIroning(PressThenDrag):
         "material": "neo-hookean",
         "steps": 120,
         "predictor": "previous",
-        "line_search": "cp",
+        "line_search": "auto",
     }
 
     def materials(self) -> dict[str, Elastic]:
