@@ -72,8 +72,7 @@ class _General:
         "Newton's line search: basic (full steps), bt (backtracking on the residual norm), "
         "cp (the step length where the residual is orthogonal to the step: a minimum of the "
         "energy along it; the penalty and hyperelastic problems are energy minimisations) or "
-        "auto (cp with penalty and compliance or with friction, else basic: the multiplier "
-        "methods' residual is a saddle point's)",
+        "auto (cp with penalty and compliance, basic with the multiplier methods)",
         choices=("basic", "bt", "cp", "auto"),
     )
     inversion_check: str = param(

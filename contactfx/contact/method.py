@@ -142,9 +142,8 @@ class MethodBase:
     #: tip's element from its neighbouring node; the driver then builds ``tip_step``)
     tip_continued: ClassVar[bool] = False
     supports: ClassVar[Supports] = Supports()
-    #: Newton's line search under ``--line-search auto`` without friction (with friction it
-    #: is cp: :func:`contactfx.driver.pipeline.line_search_type`): cp where the residual is
-    #: the gradient of an energy (the penalised problems: cp shortens a step to the energy's
+    #: Newton's line search under ``--line-search auto``: cp where the residual is the
+    #: gradient of an energy (the penalised problems: cp shortens a step to the energy's
     #: minimum along it), basic for a multiplier's saddle point (cp's criterion does not hold
     #: there: on shallow-ironing with mortar it took 82 load steps with 39 cut-backs where
     #: full steps took 44 with 4; docs/verification.md section 15)

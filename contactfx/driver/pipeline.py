@@ -398,9 +398,7 @@ class _Run:
     # -- solver --------------------------------------------------------------------------
     def build_solver(self, problem: Problem, forms: Forms) -> ContactSNES:
         options = dict(GAMG_OPTIONS) if self.num.solver == "gamg" else {}
-        options["snes_linesearch_type"] = line_search_type(
-            self.num.line_search, self.method, self.num.friction
-        )
+        options["snes_linesearch_type"] = line_search_type(self.num.line_search, self.method)
         options.update(self.method.snes_options())
         t0 = time.perf_counter()
         bulk = forms.bulk()
@@ -604,15 +602,10 @@ def _progress(step: StepLog, outer: bool) -> str:
     return f"{head}  ksp {step.ksp:4d}  force {q.force:.6g}  a {q.contact_size:.6g}{tangential}"
 
 
-def line_search_type(asked: str, method: object, friction: str = "none") -> str:
+def line_search_type(asked: str, method: object) -> str:
     """PETSc's line search type for ``--line-search`` ``asked``: ``auto`` is the method's
-    frictionless (:attr:`contactfx.contact.method.MethodBase.line_search`: cp for the
-    penalised methods, basic for the multiplier methods) and cp with friction for every
-    method (Coulomb's semi-smooth Newton can cycle between two stick-slip sets under full
-    steps: mortar on shallow-ironing cycled for 50 iterations at load 0.0668 with every
-    cut-back, which cp's damping breaks); any other value is itself."""
+    (:attr:`contactfx.contact.method.MethodBase.line_search`: cp for the penalised methods,
+    basic for the multiplier methods), any other value itself."""
     if asked != "auto":
         return asked
-    if friction != "none":
-        return "cp"
     return str(getattr(method, "line_search", "basic"))

@@ -489,11 +489,9 @@ def test_bulk_reassembled_when_its_constants_change(bulk):
 
 
 def test_auto_line_search_follows_the_method():
-    """``--line-search auto``: frictionless, cp for the penalised methods (their residual is
-    an energy's gradient), basic for the multiplier methods (a saddle point: on
-    shallow-ironing with mortar cp took 82 load steps with 39 cut-backs, full steps 44 with
-    4); with friction cp for all (mortar with Coulomb friction and full steps cycled at a
-    step no cut-back could pass); another value is kept."""
+    """``--line-search auto``: cp for the penalised methods (their residual is an energy's
+    gradient), basic for the multiplier methods (a saddle point: on shallow-ironing with mortar
+    cp took 82 load steps with 39 cut-backs, full steps 44 with 4); another value is kept."""
     from contactfx.contact.registry import method_class
     from contactfx.driver.pipeline import line_search_type
 
@@ -501,4 +499,3 @@ def test_auto_line_search_follows_the_method():
     for name, kind in expected.items():
         assert line_search_type("auto", method_class(name)) == kind
         assert line_search_type("bt", method_class(name)) == "bt"
-        assert line_search_type("auto", method_class(name), "coulomb") == "cp"
