@@ -4,8 +4,8 @@
 A parallel PETSc object dropped without ``destroy()`` is not freed by petsc4py until a
 collective ``PETSc.garbage_cleanup``; the point coupling once left a full-size vector per
 search, which grew a 40-step slide at 15344 dofs by 52 MiB (docs/verification.md, section 15).
-With that leak the 20-step run left 49 vectors more than the 5-step one (measured before the
-fix: 23 and 72 live vectors)."""
+With that leak the 20-step run left 26 vectors more than the 5-step one (this test on the
+old code: 23 and 49)."""
 
 import gc
 import os
