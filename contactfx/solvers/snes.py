@@ -35,6 +35,7 @@ from contactfx.solvers.base import ConvergenceError, SolveStats, TimeLimitExceed
 from contactfx.solvers.bulk import Bulk
 from contactfx.solvers.mumps import MumpsWorkspace
 from contactfx.solvers.options import OptionsDB
+from contactfx.solvers.pattern import nonzeros, rebuilt
 from contactfx.solvers.reduced import ReducedSystem
 
 __all__ = [
@@ -135,11 +136,6 @@ def rigid_body_modes(V: dolfinx.fem.FunctionSpace) -> PETSc.NullSpace:
             vec.axpy(-vec.dot(prev), prev)
         vec.normalize()
     return PETSc.NullSpace().create(vectors=vecs, comm=mesh.comm)
-
-
-def _nonzeros(A: PETSc.Mat) -> float:
-    """The nonzeros of A's pattern over all ranks (explicit zeros included). Collective."""
-    return float(A.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_used"])
 
 
 class _KeptPreconditioner:
@@ -351,10 +347,7 @@ class ContactSNES:
     #: converging continuation takes a few; a cycling one is solved again from the step's
     #: start)
     CONTINUE_MAX_IT = 15
-    #: a two-body coupling's Jacobian keeps the entries of every search (couplings the
-    #: contact has left stay as explicit zeros, which the factorisation fills from); at the
-    #: start of a solve whose Jacobian holds more than this factor times the bulk's nonzeros
-    #: it is rebuilt on the bulk's pattern (:meth:`_compact`)
+    #: a two-body Jacobian past this factor of the bulk's nonzeros is rebuilt at a step's start
     COMPACT_GROWTH = 1.5
 
     def __init__(
@@ -392,7 +385,7 @@ class ContactSNES:
         self.J = K.duplicate(copy=True)
         if coupling is not None:  # couplings between the bodies' dofs appear with the search
             self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        self._bulk_nonzeros = _nonzeros(K)
+        self._bulk_nonzeros = nonzeros(K)
         self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
         self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
         self.timer.assembly += time.perf_counter() - t0
@@ -731,18 +724,11 @@ class ContactSNES:
         return stats
 
     def _compact(self) -> None:
-        """Rebuild the Jacobian on the bulk's pattern when a two-body coupling's searches have
-        grown it past COMPACT_GROWTH times the bulk's nonzeros (a body sliding over many
-        elements pairs every node along its track; the pattern keeps them all). The next
-        Jacobian adds the current couplings again. Decided from the pattern alone, so a
-        restart (which restores the pattern) decides the same. Collective."""
-        if self.coupling is None or _nonzeros(self.J) <= self.COMPACT_GROWTH * self._bulk_nonzeros:
+        """The Jacobian rebuilt on the bulk's pattern once past COMPACT_GROWTH times its
+        nonzeros (:mod:`.pattern`; decided from the pattern, which a restart restores)."""
+        if self.coupling is None or nonzeros(self.J) <= self.COMPACT_GROWTH * self._bulk_nonzeros:
             return
-        K = self.bulk.jacobian(_compat.petsc_vec(self.u))
-        J = K.duplicate(copy=True)
-        J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
-        if self.nullspace is not None:
-            J.setNearNullSpace(self.nullspace)
+        J = rebuilt(self.bulk.jacobian(_compat.petsc_vec(self.u)), self.nullspace)
         self.J.destroy()
         self.J = J
         self.compactions += 1
