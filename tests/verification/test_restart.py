@@ -82,6 +82,22 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) / max(abs(a[k]), 1e-300) for k in a)
 
 
+def _worst_vectors(a: dict, b: dict) -> float:
+    """``_worst`` with each component of a vector (keys ``..._x``, ``_y``, ``_z``) relative to
+    the vector's largest component: a solve's round-off is relative to the solution, so a
+    component near zero (a sideways force 1e-5 of the push) carries the round-off of the
+    whole vector, not of itself."""
+    assert a.keys() == b.keys()
+
+    def scale(k: str) -> float:
+        stem, _, axis = k.rpartition("_")
+        if axis not in ("x", "y", "z"):
+            return abs(a[k])
+        return max(abs(a.get(f"{stem}_{c}", 0.0)) for c in "xyz")
+
+    return max(abs(a[k] - b[k]) / max(scale(k), 1e-300) for k in a)
+
+
 def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, make=None):
     """(folder, run.json of the full run and of the stopped and restarted one); ``make``:
     () -> (scene, numerics) instead of a built-in scene ``name``."""
@@ -180,7 +196,10 @@ def test_restart_problem_file_with_reactions(tmp_path, monkeypatch):
     assert _worst(_numbers(full["steps"]), _numbers(cut["steps"])) <= 1e-12
     rows = [s.reaction_rows for s in scenes]  # make(): the numerics, full, cut, restart
     assert len(rows[1]) == len(rows[3]) == 4
-    assert _worst(_numbers(rows[1]), _numbers(rows[3])) <= 1e-12
+    # 0 serially (measured); at 2 ranks the support's sideways force (4e-5 of the push) once
+    # differed by 2.3e-15 absolute, 5e-11 of itself and 5e-16 of the force: relative to the
+    # force vector, the bound is the same 1e-12
+    assert _worst_vectors(_numbers(rows[1]), _numbers(rows[3])) <= 1e-12
 
 
 def test_restart_refuses_other_numerics_mesh_and_no_checkpoint(tmp_path):
