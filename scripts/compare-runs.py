@@ -146,11 +146,22 @@ CASES: list[tuple[str, list[str]]] = [
     ("hertz-cylinders-penalty", ["run", "hertz-cylinders", "--method", "penalty"]),
     ("sliding-contact-mortar", ["run", "sliding-contact", "--method", "mortar"]),
     ("cattaneo-nitsche", ["run", "cattaneo-cylinders", "--method", "nitsche"]),
+    ("cattaneo-mortar", ["run", "cattaneo-cylinders", "--method", "mortar"]),
     # finite strain between two bodies (dragged bodies, friction)
     (
         "sliding-contact-fs-coulomb",
         ["run", "sliding-contact", "--material", "neo-hookean", "--method", "penalty"]
         + ["--friction", "coulomb", "--mu", "0.3", "--steps", "10"],
+    ),
+    (
+        "sliding-contact-fs-mortar-coulomb",
+        ["run", "sliding-contact", "--material", "neo-hookean", "--method", "mortar"]
+        + ["--friction", "coulomb", "--mu", "0.3", "--steps", "10"],
+    ),
+    (
+        "shallow-ironing-mortar-coulomb-short",
+        ["run", "shallow-ironing", "--slide", "1", "--steps", "10", "--method", "mortar"]
+        + ["--friction", "coulomb", "--mu", "0.3"],
     ),
     (
         "shallow-ironing-coulomb-short",

@@ -33,6 +33,7 @@ from contactfx import _compat
 from contactfx.contact.coupling import Coupling
 from contactfx.solvers.base import ConvergenceError, SolveStats, TimeLimitExceeded, Timer
 from contactfx.solvers.bulk import Bulk
+from contactfx.solvers.guards import ReversalGuard, RoundOffStop
 from contactfx.solvers.mumps import MumpsWorkspace
 from contactfx.solvers.options import OptionsDB
 from contactfx.solvers.pattern import nonzeros, rebuilt
@@ -169,80 +170,6 @@ class _KeptPreconditioner:
 
     def destroy(self) -> None:
         self.P.destroy()
-
-
-class _ReversalGuard:
-    """Newton's previous iterate for the friction law's reversal guard
-    (:func:`contactfx.contact.laws.reversal`): ``iterate`` (a Function of u's space that the
-    contact forms read) becomes u at every Jacobian; ``active`` False makes the residual the
-    law's own (the iterate follows u at every residual too); ``initial_norm`` the residual norm
-    at the start of the last SNES solve (its relative tolerance's reference)."""
-
-    def __init__(
-        self, iterate: dolfinx.fem.Function, u: dolfinx.fem.Function, snes: PETSc.SNES
-    ) -> None:
-        self.iterate, self.u = iterate, u
-        self.active = True
-        self.initial_norm = 0.0
-        snes.setMonitor(self._monitor)
-
-    def remember(self) -> None:
-        self.iterate.x.array[:] = self.u.x.array
-
-    def _monitor(self, snes: PETSc.SNES, its: int, norm: float) -> None:
-        if its == 0:
-            self.initial_norm = norm
-
-
-class _RoundOffStop:
-    """Newton's convergence test for finite-strain bodies: PETSc's default one (the residual
-    below ``atol`` or below ``rtol`` times the first, ``stol`` on the update, the divergence
-    tolerance), and a stop at the residual's round-off level: an iterate whose residual
-    is no longer falling (above 0.1 of the last) once the last is 1e-8 of the first is
-    converged. Newton falls quadratically to that level; below it the residual is the
-    round-off of terms far larger than it (the gap of the contact in the deformed
-    configuration is the difference of current positions, x_s - y, of size |x| where the
-    penalty kappa multiplies it: a floor of kappa eps |x| w, 2e-11 on a block pressed to
-    1e-10 of a small load increment's residual), which the relative tolerance of a step
-    whose predictor was already close does not reach. The depth is measured against the
-    largest first residual of the run's solves too: a step that changes nothing (a hold in
-    the load program) starts at the round-off level, where the residual cannot fall."""
-
-    #: how far below the first residual the last must be before a stall counts as round-off
-    DEPTH = 1e-8
-
-    def __init__(self, snes: PETSc.SNES, divergence: float) -> None:
-        self.first = self.last = 0.0
-        self.peak = 0.0  # the largest first residual of the solves so far
-        self.divergence = divergence
-        self.stalled = 0  # solves stopped at the round-off level (a statistic)
-        snes.setConvergenceTest(self)
-
-    def __call__(self, snes: PETSc.SNES, it: int, norms: tuple[float, float, float]) -> int:
-        xnorm, ynorm, fnorm = norms
-        rtol, atol, stol, _ = snes.getTolerances()
-        R = PETSc.SNES.ConvergedReason
-        last, self.last = self.last, fnorm
-        if it == 0:
-            self.first = fnorm
-            if np.isfinite(fnorm):
-                self.peak = max(self.peak, fnorm)
-        if not np.isfinite(fnorm):
-            return R.DIVERGED_FNORM_NAN
-        if fnorm < atol:
-            return R.CONVERGED_FNORM_ABS
-        if it == 0:
-            return R.CONVERGED_ITERATING
-        if fnorm <= rtol * self.first:
-            return R.CONVERGED_FNORM_RELATIVE
-        if ynorm < stol * xnorm:
-            return R.CONVERGED_SNORM_RELATIVE
-        if self.divergence > 0 and fnorm > self.divergence * self.first:
-            return R.DIVERGED_DTOL
-        if it >= 2 and last <= self.DEPTH * max(self.first, self.peak) and fnorm > 0.1 * last:
-            self.stalled += 1
-            return R.CONVERGED_FNORM_RELATIVE
-        return R.CONVERGED_ITERATING
 
 
 class _StepHalving:
@@ -408,7 +335,8 @@ class ContactSNES:
         self.snes = PETSc.SNES().create(self.comm)
         self.snes.setOptionsPrefix(prefix)
         defaults = {**DEFAULT_OPTIONS, **(options or {})}
-        if iterate is not None:
+        guarded = iterate is not None or getattr(coupling, "guarded", False)
+        if guarded:
             # the reversal guard's stick branch is unbounded (t_T = trial): at an iterate just
             # after a reversal the residual may grow by orders of magnitude, and the next step,
             # linear there, removes it. It is no merit function, so no divergence test on it
@@ -420,12 +348,12 @@ class ContactSNES:
         self.snes.setJacobian(self._jacobian, self.J, self.J)
         self.snes.setFromOptions()
         self.snes.getKSP().setFromOptions()
-        self.guard = None if iterate is None else _ReversalGuard(iterate, u, self.snes)
+        self.guard = ReversalGuard(iterate, u, self.snes, coupling) if guarded else None
         #: finite strain: PETSc's convergence test and a stop at the round-off level
         self.roundoff = None
         if roundoff_stop:
             divergence = PETSc.Options().getReal(f"{prefix}snes_divergence_tolerance", 1e4)
-            self.roundoff = _RoundOffStop(self.snes, divergence)
+            self.roundoff = RoundOffStop(self.snes, divergence)
         self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
         self.halving: _StepHalving | None = None
@@ -710,6 +638,8 @@ class ContactSNES:
         self._compact()
         self._late = False
         self._remember()
+        if self.guard is not None:
+            self.guard.start()
         stats = SolveStats(newton=0, ksp=0, reason="")
         if self.coupling is None or self.coupling.search_each_newton:
             if self.coupling is not None:
