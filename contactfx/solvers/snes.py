@@ -570,6 +570,14 @@ class ContactSNES:
             J.zeroRowsColumns(red.bc_rows, diag=1.0)
         if self.kept is not None:
             self.kept.update(snes, J)
+        elif self.coupling is not None and snes.getKSP().getPC().getType() == "gamg":
+            # a pattern grown by the search: GAMG (PETSc 3.18) would set the new matrix into
+            # the coarse levels of the last one ("Cannot change local size of Amat after
+            # use"); a reset makes the set-up a new one, as it is anyway without a kept P
+            pc = snes.getKSP().getPC()
+            pc.setType("none")
+            pc.setType("gamg")
+            pc.setFromOptions()
         self._remember()
         self.timer.assembly += time.perf_counter() - t0
 
