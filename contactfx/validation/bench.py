@@ -189,14 +189,15 @@ CASES: dict[str, BenchCase] = {
     ),
     # 3D, two finite-strain bodies, Coulomb friction: no closed form; the columns to read are
     # the load steps, Newton iterations, times, memory and the equilibrium of the reactions
-    # with the contact force. Level 1 is the scene's default mesh (penalty only)
+    # with the contact force. Level 1 is the scene's default mesh (penalty only); level 3
+    # (about 100k dofs) is for --solver gamg on 2 ranks (--levels 4)
     "sphere-slide": BenchCase(
         "sphere-slide",
         {},
         2.0,
         "neo-Hookean sphere pressed 0.3 R into a block and slid 1 R, Coulomb mu 0.3 (3D)",
         p2_levels=0,
-        levels=3,
+        levels=4,
     ),
 }
 
@@ -348,9 +349,11 @@ def observed_rates(rows: list[dict], column: str) -> tuple[float, float]:
 
 
 def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[float, int]:
-    """Wall time of assembling and solving the scene's linear-elastic problem (the contact
-    boundary loaded by a uniform pressure) by the contact solver's wrapper with the same linear
-    solver (MUMPS LU or GMRES + GAMG) and no contact terms; and its dofs."""
+    """Wall time of assembling and solving the scene's linear-elastic problem by the contact
+    solver's wrapper with the same linear solver (MUMPS LU or GMRES + GAMG) and no contact
+    terms; and its dofs. An obstacle scene's contact boundary is loaded by a uniform pressure;
+    two bodies (each held by its own supports) by a uniform body force, each body with its
+    small-strain constants."""
     import dolfinx
 
     from contactfx import _compat
@@ -362,8 +365,14 @@ def linear_elastic_time(scene, degree: int, comm, solver: str = "lu") -> tuple[f
     V = _compat.function_space(mesh, "Lagrange", degree, (gdim,))
     du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=facet_tags)
-    a = dolfinx.fem.form(ufl.inner(scene.material().sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx)
-    L = dolfinx.fem.form(-1.0 * v[gdim - 1] * ds(scene.contact_tag))
+    if hasattr(scene, "contact_tag"):
+        material = scene.material()
+        L = dolfinx.fem.form(-1.0 * v[gdim - 1] * ds(scene.contact_tag))
+    else:  # two bodies: their supports' constants (the driven ones at load 0), E per body
+        scene.make_constants(mesh)
+        material = scene.body_material(mesh)
+        L = dolfinx.fem.form(-1.0 * v[gdim - 1] * ufl.dx)
+    a = dolfinx.fem.form(ufl.inner(material.sigma(du), ufl.sym(ufl.grad(v))) * ufl.dx)
     bcs = scene.dirichlet(V, facet_tags)
     comm.barrier()
     t0 = time.perf_counter()
@@ -435,14 +444,18 @@ def run_bench(
                         )[0]
                         if again["status"] == "ok" and again["t_run"] < row["t_run"]:
                             row = again
-                    # the yardstick loads the obstacle's contact boundary: obstacle scenes only
-                    if row["status"] == "ok" and linear and hasattr(scene, "contact_tag"):
+                    # the yardstick: obstacle scenes and two bodies (not the interfaces)
+                    yardstick = hasattr(scene, "contact_tag") or hasattr(scene, "body_material")
+                    if row["status"] == "ok" and linear and yardstick:
                         lin = min(
                             linear_elastic_time(scene, degree, comm, solver)[0]
                             for _ in range(repeat)
                         )
                         row["t_linear"] = lin
                         row["contact_over_linear"] = row["t_run"] / lin
+                        # one Newton iteration (its assembly, contact terms and solve)
+                        newton = max(int(row["newton"]), 1)
+                        row["newton_over_linear"] = row["t_run"] / newton / lin
                     if row["status"] == "ok" and speedup and comm.size > 1:
                         _add_speedup(row, scene, num, comm, ceiling)
                     rows.append(row)

@@ -113,6 +113,7 @@ VALUE_COLUMNS = (
     ("t_contact", "t contact"),
     ("contact_over_bulk", "contact over bulk"),
     ("contact_over_linear", "contact over linear"),
+    ("newton_over_linear", "Newton over linear"),
     ("speedup", "speedup"),
 )
 
