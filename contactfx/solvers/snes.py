@@ -154,7 +154,8 @@ class _KeptPreconditioner:
         if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
             self.P.setNearNullSpace(nullspace)
 
-    def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
+    def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> bool:
+        """Refresh P from J when due; whether it was."""
         ksp = snes.getKSP()
         fresh = (
             snes.getIterationNumber() == 0
@@ -167,6 +168,7 @@ class _KeptPreconditioner:
                 self.P,
                 structure=S.DIFFERENT_NONZERO_PATTERN if self.coupled else S.SAME_NONZERO_PATTERN,
             )
+        return fresh
 
     def destroy(self) -> None:
         self.P.destroy()
@@ -420,6 +422,12 @@ class ContactSNES:
             return
         if not self.bulk.constant_jacobian:
             return
+        if self.coupling is not None:
+            # between two bodies the contact rows change the operator as the contact set
+            # grows: a hierarchy of a solve's first iterate preconditioned hertz-cylinders so
+            # badly that Newton crawled (40 iterations at 2 ranks, with GMRES at its tolerance
+            # in the preconditioned norm) or GMRES broke down; each Jacobian's own is used
+            return
         self._keep_preconditioner(self.AMG_REBUILD_IT)
 
     def _keep_preconditioner(self, rebuild_it: int) -> None:
@@ -568,12 +576,11 @@ class ContactSNES:
             J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
         else:
             J.zeroRowsColumns(red.bc_rows, diag=1.0)
-        if self.kept is not None:
-            self.kept.update(snes, J)
-        elif self.coupling is not None and snes.getKSP().getPC().getType() == "gamg":
+        fresh = self.kept.update(snes, J) if self.kept is not None else snes is not None
+        if fresh and self.coupling is not None and snes.getKSP().getPC().getType() == "gamg":
             # a pattern grown by the search: GAMG (PETSc 3.18) would set the new matrix into
             # the coarse levels of the last one ("Cannot change local size of Amat after
-            # use"); a reset makes the set-up a new one, as it is anyway without a kept P
+            # use"); a new preconditioner makes the set-up a new one, as a refresh is anyway
             pc = snes.getKSP().getPC()
             pc.setType("none")
             pc.setType("gamg")
