@@ -154,8 +154,7 @@ class _KeptPreconditioner:
         if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
             self.P.setNearNullSpace(nullspace)
 
-    def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> bool:
-        """Refresh P from J when due; whether it was."""
+    def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
         fresh = (
             snes.getIterationNumber() == 0
@@ -168,7 +167,6 @@ class _KeptPreconditioner:
                 self.P,
                 structure=S.DIFFERENT_NONZERO_PATTERN if self.coupled else S.SAME_NONZERO_PATTERN,
             )
-        return fresh
 
     def destroy(self) -> None:
         self.P.destroy()
@@ -311,9 +309,8 @@ class ContactSNES:
         t0 = time.perf_counter()
         self.bulk = bulk
         K = bulk.jacobian(_compat.petsc_vec(u))
-        self.J = K.duplicate(copy=True)
-        if coupling is not None:  # couplings between the bodies' dofs appear with the search
-            self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        # couplings between the bodies' dofs appear with the search
+        self.J = K.duplicate(copy=True) if coupling is None else rebuilt(K)
         self._bulk_nonzeros = nonzeros(K)
         self.Jc = None if contact_jacobian is None else _compat.create_matrix(contact_jacobian)
         self.fc = None if contact_residual is None else _compat.create_vector(contact_residual)
@@ -576,11 +573,16 @@ class ContactSNES:
             J.zeroRowsColumnsLocal(self._bc_rows, diag=1.0)
         else:
             J.zeroRowsColumns(red.bc_rows, diag=1.0)
-        fresh = self.kept.update(snes, J) if self.kept is not None else snes is not None
-        if fresh and self.coupling is not None and snes.getKSP().getPC().getType() == "gamg":
-            # a pattern grown by the search: GAMG (PETSc 3.18) would set the new matrix into
-            # the coarse levels of the last one ("Cannot change local size of Amat after
-            # use"); a new preconditioner makes the set-up a new one, as a refresh is anyway
+        if self.kept is not None:
+            self.kept.update(snes, J)
+        elif (
+            snes is not None
+            and self.coupling is not None
+            and snes.getKSP().getPC().getType() == "gamg"
+        ):
+            # two bodies keep no AMG preconditioner (reuse_preconditioner), and the search grows
+            # the pattern: GAMG (PETSc 3.18) would set the new matrix into the coarse levels of
+            # the last one ("Cannot change local size of Amat after use"); a new one is set up
             pc = snes.getKSP().getPC()
             pc.setType("none")
             pc.setType("gamg")
