@@ -188,10 +188,14 @@ def create_vector(form) -> PETSc.Vec:
     return dolfinx.fem.petsc.create_vector(form)
 
 
-def assemble_matrix(A: PETSc.Mat, form) -> PETSc.Mat:
-    """Zero ``A`` and assemble ``form`` into it (no boundary conditions), finalised."""
+def assemble_matrix(A: PETSc.Mat, form, bcs: list | None = None) -> PETSc.Mat:
+    """Zero ``A`` and assemble ``form`` into it, finalised; with ``bcs`` their rows and
+    columns zero and a unit diagonal."""
     A.zeroEntries()
-    dolfinx.fem.petsc.assemble_matrix(A, form)
+    if bcs:  # (both versions dispatch on the matrix: A, form, bcs positional)
+        dolfinx.fem.petsc.assemble_matrix(A, form, bcs)
+    else:
+        dolfinx.fem.petsc.assemble_matrix(A, form)
     A.assemble()
     return A
 

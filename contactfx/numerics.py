@@ -19,6 +19,7 @@ from contactfx.contact.laws import friction_law
 from contactfx.contact.registry import METHODS, method_class, methods_supporting
 from contactfx.mechanics.hyperelastic import material_from_spec, parse_spec
 from contactfx.params import option_name, param, validate
+from contactfx.solvers.dynamics import SCHEMES, Scheme
 
 __all__ = ["Numerics", "FRICTION_LAWS", "FORMULATIONS", "method_parameters", "shared_option"]
 
@@ -100,6 +101,25 @@ class _General:
         "with a finite-strain --material: the contact in the deformed configuration)",
         choices=("step", "newton"),
     )
+    dynamic: bool = param(
+        False,
+        "implicit dynamics: time steps of --dt up to --t-end with --scheme, the inertia from "
+        "the bodies' density (a static run has no mass matrix and no velocity)",
+    )
+    scheme: str = param(
+        "newmark",
+        "time scheme of --dynamic: newmark (average acceleration), hht (Hilber-Hughes-Taylor) "
+        "or generalized-alpha (Chung-Hulbert), the last two with --rho-inf",
+        choices=SCHEMES,
+    )
+    rho_inf: float = param(
+        1.0,
+        "spectral radius at infinite time step of hht ([0.5, 1]) and generalized-alpha "
+        "([0, 1]): 1 no numerical dissipation, smaller damps the highest frequencies",
+        nonnegative=True,
+    )
+    dt: float = param(0.0, "time step of --dynamic (0: the scene's)", nonnegative=True)
+    t_end: float = param(0.0, "end time of --dynamic (0: the scene's)", nonnegative=True)
 
 
 def method_parameters() -> dict[str, list[tuple[str, dataclasses.Field]]]:
@@ -212,6 +232,17 @@ class _Checks:
                     "formulation mixed-up needs a volumetric-isochoric split of the energy: "
                     "use --material neo-hookean or mooney-rivlin (svk has none)"
                 )
+
+        if self.dynamic:
+            Scheme.named(self.scheme, self.rho_inf)  # --rho-inf's range, one line
+            if not self.dt > 0.0:
+                raise ValueError(f"--dynamic needs a time step --dt > 0, got {self.dt}")
+            if not self.t_end >= self.dt * (1.0 - 1e-12):
+                raise ValueError(
+                    f"--t-end ({self.t_end}) must be at least one time step (--dt {self.dt})"
+                )
+            if self.nested:
+                raise ValueError("--nested is offered for static load steps, not with --dynamic")
 
     def method_object(self):
         """The configured contact method."""

@@ -81,6 +81,7 @@ __all__ = [
     "hertz_3d",
     "rigid_punch_2d",
     "bar_nitsche_exact",
+    "bar_impact_exact",
     "oedometric_modulus",
     "crack_perturbation_stress",
     "opening",
@@ -266,3 +267,33 @@ def propping_pressure(h, a, b, E, nu):
     proppant thickness h at the proppant edges x = +-b (b < a): above it the proppant carries
     nothing."""
     return h * E / (1.0 - nu**2) / (4.0 * (a**2 - b**2) ** 0.5)
+
+
+def bar_impact_exact(x, t):
+    """The elastic bar against a rigid wall (Dabaghi, Petrov, Pousin and Renard,
+    arXiv:1601.00778, the benchmark of GetFEM's ``demo_dynamic_contact_1D.py``): rho = E = 1,
+    the bar (0, 1) fixed at x = 1, Signorini at x = 0, u(x, 0) = (1 - x) / 2, v(x, 0) = 0.
+    With s = t mod 1 and k = floor(t mod 3): k = 0 (flight) u = (1 - max(x, s)) / 2; k = 1
+    (contact) u = -min(s, 1 - s, x, 1 - x) / 2; k = 2 (rebound) u = min(s, 1 - x) / 2.
+    Returns (u, u_x, u_t) at the points x (arrays) and time t; the contact stress is
+    u_x(0, t) (-1/2 on t in [1, 2] + 3 n), the energy 1/2 int (u_t^2 + u_x^2) dx = 1/8."""
+    x = np.asarray(x, dtype=float)
+    tp = t % 3.0
+    k = int(np.floor(tp))
+    s = tp - k
+    if k == 0:
+        u = 0.5 * (1.0 - np.maximum(x, s))
+        ux = np.where(x > s, -0.5, 0.0)
+        ut = np.where(x > s, 0.0, -0.5)
+    elif k == 1:
+        parts = np.stack(np.broadcast_arrays(s, 1.0 - s, x, 1.0 - x))
+        which = np.argmin(parts, axis=0)
+        u = -0.5 * np.min(parts, axis=0)
+        ux = np.choose(which, [0.0, 0.0, -0.5, 0.5])
+        ut = np.choose(which, [-0.5, 0.5, 0.0, 0.0])
+    else:
+        first = s < 1.0 - x
+        u = 0.5 * np.where(first, s, 1.0 - x)
+        ux = np.where(first, 0.0, -0.5)
+        ut = np.where(first, 0.5, 0.0)
+    return u, ux, ut

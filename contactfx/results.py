@@ -165,10 +165,20 @@ class StepLog:
     coarse_newton: int  # nested iteration: Newton iterations on the coarser meshes
     halvings: int  # Newton steps halved so that no element inverts (finite strain)
     quantities: Quantities
+    #: a dynamic run's energy balance at the step (:class:`contactfx.driver.inertia.
+    #: EnergyLedger`), None in a static run
+    energy: dict[str, float] | None = None
 
     def to_json(self) -> dict[str, Any]:
-        head = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)[:-1]}
-        return {**head, **self.quantities.step_json()}
+        head = {f.name: getattr(self, f.name) for f in _STEP_COUNTS}
+        out = {**head, **self.quantities.step_json()}
+        if self.energy is not None:
+            out["energy"] = dict(self.energy)
+        return out
+
+
+#: StepLog's fields before its quantities (the step, its time and counts)
+_STEP_COUNTS = dataclasses.fields(StepLog)[:-2]
 
 
 @dataclass
@@ -205,6 +215,8 @@ class RunSummary:
     #: a run continued from a checkpoint: {"step": its step, "load": its load factor}; the
     #: steps before are the checkpoint's (their timings not in ``timings``)
     restarted: dict[str, Any] | None = None
+    #: a dynamic run's energy balance (:meth:`contactfx.driver.inertia.EnergyLedger.summary`)
+    energy: dict[str, Any] | None = None
 
     # -- named views of the final state ---------------------------------------------------
     @property
@@ -261,7 +273,7 @@ class RunSummary:
         steps keep their iterations, their quantities are the final state's)."""
         q = Quantities.from_json(d)
         steps = [
-            StepLog(*(s.get(f.name, 0) for f in dataclasses.fields(StepLog)[:-1]), q)
+            StepLog(*(s.get(f.name, 0) for f in _STEP_COUNTS), q, s.get("energy"))
             for s in d["steps"]
         ]
         names = [
@@ -306,6 +318,8 @@ class RunSummary:
             out["plot"] = self.plot
         if self.restarted is not None:
             out["restarted"] = dict(self.restarted)
+        if self.energy is not None:
+            out["energy"] = dict(self.energy)
         return out
 
 

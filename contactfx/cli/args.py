@@ -98,6 +98,15 @@ def add_options(parser, cls, defaults: dict) -> None:
         name = option_name(f)
         default = defaults.get(name, f.default)
         kind = type(f.default)
+        if kind is bool:  # --dynamic / --no-dynamic
+            parser.add_argument(
+                "--" + name.replace("_", "-"),
+                dest=name,
+                action=argparse.BooleanOptionalAction,
+                default=default,
+                help=f"{option_help(f)} (default: {default})",
+            )
+            continue
         parser.add_argument(
             "--" + name.replace("_", "-"),
             dest=name,

@@ -120,6 +120,15 @@ def table(res: RunSummary) -> str:
         rows += [(k.replace("_", " "), f"{v:.6g}") for k, v in {**ref, **res.errors}.items()]
     if res.plot:
         rows.append(("line plot", res.plot))
+    if res.energy:
+        e = res.energy
+        rows.append(
+            (
+                "energy initial / final / largest remainder",
+                f"{e['initial_total']:.6g} / {e['final_total']:.6g} / "
+                f"{e['largest_remainder']:.3g} ({e['largest_remainder_relative']:.2%})",
+            )
+        )
     rows += [("warning", w) for w in res.warnings]
     width = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{width}}  {v}" for k, v in rows)

@@ -176,6 +176,13 @@ class MethodBase:
     def snes_options(self) -> dict[str, object]:
         return {}
 
+    def contact_energy(self, s: Surface) -> Expr | None:
+        """The energy the contact terms store, a density on the contact surface (a dynamic
+        run's energy balance), or None: a method whose contact stores none it can name (the
+        multiplier methods: none at a converged solution), or one with friction (the
+        tangential terms' share is in the balance's remainder)."""
+        return None
+
     def trial_traction(self, s: Surface) -> tuple[Expr, Expr] | None:
         """With friction, the trial tangential traction and the friction bound that Newton's
         reversal guard compares between iterates (:func:`contactfx.contact.laws.reversal`);

@@ -78,6 +78,16 @@ class Nitsche(TrialFriction, MethodBase):
         n = s.normal()
         return positive_part(-s.traction_n(n) - self.gamma(s) * s.gap())
 
+    def contact_energy(self, s: Surface) -> Expr | None:
+        """theta / (2 gamma_N) (P_n(u)^2 - sigma_n(u)^2) (frictionless): with theta = 1 the
+        residual's contact terms are this energy's derivative, so that the semi-discrete
+        energy 1/2 |v|_M^2 + 1/2 a(u, u) + this term is conserved (Chouly, Hild and Renard
+        2015, doi:10.1051/m2an/2014041); 0 for theta = 0 (the mechanical energy alone)."""
+        if s.friction is not None:
+            return None
+        sn = s.traction_n(s.normal())
+        return self.theta / (2.0 * self.gamma(s)) * (self.pressure(s) ** 2 - sn**2)
+
     def _trial_t(self, s: Surface) -> Expr:
         """The trial tangential traction sigma_T(u) - gamma_N du_T."""
         n = s.normal()

@@ -77,6 +77,13 @@ class Penalty(TrialFriction, MethodBase):
         s = self.law_surface(s)
         return self.kappa(s) * positive_part(-s.gap())
 
+    def contact_energy(self, s: Surface) -> Expr | None:
+        """kappa / 2 [-g(u)]_+^2, the penalty's elastic energy (frictionless)."""
+        if s.friction is not None:
+            return None
+        s = self.law_surface(s)
+        return 0.5 * self.kappa(s) * positive_part(-s.gap()) ** 2
+
     def _trial_t(self, s: Surface) -> Expr:
         """The trial tangential traction t_prev - kappa du_T."""
         s = self.law_surface(s)

@@ -55,6 +55,7 @@ class ObstacleProblem(Problem):
     nested = True
     nonlinear_bulk = True
     axisymmetric = True
+    dynamic = True
 
     surface: ContactSurface
     obstacle: Any

@@ -22,7 +22,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from mpi4py import MPI
 
+from contactfx import _compat
 from contactfx.contact.registry import methods_supporting
+from contactfx.driver.inertia import EnergyLedger, initial_acceleration
 from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.driver.restart import Checkpoints, Restart, run_identity
 from contactfx.io.checkpoint import CHECKPOINT
@@ -31,9 +33,10 @@ from contactfx.io.provenance import versions, write_json, write_json_local
 from contactfx.io.vtk import ResultsWriter
 from contactfx.io.xdmf import XdmfWriter, h5py_mpi
 from contactfx.results import RunSummary, StepLog, never_closed
+from contactfx.solvers.dynamics import Dynamic, Scheme
 from contactfx.solvers.interrupt import Interrupted, StopRequest
 from contactfx.solvers.snes import GAMG_OPTIONS, ContactSNES, ConvergenceError
-from contactfx.solvers.stepper import QuasiStatic, StepRecord, march
+from contactfx.solvers.stepper import QuasiStatic, Stepper, StepRecord, march
 
 if TYPE_CHECKING:
     from contactfx.driver.problem import Forms, Method, Numerics, Problem, Scene, Solver
@@ -237,6 +240,11 @@ def _checked_method(scene: Scene, numerics: Numerics) -> Method:
                 f"--nested: scene '{scene.name}' cannot mesh itself coarser "
                 "(its mesh comes from a file)"
             )
+    if numerics.dynamic and not scene.problem.dynamic:
+        raise ValueError(
+            f"--dynamic: scene '{scene.name}': its problem kind is offered static only (time "
+            "integration is offered against rigid obstacles)"
+        )
     scene.configure(numerics)
     return method
 
@@ -417,7 +425,13 @@ class _Run:
             confined=problem.confined,
             iterate=problem.iterate,
             deadline=self.deadline,
-            roundoff_stop=problem.material.finite_strain or problem.roundoff_stop,
+            # (a dynamic step's residual holds c M w, 1 / (beta dt^2) times the state: its
+            # round-off floor lies far above 1e-10 of a well-predicted step's first residual)
+            roundoff_stop=(
+                problem.material.finite_strain
+                or problem.roundoff_stop
+                or problem.inertia is not None
+            ),
         )
         solver.timer.assembly += assembly
         if problem.material.finite_strain and self.num.inversion_check == "halve":
@@ -476,16 +490,19 @@ class _Run:
                 if checkpoints is not None and checkpoints.due(rec.step, stepper.done()):
                     with self.timed("checkpoint"):
                         checkpoints.write(rec.step, rec.time, roots(), steps, writer)
+                if self.energy is not None:
+                    steps[-1] = dataclasses.replace(steps[-1], energy=self.energy.record(rec.time))
                 elapsed = time.perf_counter() - t0
                 self.progress(
                     _progress(steps[-1], problem.method.multiplier.nodal)
-                    + _remaining(elapsed, rec.time - t_start, 1.0 - t_start)
+                    + _remaining(elapsed, rec.time - t_start, self.end_time - t_start)
                 )
 
             def roots() -> dict[str, Any]:
                 """The objects that hold the run's state (contactfx.io.checkpoint)."""
                 return {
                     "stepper": stepper,
+                    "energy": self.energy,
                     "problem": problem,
                     "post": post,
                     "solver": solver,
@@ -500,11 +517,7 @@ class _Run:
             t0 = time.perf_counter()
             t_start = 0.0 if restart is None else restart.load
             a0 = solver.timer.assembly
-            stepper = QuasiStatic(
-                self.num.steps,
-                max_increment=self.num.max_increment or None,
-                predictor=self.num.predictor,
-            )
+            stepper = self.stepper(problem, solver)
             with StopRequest(self.comm) as stop:
                 try:
                     march(
@@ -527,6 +540,40 @@ class _Run:
         self.timings["solve"] = total - (solver.timer.assembly - a0) - output
         self.timings.update(solver.phase_timings())  # within the solve (nested: the coarse chain)
         return steps
+
+    #: a dynamic run's energy balance (:class:`contactfx.driver.inertia.EnergyLedger`)
+    energy: EnergyLedger | None = None
+
+    @property
+    def end_time(self) -> float:
+        """The program's end: the last load factor 1, or a dynamic run's t_end."""
+        return self.num.t_end if self.num.dynamic else 1.0
+
+    def stepper(self, problem: Problem, solver: Solver) -> Stepper:
+        """The program over time: load factors (:class:`QuasiStatic`), or a dynamic run's
+        time steps (:class:`contactfx.solvers.dynamics.Dynamic`, its energy balance kept in
+        :attr:`energy`)."""
+        if not self.num.dynamic:
+            return QuasiStatic(
+                self.num.steps,
+                max_increment=self.num.max_increment or None,
+                predictor=self.num.predictor,
+            )
+        inertia = problem.inertia
+        assert inertia is not None  # built by the problem for a dynamic run
+        self.energy = EnergyLedger(problem, inertia, problem.load_form)
+        vec = _compat.petsc_vec
+        return Dynamic(
+            Scheme.named(self.num.scheme, self.num.rho_inf),
+            dt=self.num.dt,
+            t_end=self.num.t_end,
+            v=vec(inertia.v),
+            a=vec(inertia.a),
+            a_star=vec(inertia.a_star),
+            set_mass_factor=inertia.set_mass_factor,
+            reassemble=solver.reassemble_bulk,
+            initial_acceleration=initial_acceleration(problem, solver, inertia),
+        )
 
     def _output(self, suffix: str) -> str | None:
         return None if self.out is None else str(self.out / f"{self.scene.name}{suffix}")
@@ -564,8 +611,11 @@ class _Run:
                 if self.restart is None
                 else {"step": self.restart.step, "load": self.restart.load}
             ),
+            energy=None if self.energy is None else self.energy.summary(),
             **extra,
         )
+        if self.energy is not None and self.out is not None:
+            self.energy.write(self.out)
         if self.out is not None:
             write_json(self.out / "run.json", summary.to_json(), self.comm)
         return summary

@@ -36,6 +36,7 @@ from contactfx.driver.fields import (
     surface_mask,
     vertex_rule,
 )
+from contactfx.driver.inertia import Inertia
 from contactfx.driver.inversion import VolumeRatio
 from contactfx.mechanics.axisymmetric import hoop_strain, measure
 from contactfx.mechanics.elasticity import locking_hint
@@ -108,6 +109,8 @@ class Problem:
     #: whether the kind solves axisymmetric bodies (its integrals weighted by r, the hoop term;
     #: :mod:`contactfx.mechanics.axisymmetric`)
     axisymmetric = False
+    #: whether the kind integrates in time (``--dynamic``: :mod:`contactfx.driver.inertia`)
+    dynamic = False
     #: Newton stops at the residual's round-off level too (:class:`contactfx.solvers.snes.
     #: _RoundOffStop`): finite strain, and an interference fit (the interference's own contact
     #: forces set a floor that a well-predicted step's relative tolerance does not reach)
@@ -184,6 +187,8 @@ class Problem:
         self.h = _compat.cell_diameter(mesh)
         self.mult_shape = (self.gdim,) if self.friction is not None else ()
         self._spaces()
+        #: a dynamic run's inertia (:mod:`contactfx.driver.inertia`), None in a static run
+        self.inertia = Inertia(self) if numerics.dynamic else None
         self.confined: list = []  # those of bcs that confine a field to a surface (confine)
         self.bcs = self.boundary_conditions()
         self.prev = None  # the last converged state: the history of friction
@@ -379,6 +384,10 @@ class Problem:
                 * self.dx
             )
         L = self.extra_load(L)
+        #: the compiled external load f_ext (a dynamic run's energy balance reads it)
+        self.load_form = dolfinx.fem.form(L)
+        if self.inertia is not None and self.material.linear:  # + M a*
+            L = L + self.inertia.load_term(self.V_test)
         # two bodies: no UFL surface, the contact terms are the solver's coupling
         F = None if self.surface is None else self.contact_residual()
         bulk = self.bulk(dolfinx.fem.form(L))
@@ -393,10 +402,16 @@ class Problem:
         :meth:`bulk_form` (bilinear, assembled once), else a
         :class:`contactfx.solvers.bulk.NonlinearBulk` of :meth:`internal_form` and its
         ``ufl.derivative`` (plus :meth:`tangent_pattern`), assembled at every iteration."""
+        inertia = self.inertia
         if self.material.linear:
-            a = dolfinx.fem.form(self.bulk_form())
+            form = self.bulk_form()
+            if inertia is not None:  # K + c M
+                form = form + inertia.mass_term(self.dU, self.V_test)
+            a = dolfinx.fem.form(form)
             return functools.partial(LinearBulk, stiffness=a, load=load)
         f_int = self.internal_form()
+        if inertia is not None:  # + rho (c u - a*) . v
+            f_int = f_int + inertia.internal_term(self.U, self.V_test)
         tangent = ufl.derivative(f_int, self.state, self.trial)
         pattern = self.tangent_pattern()
         if pattern is not None:

@@ -205,6 +205,13 @@ class Elastic:
     def cauchy(self, u: Expr, p: Expr | None = None) -> Expr:
         return self.sigma(u, p)
 
+    def strain_energy(self, u: Expr) -> Expr:
+        """The stored energy density 1/2 sigma(u) : eps(u) (with the hoop term of an
+        axisymmetric body): half the weak form's internal work of u on itself."""
+        w = 0.5 * ufl.inner(self.sigma(u), ufl.sym(ufl.grad(u)))
+        hoop = self.hoop_work(u, None, u)
+        return w if hoop is None else w + 0.5 * hoop
+
     def stress(self, eps: Expr) -> Expr:
         """Stress of the strain eps (a UFL tensor)."""
         E, mu, lmbda = self._moduli()

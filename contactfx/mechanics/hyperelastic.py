@@ -178,6 +178,15 @@ class Hyperelastic:
             raise ValueError(f"material {self.name} has no mixed u-p formulation")
         return ufl.diff(self.W(F), F) - p * ufl.inv(F).T
 
+    def strain_energy(self, u: Expr) -> Expr:
+        """The stored energy density psi(F3) per unit reference volume (the volumetric term
+        included)."""
+        F = self.deformation_gradient(u)
+        psi = self.W(F)
+        if self.K is not None:
+            psi = psi + 0.5 * self.K * ufl.ln(ufl.det(F)) ** 2
+        return psi
+
     def piola(self, u: Expr, p: Expr | None = None) -> Expr:
         """The first Piola stress P3 (3 x 3) of u (and the pressure p, mixed)."""
         F = ufl.variable(self.deformation_gradient(u))

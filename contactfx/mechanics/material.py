@@ -11,7 +11,8 @@ A material answers in UFL, for the state u (and the pressure p of a mixed u-p fo
   (Nitsche's n . sigma(u) n, its tangential part);
 * ``hoop_work(u, p, v)``: an axisymmetric body's hoop term S_tt v_r / r of the weak form (None
   for other bodies; :mod:`contactfx.mechanics.axisymmetric`);
-* ``cauchy(u, p)`` and ``von_mises(u, p)`` for the output;
+* ``cauchy(u, p)`` and ``von_mises(u, p)`` for the output, ``strain_energy(u)`` (the stored
+  energy density per unit reference volume) for a dynamic run's energy balance;
 * ``E`` (the reference modulus of the closed forms; the scenes' contact modulus scales the
   methods' parameters, gamma_N = gamma0 E / h) and ``density`` (None in a static run);
 * ``linear``: whether S is linear in (u, p), so that the bulk is assembled once
@@ -58,3 +59,5 @@ class Material(Protocol):
     def cauchy(self, u: Any, p: Any = None) -> Any: ...
 
     def von_mises(self, u: Any, p: Any = None) -> Any: ...
+
+    def strain_energy(self, u: Any) -> Any: ...

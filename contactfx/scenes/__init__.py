@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from contactfx.numerics import Numerics
-from contactfx.scenes.bar import Bar1D
+from contactfx.scenes.bar import Bar1D, BarImpact
 from contactfx.scenes.base import Scene
 from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
@@ -30,6 +30,7 @@ SCENES: dict[str, type[Scene]] = {
         FlatPunch3D,
         SlidingBlock,
         Bar1D,
+        BarImpact,
         CrackSneddon,
         CrackInclined,
         ProppedFracture,

@@ -99,6 +99,10 @@ class Stepper(Protocol):
     def predict(self) -> None:
         """Set the unknown (and the stepper's other fields) to the next step's start."""
 
+    def load_time(self) -> float:
+        """The time the step's loads are set for (after :meth:`next_time`): the step's end,
+        or a generalised-alpha scheme's intermediate time."""
+
     def accept(self, stats: SolveStats) -> StepRecord:
         """The step converged: it becomes the history of the next."""
 
@@ -184,6 +188,9 @@ class QuasiStatic:
         self.t = min(1.0, self.t_prev + self.dt)
         return self.t
 
+    def load_time(self) -> float:
+        return self.t
+
     def predict(self) -> None:
         """x = previous + factor (previous - older): the secant extrapolation of the last two
         converged states (previous alone, factor 0, in the first step: before it, previous
@@ -264,7 +271,7 @@ def march(
         while not stepper.done():
             t = stepper.next_time()
             stepper.predict()
-            apply_load(t)
+            apply_load(stepper.load_time())
             solver.assemble_load()
             try:
                 stats = solver.solve()

@@ -179,6 +179,7 @@ NO_PROBLEM_FILE = {
     "penny-shear": "problem files carry 2D interfaces only",
     "fault-block": "problem files carry 2D interfaces only",
     "crack-set": "problem files carry fitted interfaces only",
+    "bar-impact": "problem files carry no time integration yet",
 }
 
 

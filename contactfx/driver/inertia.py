@@ -1,0 +1,232 @@
+"""A dynamic run's part of a problem kind: the inertia of the bodies and the energy balance.
+
+:class:`Inertia` holds the velocity v, the acceleration a and the inertia load a* (Functions of
+the unknown's space, the stepper's :class:`contactfx.solvers.dynamics.Dynamic` fields) and the
+mass factor c, and gives the bulk its inertia terms: with density rho,
+
+    linear bulk:    a(du, v) + c int rho du . v dx,    f_ext + int rho a* . v dx
+    nonlinear bulk: f_int(u; v) + int rho (c u - a*) . v dx
+
+(the effective stiffness K + c M of a linear bulk assembled once per step size). A static run
+has none of this (no mass matrix, no velocity field).
+
+:class:`EnergyLedger` keeps the balance at every step: the kinetic energy 1/2 v . M v, the
+strain energy (the material's density), the energy the contact terms store (the method's, e.g.
+Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_+^2), the work
+of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), and the
+remainder W_ext - (E - E_0): what the scheme dissipated (or gained: the error of a
+non-conserving discretisation). The supports are fixed in the scenes that use it (no work);
+a moving support's or obstacle's work is not counted (it would appear in the remainder).
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import Any
+
+import dolfinx
+import numpy as np
+import ufl
+from petsc4py import PETSc
+
+from contactfx import _compat
+from contactfx.driver.fields import global_sum
+
+__all__ = ["Inertia", "EnergyLedger"]
+
+
+class Inertia:
+    """See the module docstring. ``problem``: the kind (its state, measures, material)."""
+
+    def __init__(self, problem: Any) -> None:
+        if problem.split:
+            raise ValueError(
+                "--dynamic: a method with a multiplier field or the mixed u-p formulation is "
+                "not offered in time yet; use --method nitsche or penalty with --formulation "
+                "displacement"
+            )
+        rho = problem.material.density
+        if rho is None:
+            raise ValueError(
+                "--dynamic needs the bodies' density: the scene's or problem file's material "
+                "has none (density = ... in [[bodies]])"
+            )
+        self.rho = rho
+        W = problem.state.function_space
+        self.v = dolfinx.fem.Function(W, name="velocity")
+        self.a = dolfinx.fem.Function(W, name="acceleration")
+        self.a_star = dolfinx.fem.Function(W, name="inertia_load")
+        self.c = dolfinx.fem.Constant(problem.mesh, 0.0)
+        self.dx = problem.dx
+        self.mesh = problem.mesh
+
+    def mass_term(self, du: Any, v: Any) -> ufl.Form:
+        """c int rho du . v dx (bilinear: the linear bulk's K + c M)."""
+        return self.c * self.rho * ufl.inner(du, v) * self.dx
+
+    def load_term(self, v: Any) -> ufl.Form:
+        """int rho a* . v dx (the linear bulk's extra load)."""
+        return self.rho * ufl.inner(self.a_star, v) * self.dx
+
+    def internal_term(self, u: Any, v: Any) -> ufl.Form:
+        """int rho (c u - a*) . v dx (a nonlinear bulk's inertia in its residual)."""
+        return self.rho * ufl.inner(self.c * u - self.a_star, v) * self.dx
+
+    def set_mass_factor(self, c: float) -> None:
+        self.c.value = c
+
+    def mass_matrix(self, trial: Any, test: Any, bcs: list[Any]) -> PETSc.Mat:
+        """M (rho du . v dx), its supported rows and columns replaced by the identity."""
+        form = dolfinx.fem.form(self.rho * ufl.inner(trial, test) * self.dx)
+        return _compat.assemble_matrix(_compat.create_matrix(form), form, bcs)
+
+    def kinetic_form(self) -> Any:
+        return dolfinx.fem.form(0.5 * self.rho * ufl.inner(self.v, self.v) * self.dx)
+
+
+def initial_acceleration(
+    problem: Any, solver: Any, inertia: Inertia
+) -> Any:  # a callable (x, a) -> None for the stepper
+    """a_0 from the balance at the initial state, M a_0 = f_ext(0) - f_int(u_0) - f_c(u_0) on
+    the free dofs (0 on the supported ones): the residual of the solver's equations with c = 0
+    and a* = 0, solved with M (LU: once per run)."""
+
+    def solve(x: PETSc.Vec, a: PETSc.Vec) -> None:
+        inertia.set_mass_factor(0.0)
+        inertia.a_star.x.array[:] = 0.0
+        solver.reassemble_bulk()  # K without c M
+        problem.apply_load(0.0)
+        solver.assemble_load()
+        R = solver.reactions()  # f_int + f_c - f_ext on every row
+        R.scale(-1.0)
+        dolfinx.fem.petsc.set_bc(R, problem.bcs, x, 0.0)  # 0 on the supported rows
+        M = inertia.mass_matrix(problem.trial, problem.test, problem.bcs)
+        ksp = PETSc.KSP().create(problem.mesh.comm)
+        ksp.setOperators(M)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.solve(R, a)
+        a.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        for obj in (ksp, M, R):
+            obj.destroy()
+
+    return solve
+
+
+class EnergyLedger:
+    """The energy balance of a dynamic run, one row per step (module docstring)."""
+
+    KEYS = (
+        "time",
+        "kinetic",
+        "strain",
+        "contact",
+        "total",
+        "external_work",
+        "remainder",
+    )
+
+    def __init__(self, problem: Any, inertia: Inertia, load_form: Any) -> None:
+        self.comm = problem.mesh.comm
+        self.u = problem.state
+        self.kinetic = inertia.kinetic_form()
+        self.strain = dolfinx.fem.form(problem.material.strain_energy(problem.U) * problem.dx)
+        energy = None
+        if problem.surface is not None:
+            energy = problem.method.contact_energy(problem.surface)
+        #: whether the contact's stored energy is counted (else it is in the remainder)
+        self.contact_counted = energy is not None
+        self.contact = None if energy is None else dolfinx.fem.form(energy * problem.surface.ds)
+        self.load_form = load_form
+        self.f = _compat.create_vector(load_form)
+        self.f_prev = self.f.duplicate()
+        self.u_prev = _compat.petsc_vec(self.u).copy()
+        self.rows: list[dict[str, float]] = []
+        self.work = 0.0
+
+    def _load(self, out: PETSc.Vec) -> None:
+        _compat.assemble_vector(out, self.load_form)
+
+    def record(self, t: float) -> dict[str, float]:
+        """The balance at the state just accepted (time t): collective."""
+        u = _compat.petsc_vec(self.u)
+        self._load(self.f)
+        if self.rows:  # W += 1/2 (f_n + f_n+1) . (u_n+1 - u_n)
+            du = u.copy()
+            du.axpy(-1.0, self.u_prev)
+            self.work += 0.5 * (self.f.dot(du) + self.f_prev.dot(du))
+            du.destroy()
+        u.copy(self.u_prev)
+        self.f.copy(self.f_prev)
+        kin = global_sum(self.kinetic, self.comm)
+        strain = global_sum(self.strain, self.comm)
+        contact = 0.0 if self.contact is None else global_sum(self.contact, self.comm)
+        total = kin + strain + contact
+        e0 = self.rows[0]["total"] if self.rows else total
+        row = {
+            "time": t,
+            "kinetic": kin,
+            "strain": strain,
+            "contact": contact,
+            "total": total,
+            "external_work": self.work,
+            "remainder": self.work - (total - e0),
+        }
+        self.rows.append(row)
+        return row
+
+    def summary(self) -> dict[str, Any]:
+        """run.json's ``energy``: initial and final total, the largest |remainder| (absolute
+        and relative to the largest energy of the run), whether the contact's energy is
+        counted."""
+        if not self.rows:
+            return {}
+        scale = max(max(abs(r["total"]) for r in self.rows), 1e-300)
+        worst = max(abs(r["remainder"]) for r in self.rows)
+        return {
+            "initial_total": self.rows[0]["total"],
+            "final_total": self.rows[-1]["total"],
+            "external_work": self.rows[-1]["external_work"],
+            "largest_remainder": worst,
+            "largest_remainder_relative": worst / scale,
+            "contact_counted": self.contact_counted,
+        }
+
+    def write(self, out: Path) -> list[Path]:
+        """energy.csv and energy.png in ``out`` (rank 0)."""
+        if self.comm.rank != 0 or not self.rows:
+            return []
+        path = out / "energy.csv"
+        with path.open("w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=list(self.KEYS))
+            writer.writeheader()
+            for row in self.rows:
+                writer.writerow({k: f"{row[k]:.12g}" for k in self.KEYS})
+        return [path, self._plot(out / "energy.png")]
+
+    def _plot(self, path: Path) -> Path:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        t = np.array([r["time"] for r in self.rows])
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for key in ("kinetic", "strain", "contact", "total", "external_work", "remainder"):
+            if key == "contact" and not self.contact_counted:
+                continue
+            ax.plot(t, [r[key] for r in self.rows], label=key.replace("_", " "))
+        ax.set_xlabel("time")
+        ax.set_ylabel("energy")
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        return path
+
+    def destroy(self) -> None:
+        for v in (self.f, self.f_prev, self.u_prev):
+            v.destroy()

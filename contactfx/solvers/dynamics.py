@@ -1,0 +1,240 @@
+"""Implicit time integration: the Newmark family as a :class:`contactfx.solvers.stepper.Stepper`.
+
+One step of the generalised-alpha method (Chung and Hulbert 1993, doi:10.1115/1.2900803)
+solves the balance at the intermediate times t_{n+1-alpha_m} (inertia) and t_{n+1-alpha_f}
+(internal, contact and external forces)
+
+    M a_{n+1-alpha_m} + f_int(u_{n+1-alpha_f}) + f_c(u_{n+1-alpha_f}) = f_ext(t_{n+1-alpha_f})
+
+with x_{n+1-alpha} = (1 - alpha) x_{n+1} + alpha x_n and Newmark's updates (Newmark 1959)
+
+    u_{n+1} = u_n + dt v_n + dt^2 ((1/2 - beta) a_n + beta a_{n+1})
+    v_{n+1} = v_n + dt ((1 - gamma) a_n + gamma a_{n+1}).
+
+The unknown the nonlinear solver iterates on is w = u_{n+1-alpha_f} (the state the forces are
+evaluated at: a nonlinear bulk, the contact and friction laws read it as they read a static
+state). With u_{n+1} = (w - alpha_f u_n) / (1 - alpha_f) the inertia term is
+
+    M a_{n+1-alpha_m} = c M w - M a*,   c = (1 - alpha_m) / ((1 - alpha_f) beta dt^2),
+    a* = (1 - alpha_m) ((u_n / (1 - alpha_f) + dt v_n) / (beta dt^2) + (1 / (2 beta) - 1) a_n)
+         - alpha_m a_n,
+
+so a step is a static solve of the bulk plus c M (its Jacobian K + c M: a linear bulk
+assembles it once per step size) under the extra load M a*. The schemes:
+
+* ``newmark``: alpha_m = alpha_f = 0, beta = 1/4, gamma = 1/2 (average acceleration: no
+  numerical dissipation, the energy of a linear system conserved);
+* ``hht``: Hilber, Hughes and Taylor 1977 (doi:10.1002/eqe.4290050306), alpha_m = 0,
+  alpha_f = (1 - rho_inf) / (1 + rho_inf) in [0, 1/3] (rho_inf in [1/2, 1]),
+  gamma = 1/2 + alpha_f, beta = (1 + alpha_f)^2 / 4;
+* ``generalized-alpha``: alpha_m = (2 rho_inf - 1) / (rho_inf + 1),
+  alpha_f = rho_inf / (rho_inf + 1), gamma = 1/2 - alpha_m + alpha_f,
+  beta = (1 - alpha_m + alpha_f)^2 / 4 (rho_inf in [0, 1]: the spectral radius at
+  dt -> infinity; 1 is the average acceleration rule).
+
+All are second-order accurate and unconditionally stable for linear problems (the alpha-method
+sign convention here is Chung and Hulbert's: HHT's alpha is -alpha_f).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+
+from contactfx.solvers.snes import SolveStats
+from contactfx.solvers.stepper import Snapshot, StepRecord
+
+__all__ = ["Scheme", "SCHEMES", "Dynamic"]
+
+SCHEMES = ("newmark", "hht", "generalized-alpha")
+
+
+@dataclass(frozen=True)
+class Scheme:
+    """The four parameters of a generalised-alpha scheme (module docstring)."""
+
+    name: str
+    alpha_m: float
+    alpha_f: float
+    beta: float
+    gamma: float
+
+    @classmethod
+    def named(cls, name: str, rho_inf: float = 1.0) -> Scheme:
+        """``newmark`` (rho_inf unused), ``hht`` (rho_inf in [1/2, 1]) or
+        ``generalized-alpha`` (rho_inf in [0, 1]); ValueError otherwise."""
+        if not 0.0 <= rho_inf <= 1.0:
+            raise ValueError(f"--rho-inf must lie in [0, 1], got {rho_inf}")
+        if name == "newmark":
+            return cls(name, 0.0, 0.0, 0.25, 0.5)
+        if name == "hht":
+            if rho_inf < 0.5:
+                raise ValueError(
+                    f"--scheme hht needs --rho-inf in [0.5, 1] (alpha in [-1/3, 0]), got "
+                    f"{rho_inf}; use --scheme generalized-alpha below 0.5"
+                )
+            af = (1.0 - rho_inf) / (1.0 + rho_inf)
+            return cls(name, 0.0, af, 0.25 * (1.0 + af) ** 2, 0.5 + af)
+        if name == "generalized-alpha":
+            am = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
+            af = rho_inf / (rho_inf + 1.0)
+            return cls(name, am, af, 0.25 * (1.0 - am + af) ** 2, 0.5 - am + af)
+        raise ValueError(f"unknown time scheme {name!r}; one of {', '.join(SCHEMES)}")
+
+    def mass_factor(self, dt: float) -> float:
+        """c of the inertia term c M w - M a* (module docstring)."""
+        return (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
+
+
+class Dynamic:
+    """The time steps t = dt, 2 dt, ..., t_end of a :class:`Scheme` (see the module
+    docstring): holds u_n, v_n, a_n, sets the inertia load a* and the mass factor c for each
+    step, and on a converged step computes u_{n+1}, v_{n+1}, a_{n+1}. A failed step is retried
+    with half the step, up to ``max_cutbacks`` halvings in a row; after a converged step the
+    step doubles back towards ``dt`` (a fixed step with cut-back). Each change of the step size
+    changes c: ``set_mass_factor(c)`` sets it in the forms and ``reassemble()`` re-assembles
+    the bulk (K + c M).
+
+    ``v``, ``a``, ``a_star``: the (ghosted) vectors of the velocity, acceleration and inertia
+    load Functions, in the unknown's layout; ``initial_acceleration(x, a)``: a_0 from the
+    balance at the initial state (collective), called at :meth:`start` unless ``a`` holds
+    it already (``a0_given``). ``fields``: other vectors restored on a cut-back (a multiplier).
+    """
+
+    def __init__(
+        self,
+        scheme: Scheme,
+        *,
+        dt: float,
+        t_end: float,
+        v: PETSc.Vec,
+        a: PETSc.Vec,
+        a_star: PETSc.Vec,
+        set_mass_factor: Callable[[float], None],
+        reassemble: Callable[[], None],
+        initial_acceleration: Callable[[PETSc.Vec, PETSc.Vec], None] | None = None,
+        max_cutbacks: int = 6,
+        fields: Sequence[PETSc.Vec] = (),
+        t_start: float = 0.0,
+    ) -> None:
+        if not dt > 0.0:
+            raise ValueError(f"--dt must be > 0, got {dt}")
+        if not t_end >= t_start + dt * (1.0 - 1e-12):
+            raise ValueError(f"--t-end ({t_end}) must be at least one step (--dt {dt})")
+        self.scheme, self.dt_base, self.t_end = scheme, dt, t_end
+        self.v, self.a, self.a_star = v, a, a_star
+        self.set_mass_factor, self.reassemble = set_mass_factor, reassemble
+        self.initial_acceleration = initial_acceleration
+        self.max_cutbacks, self.fields = max_cutbacks, list(fields)
+        self.t_start = t_start
+        self.step = 0
+
+    # -- the Stepper protocol ------------------------------------------------------------------
+    def start(self, x: PETSc.Vec) -> None:
+        self.x = x
+        if self.initial_acceleration is not None:
+            self.initial_acceleration(x, self.a)
+        #: u_n, v_n, a_n (and the other fields) of the last accepted step
+        self.previous = Snapshot([x, self.v, self.a, *self.fields])
+        self.t_prev = self.t_start
+        self.dt = self.dt_base
+        self.dt_min = self.dt / 2**self.max_cutbacks
+        self._c: float | None = None
+        self.cutbacks = 0
+        self.step = 0
+
+    def done(self) -> bool:
+        return self.t_prev >= self.t_end - 1e-9 * self.dt_base
+
+    def next_time(self) -> float:
+        self.t = min(self.t_end, self.t_prev + self.dt)
+        if self.t_end - self.t < 1e-6 * self.dt:  # no sliver of a last step
+            self.t = self.t_end
+        #: the step's size: the nominal one unless the end clipped it (so that the times'
+        #: round-off does not change c M and re-assemble the bulk)
+        self.h = self.t - self.t_prev
+        if abs(self.h - self.dt) <= 1e-9 * self.dt:
+            self.h = self.dt
+        return self.t
+
+    def load_time(self) -> float:
+        """The time the step's forces are evaluated at: t_{n+1-alpha_f}."""
+        af = self.scheme.alpha_f
+        return (1.0 - af) * self.t + af * self.t_prev
+
+    def predict(self) -> None:
+        """a* and c of the step; w starts at u_n + (1 - alpha_f)(dt v_n + dt^2 / 2 a_n)."""
+        s, dt = self.scheme, self.h
+        self.previous.restore()
+        c = s.mass_factor(dt)
+        if c != self._c:  # K + c M assembled again (the first time: it had c = 0)
+            self.set_mass_factor(c)
+            self.reassemble()
+            self._c = c
+        u_n, v_n, a_n = self.previous.copies[:3]
+        af, am, b = s.alpha_f, s.alpha_m, s.beta
+        # a* = (1 - am) / (b dt^2) (u_n / (1 - af) + dt v_n) + ((1 - am)(1/(2b) - 1) - am) a_n
+        k = (1.0 - am) / (b * dt * dt)
+        self.a_star.set(0.0)
+        self.a_star.axpy(k / (1.0 - af), u_n)
+        self.a_star.axpy(k * dt, v_n)
+        self.a_star.axpy((1.0 - am) * (0.5 / b - 1.0) - am, a_n)
+        _ghost_update(self.a_star)
+        self.x.axpy((1.0 - af) * dt, v_n)
+        self.x.axpy((1.0 - af) * 0.5 * dt * dt, a_n)
+        _ghost_update(self.x)
+
+    def accept(self, stats: SolveStats) -> StepRecord:
+        """u_{n+1} from w, then a_{n+1} and v_{n+1} (Newmark's updates); the unknown is set
+        to u_{n+1} (the state of the output and of the next step's history)."""
+        s, dt = self.scheme, self.h
+        u_n, v_n, a_n = self.previous.copies[:3]
+        af, b, g = s.alpha_f, s.beta, s.gamma
+        if af != 0.0:  # u_{n+1} = (w - af u_n) / (1 - af)
+            self.x.axpy(-af, u_n)
+            self.x.scale(1.0 / (1.0 - af))
+            _ghost_update(self.x)
+        # a_{n+1} = (u_{n+1} - u_n - dt v_n) / (b dt^2) - (1 / (2 b) - 1) a_n
+        a = self.a
+        self.x.copy(a)
+        a.axpy(-1.0, u_n)
+        a.axpy(-dt, v_n)
+        a.scale(1.0 / (b * dt * dt))
+        a.axpy(-(0.5 / b - 1.0), a_n)
+        _ghost_update(a)
+        # v_{n+1} = v_n + dt ((1 - g) a_n + g a_{n+1})
+        v = self.v
+        v_n.copy(v)
+        v.axpy(dt * (1.0 - g), a_n)
+        v.axpy(dt * g, a)
+        _ghost_update(v)
+        self.step += 1
+        self.previous.save()
+        record = StepRecord(step=self.step, time=self.t, dt=dt, stats=stats, cutbacks=self.cutbacks)
+        self.t_prev = self.t
+        if self.cutbacks == 0 and self.dt < self.dt_base * (1.0 - 1e-12):
+            self.dt = min(self.dt_base, 2.0 * self.dt)
+        self.cutbacks = 0
+        return record
+
+    def cut_back(self) -> bool:
+        self.cutbacks += 1
+        if self.cutbacks > self.max_cutbacks or 0.5 * self.dt < self.dt_min * (1.0 - 1e-12):
+            return False
+        self.dt *= 0.5
+        return True
+
+    def restore(self) -> None:
+        self.previous.restore()
+
+    def describe(self, t: float) -> str:
+        return f"time {t:.6g}"
+
+    def destroy(self) -> None:
+        self.previous.destroy()
+
+
+def _ghost_update(x: PETSc.Vec) -> None:
+    x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
