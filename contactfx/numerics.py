@@ -118,6 +118,13 @@ class _General:
         "([0, 1]): 1 no numerical dissipation, smaller damps the highest frequencies",
         nonnegative=True,
     )
+    mass: str = param(
+        "consistent",
+        "mass matrix of --dynamic: consistent, lumped (P1: the row sums) or redistributed "
+        "(lumped, the contact nodes' mass moved to the other nodes of their cells: no inertia "
+        "at the contact, after Khenous, Laborde and Renard 2008)",
+        choices=("consistent", "lumped", "redistributed"),
+    )
     dt: float = param(0.0, "time step of --dynamic (0: the scene's)", nonnegative=True)
     t_end: float = param(0.0, "end time of --dynamic (0: the scene's)", nonnegative=True)
 
@@ -243,6 +250,8 @@ class _Checks:
                 )
             if self.nested:
                 raise ValueError("--nested is offered for static load steps, not with --dynamic")
+            if self.mass != "consistent" and self.degree != 1:
+                raise ValueError(f"--mass {self.mass} is a P1 lumping: use --degree 1")
 
     def method_object(self):
         """The configured contact method."""

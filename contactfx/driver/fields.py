@@ -39,16 +39,20 @@ TolerancePoints = Sequence[tuple[NDArray[np.float64], float]]
 
 
 def vertex_rule(fdim: int) -> dict[str, Any]:
-    """Quadrature at the facet's vertices (trapezoidal rule): nodal collocation of the
-    multiplier equations, exact nodal complementarity."""
+    """Quadrature at the vertices of a simplex of dimension ``fdim`` (a facet's: the
+    trapezoidal rule, nodal collocation of the multiplier equations, exact nodal
+    complementarity; a cell's: the lumped mass of P1)."""
     points: tuple[tuple[float, ...], ...]
     weights: tuple[float, ...]
     if fdim == 0:
         points, weights = ((),), (1.0,)
     elif fdim == 1:
         points, weights = ((0.0,), (1.0,)), (0.5, 0.5)
-    else:
+    elif fdim == 2:
         points, weights = ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)), (1.0 / 6.0,) * 3
+    else:
+        points = ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+        weights = (1.0 / 24.0,) * 4
     return {
         "quadrature_rule": "custom",
         "quadrature_degree": 1,

@@ -4,8 +4,9 @@
 the unknown's space, the stepper's :class:`contactfx.solvers.dynamics.Dynamic` fields) and the
 mass factor c, and gives the bulk its inertia terms: with density rho,
 
-    linear bulk:    a(du, v) + c int rho du . v dx,    f_ext + int rho a* . v dx
-    nonlinear bulk: f_int(u; v) + int rho (c u - a*) . v dx
+    linear bulk:    a(du, v) + c int rho du . v dx
+    nonlinear bulk: f_int(u; v) + c int rho u . v dx
+    load:           f_ext + int rho a* . v dx
 
 (the effective stiffness K + c M of a linear bulk assembled once per step size). A static run
 has none of this (no mass matrix, no velocity field).
@@ -31,7 +32,7 @@ import ufl
 from petsc4py import PETSc
 
 from contactfx import _compat
-from contactfx.driver.fields import global_sum
+from contactfx.driver.fields import global_sum, surface_mask, vertex_rule
 
 __all__ = ["Inertia", "EnergyLedger"]
 
@@ -58,28 +59,58 @@ class Inertia:
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.a_star = dolfinx.fem.Function(W, name="inertia_load")
         self.c = dolfinx.fem.Constant(problem.mesh, 0.0)
-        self.dx = problem.dx
         self.mesh = problem.mesh
+        self.dx, self.rho = self._mass(problem, rho)
+
+    @staticmethod
+    def _mass(problem: Any, rho: float) -> tuple[ufl.Measure, Any]:
+        """The mass's measure and density (``--mass``): consistent (dx, rho); lumped (the
+        P1 cells' vertex rule: M_ii = the row sums); redistributed (lumped, with the density
+        weighted by (1 - chi) / (1 - mean_K chi) at the vertices of cell K, chi the indicator
+        of the contact surface's nodes: no mass at the contact, each cell's mass kept; a
+        cell whose vertices are all on the contact loses its mass)."""
+        mass = problem.num.mass
+        if mass == "consistent":
+            return problem.dx, rho
+        mesh = problem.mesh
+        dx = problem.dx(metadata=vertex_rule(mesh.topology.dim))
+        if mass == "lumped":
+            return dx, rho
+        Q1 = _compat.function_space(mesh, "Lagrange", 1)
+        chi = dolfinx.fem.Function(Q1, name="contact_nodes")
+        chi.x.array[:] = surface_mask(Q1, problem.fdim, problem.contact_facets)
+        mean = dolfinx.fem.Function(_compat.function_space(mesh, "DG", 0))
+        mean.interpolate(chi)  # a P1 field's value at a simplex's centroid: its vertex mean
+        weight = ufl.conditional(ufl.lt(mean, 1.0 - 1e-12), (1.0 - chi) / (1.0 - mean), 0.0)
+        return dx, rho * weight
 
     def mass_term(self, du: Any, v: Any) -> ufl.Form:
         """c int rho du . v dx (bilinear: the linear bulk's K + c M)."""
         return self.c * self.rho * ufl.inner(du, v) * self.dx
 
     def load_term(self, v: Any) -> ufl.Form:
-        """int rho a* . v dx (the linear bulk's extra load)."""
+        """int rho a* . v dx (the bulk's extra load)."""
         return self.rho * ufl.inner(self.a_star, v) * self.dx
 
     def internal_term(self, u: Any, v: Any) -> ufl.Form:
-        """int rho (c u - a*) . v dx (a nonlinear bulk's inertia in its residual)."""
-        return self.rho * ufl.inner(self.c * u - self.a_star, v) * self.dx
+        """c int rho u . v dx (a nonlinear bulk's inertia in its residual; its tangent is the
+        mass term)."""
+        return self.c * self.rho * ufl.inner(u, v) * self.dx
 
     def set_mass_factor(self, c: float) -> None:
         self.c.value = c
 
     def mass_matrix(self, trial: Any, test: Any, bcs: list[Any]) -> PETSc.Mat:
-        """M (rho du . v dx), its supported rows and columns replaced by the identity."""
+        """M (rho du . v dx), its supported rows and columns replaced by the identity, and a
+        unit diagonal where the mass is zero (the contact nodes of a redistributed mass:
+        their acceleration is left 0)."""
         form = dolfinx.fem.form(self.rho * ufl.inner(trial, test) * self.dx)
-        return _compat.assemble_matrix(_compat.create_matrix(form), form, bcs)
+        M = _compat.assemble_matrix(_compat.create_matrix(form), form, bcs)
+        d = M.getDiagonal()
+        d.array[d.array == 0.0] = 1.0
+        M.setDiagonal(d, addv=PETSc.InsertMode.INSERT_VALUES)
+        d.destroy()
+        return M
 
     def kinetic_form(self) -> Any:
         return dolfinx.fem.form(0.5 * self.rho * ufl.inner(self.v, self.v) * self.dx)

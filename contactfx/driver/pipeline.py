@@ -378,6 +378,9 @@ class _Run:
             with self.timed("initial_guess"):
                 problem.start(solver)
             solver = self.method.attach(solver, problem)
+            if problem.inertia is not None and problem.material.linear:
+                # K + c M factorised once per step size (ContactSNES.reuse_factorisation)
+                solver.reuse_factorisation(across_solves=True)
             levels = nested_levels(self.num.nested, problem.dofs(), mesh.topology.dim)
             if levels:
                 solver = self.nested(problem, solver, levels)
@@ -432,6 +435,7 @@ class _Run:
                 or problem.roundoff_stop
                 or problem.inertia is not None
             ),
+            load_scale=problem.inertia is not None,
         )
         solver.timer.assembly += assembly
         if problem.material.finite_strain and self.num.inversion_check == "halve":
@@ -641,7 +645,8 @@ def _remaining(elapsed: float, load: float, total: float = 1.0) -> str:
 
 def _progress(step: StepLog, outer: bool) -> str:
     q = step.quantities
-    head = f"  step {step.step:3d}  load {step.load:6.3f}  newton {step.newton:3d}"
+    when = "time" if step.energy is not None else "load"  # a dynamic run's steps are in time
+    head = f"  step {step.step:3d}  {when} {step.load:6.3f}  newton {step.newton:3d}"
     head += f"  outer {step.outer:3d}" if outer else ""
     if q.interface is not None:
         return (

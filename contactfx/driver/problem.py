@@ -386,7 +386,7 @@ class Problem:
         L = self.extra_load(L)
         #: the compiled external load f_ext (a dynamic run's energy balance reads it)
         self.load_form = dolfinx.fem.form(L)
-        if self.inertia is not None and self.material.linear:  # + M a*
+        if self.inertia is not None:  # + M a*
             L = L + self.inertia.load_term(self.V_test)
         # two bodies: no UFL surface, the contact terms are the solver's coupling
         F = None if self.surface is None else self.contact_residual()
@@ -410,7 +410,7 @@ class Problem:
             a = dolfinx.fem.form(form)
             return functools.partial(LinearBulk, stiffness=a, load=load)
         f_int = self.internal_form()
-        if inertia is not None:  # + rho (c u - a*) . v
+        if inertia is not None:  # + c rho u . v (M a* is in the load)
             f_int = f_int + inertia.internal_term(self.U, self.V_test)
         tangent = ufl.derivative(f_int, self.state, self.trial)
         pattern = self.tangent_pattern()

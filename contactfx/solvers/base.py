@@ -48,6 +48,7 @@ class ConvergenceError(RuntimeError):
         stats: SolveStats | None = None,
         *,
         detail: str = "",
+        when: str | None = None,
     ) -> None:
         self.reason = reason
         #: the iteration counts up to the failure, when known
@@ -56,7 +57,10 @@ class ConvergenceError(RuntimeError):
         self.load = load
         #: what the failed iterate shows (e.g. where an element inverted), or ""
         self.detail = detail
-        where = "" if step is None else f" at load step {step} (load factor {load:.6g})"
+        # ``when``: the stepper's words for the time (a dynamic run's "time 0.5")
+        when = when or ("" if load is None else f"load factor {load:.6g}")
+        kind = "load step" if "load" in when else "time step"
+        where = "" if step is None else f" at {kind} {step} ({when})"
         super().__init__(
             f"nonlinear solve diverged{where}: {reason}" + (f"; {detail}" if detail else "")
         )
@@ -105,8 +109,9 @@ class Solver(Protocol):
     def reassemble_bulk(self) -> None:
         """The bulk's forms changed their constants: assemble its Jacobian again."""
 
-    def reuse_factorisation(self) -> None:
-        """Keep an LU factorisation across Newton iterations (starts close to the solution)."""
+    def reuse_factorisation(self, across_solves: bool = False) -> None:
+        """Keep an LU factorisation across Newton iterations (starts close to the solution),
+        and across solves (``across_solves``: a dynamic run's steps)."""
 
     def phase_timings(self) -> dict[str, float]:
         """Wall times of the solver's own phases, for run.json (e.g. the coarse chain's)."""
@@ -141,8 +146,8 @@ class SolverWrapper:
     def reassemble_bulk(self) -> None:
         self.inner.reassemble_bulk()
 
-    def reuse_factorisation(self) -> None:
-        self.inner.reuse_factorisation()
+    def reuse_factorisation(self, across_solves: bool = False) -> None:
+        self.inner.reuse_factorisation(across_solves)
 
     def phase_timings(self) -> dict[str, float]:
         return self.inner.phase_timings()

@@ -82,6 +82,10 @@ class RoundOffStop:
     def __init__(self, snes: PETSc.SNES, divergence: float) -> None:
         self.first = self.last = 0.0
         self.peak = 0.0  # the largest first residual of the solves so far
+        #: the size of the residual's terms when known (a dynamic step's inertia load M a*:
+        #: its round-off floor, 1e-16 of that, can lie above 1e-8 of a well-predicted step's
+        #: first residual), else 0
+        self.scale = 0.0
         self.divergence = divergence
         self.stalled = 0  # solves stopped at the round-off level (a statistic)
         snes.setConvergenceTest(self)
@@ -107,7 +111,8 @@ class RoundOffStop:
             return R.CONVERGED_SNORM_RELATIVE
         if self.divergence > 0 and fnorm > self.divergence * self.first:
             return R.DIVERGED_DTOL
-        if it >= 2 and last <= self.DEPTH * max(self.first, self.peak) and fnorm > 0.1 * last:
+        depth = self.DEPTH * max(self.first, self.peak, self.scale)
+        if it >= 2 and last <= depth and fnorm > 0.1 * last:
             self.stalled += 1
             return R.CONVERGED_FNORM_RELATIVE
         return R.CONVERGED_ITERATING

@@ -144,12 +144,20 @@ class _KeptPreconditioner:
     Jacobian J only at the first iteration of a solve, after a failed Krylov solve and after
     one that needed ``rebuild_it`` iterations or more (an unchanged P is not set up again:
     PCSetUp compares the matrix state). ``coupled``: J's pattern may grow between refreshes
-    (a two-body coupling's search)."""
+    (a two-body coupling's search). ``every_solve`` False: not refreshed at a solve's first
+    iteration either (a dynamic run's steps, whose Jacobian changes with the contact status
+    only); ``stale``: refreshed at the next Jacobian (the bulk was re-assembled)."""
 
     def __init__(
-        self, J: PETSc.Mat, nullspace: PETSc.NullSpace | None, rebuild_it: int, coupled: bool
+        self,
+        J: PETSc.Mat,
+        nullspace: PETSc.NullSpace | None,
+        rebuild_it: int,
+        coupled: bool,
+        every_solve: bool = True,
     ) -> None:
-        self.rebuild_it, self.coupled = rebuild_it, coupled
+        self.rebuild_it, self.coupled, self.every_solve = rebuild_it, coupled, every_solve
+        self.stale = False
         self.P = J.duplicate(copy=True)
         if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
             self.P.setNearNullSpace(nullspace)
@@ -157,11 +165,13 @@ class _KeptPreconditioner:
     def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
         fresh = (
-            snes.getIterationNumber() == 0
+            self.stale
+            or (self.every_solve and snes.getIterationNumber() == 0)
             or ksp.getConvergedReason() < 0
             or ksp.getIterationNumber() >= self.rebuild_it
         )
         if fresh:
+            self.stale = False
             S = PETSc.Mat.Structure
             J.copy(
                 self.P,
@@ -252,7 +262,8 @@ class ContactSNES:
     reversal guard), ``deadline`` (a ``time.perf_counter()`` value past which a solve stops
     with :class:`TimeLimitExceeded`, checked collectively at every residual),
     ``roundoff_stop`` (finite strain: Newton also stops at the residual's round-off level,
-    :class:`_RoundOffStop`).
+    :class:`_RoundOffStop`), ``load_scale`` (that level also measured against the load's
+    size: a dynamic step's, which holds the inertia M a*).
 
     Its collaborators: the options database (:class:`contactfx.solvers.options.OptionsDB`),
     the reduced system on the kept dofs (:class:`contactfx.solvers.reduced.ReducedSystem`:
@@ -294,6 +305,7 @@ class ContactSNES:
         iterate: dolfinx.fem.Function | None = None,
         deadline: float | None = None,
         roundoff_stop: bool = False,
+        load_scale: bool = False,
     ) -> None:
         self.u = u
         self.comm = u.function_space.mesh.comm
@@ -353,6 +365,9 @@ class ContactSNES:
         if roundoff_stop:
             divergence = PETSc.Options().getReal(f"{prefix}snes_divergence_tolerance", 1e4)
             self.roundoff = RoundOffStop(self.snes, divergence)
+        #: the round-off stop's depth also measured against |f_ext| (a dynamic run, whose
+        #: load holds the inertia M a*)
+        self.load_scale = load_scale
         self.kept: _KeptPreconditioner | None = None
         self.reuse_preconditioner()
         self.halving: _StepHalving | None = None
@@ -389,13 +404,18 @@ class ContactSNES:
         self.snes.setTolerances(**tolerances)
 
     # -- preconditioner reuse --------------------------------------------------------------
-    def reuse_factorisation(self) -> None:
+    def reuse_factorisation(self, across_solves: bool = False) -> None:
         """From the second Newton iteration of a solve on, keep the LU factorisation of an
         earlier Jacobian as GMRES's preconditioner while GMRES converges with it within
         REUSE_MAX_IT iterations; refactorise at the first iteration of every solve and after a
         Krylov solve that needed more. For starts close to the solution (nested iteration),
         where the later Jacobians differ from the first in a few contact rows only. Only with
-        a direct solver whose Krylov type is preonly (what the defaults give)."""
+        a direct solver whose Krylov type is preonly (what the defaults give).
+        ``across_solves``: not refactorised at a solve's start either, only after a slow or
+        failed Krylov solve and after the bulk is re-assembled (a dynamic run with a linear
+        bulk: K + c M factorised once per step size, the contact's rows changing the
+        Jacobian only when the contact status changes; an unchanged Jacobian costs one
+        back-substitution)."""
         ksp = self.snes.getKSP()
         if ksp.getPC().getType() != "lu" or ksp.getType() != "preonly":
             return
@@ -405,7 +425,7 @@ class ContactSNES:
         ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=self.REUSE_MAX_IT)
         # a Krylov solve stopped at REUSE_MAX_IT is still a descent step: take it, refactorise
         self.snes.setMaxLinearSolveFailures(10**6)
-        self._keep_preconditioner(self.REUSE_MAX_IT)
+        self._keep_preconditioner(self.REUSE_MAX_IT, every_solve=not across_solves)
 
     def reuse_preconditioner(self) -> None:
         """Keep an iterative solver's preconditioner (the AMG hierarchy, whose Galerkin
@@ -427,11 +447,15 @@ class ContactSNES:
             return
         self._keep_preconditioner(self.AMG_REBUILD_IT)
 
-    def _keep_preconditioner(self, rebuild_it: int) -> None:
+    def _keep_preconditioner(self, rebuild_it: int, every_solve: bool = True) -> None:
         if self.kept is not None:
             self.kept.destroy()
         self.kept = _KeptPreconditioner(
-            self.J, self.nullspace, rebuild_it, coupled=self.coupling is not None
+            self.J,
+            self.nullspace,
+            rebuild_it,
+            coupled=self.coupling is not None,
+            every_solve=every_solve,
         )
         self.snes.setJacobian(self._jacobian, self.J, self.kept.P)
 
@@ -530,6 +554,8 @@ class ContactSNES:
         K = self.bulk.jacobian(_compat.petsc_vec(self.u))
         if self.reduced is not None and self.bulk.constant_jacobian:
             self.reduced.bulk_block(K)
+        if self.kept is not None:
+            self.kept.stale = True
         self.snes.getKSP().getPC().reset()
         self.timer.assembly += time.perf_counter() - t0
 
@@ -653,6 +679,8 @@ class ContactSNES:
         dolfinx.fem.petsc.set_bc(x, self.bcs)
         self._sync(x)
         self._compact()
+        if self.roundoff is not None and self.load_scale:
+            self.roundoff.scale = self.bulk.load.norm()
         self._late = False
         self._remember()
         if self.guard is not None:
@@ -680,7 +708,7 @@ class ContactSNES:
         self.J = J
         self.compactions += 1
         if self.kept is not None:
-            self._keep_preconditioner(self.kept.rebuild_it)
+            self._keep_preconditioner(self.kept.rebuild_it, self.kept.every_solve)
         else:
             self.snes.setJacobian(self._jacobian, self.J, self.J)
 

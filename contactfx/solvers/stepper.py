@@ -282,7 +282,13 @@ def march(
                 if not stepper.cut_back():
                     detail = diagnose() if diagnose is not None else ""
                     stepper.restore()
-                    raise ConvergenceError(err.reason, stepper.step + 1, t, detail=detail) from None
+                    raise ConvergenceError(
+                        err.reason,
+                        stepper.step + 1,
+                        t,
+                        detail=detail,
+                        when=stepper.describe(t),
+                    ) from None
                 continue
             record = stepper.accept(stats)
             records.append(record)
