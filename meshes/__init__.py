@@ -47,6 +47,7 @@ from contactfx.meshes.crack_plate import (
     crack_set_plate,
     structured_plate,
 )
+from contactfx.meshes.disc import DiscCells, DiscFacets, disc
 from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
 from contactfx.meshes.penny_block import PennyBlockCells, PennyBlockFacets, penny_block
@@ -106,6 +107,8 @@ __all__ = [
     "Builder",
     "CrackPlateCells",
     "CrackPlateFacets",
+    "DiscCells",
+    "DiscFacets",
     "IntervalCells",
     "IntervalFacets",
     "CylindersCells",
@@ -135,6 +138,7 @@ __all__ = [
     "StackedBoxesFacets",
     "box",
     "build",
+    "disc",
     "build_file",
     "build_grouped",
     "builder_groups",

@@ -124,9 +124,15 @@ def table(res: RunSummary) -> str:
         e = res.energy
         rows.append(
             (
-                "energy initial / final / largest remainder",
-                f"{e['initial_total']:.6g} / {e['final_total']:.6g} / "
-                f"{e['largest_remainder']:.3g} ({e['largest_remainder_relative']:.2%})",
+                "energy initial / final / work of loads",
+                f"{e['initial_total']:.6g} / {e['final_total']:.6g} / {e['external_work']:.6g}",
+            )
+        )
+        rows.append(
+            (
+                "energy balance: largest remainder",
+                f"{e['largest_remainder']:.3g} ({e['largest_remainder_relative']:.2%} of the "
+                "largest energy)",
             )
         )
     rows += [("warning", w) for w in res.warnings]

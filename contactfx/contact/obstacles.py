@@ -24,7 +24,7 @@ import ufl
 
 from contactfx.contact.laws import Expr
 
-__all__ = ["Obstacle", "HalfSpace", "Ball", "Paraboloid", "FlatPunch", "Sinusoid"]
+__all__ = ["Obstacle", "HalfSpace", "Floor", "Ball", "Paraboloid", "FlatPunch", "Sinusoid"]
 
 
 def _tangential_sq(y: Expr) -> Expr:
@@ -77,6 +77,28 @@ class HalfSpace(Obstacle):
 
     def height(self, t: np.ndarray) -> np.ndarray:
         return np.full(t.shape[0], self.level)
+
+
+@dataclass(frozen=True)
+class Floor(Obstacle):
+    """The half-space y_d <= level, the body above it (a floor a body falls onto): the
+    gap y_d - level, the contact normal -e_d. The one obstacle below its body (the others
+    lie above theirs, module docstring); offered to the methods that read the gap and the
+    normal (not the VI's vertical bounds: ``height`` is the floor's upper surface, -inf
+    nowhere)."""
+
+    level: float = 0.0
+    #: below its body: the contact force the post-processing reports is along -e_d
+    below = True
+
+    def phi(self, y: Expr) -> Expr:
+        return y[ufl.shape(y)[0] - 1] - self.level
+
+    def normal(self, y: Expr) -> Expr:
+        return -_e_last(ufl.shape(y)[0])
+
+    def height(self, t: np.ndarray) -> np.ndarray:
+        raise ValueError("a floor below the body has no upper bound (method vi)")
 
 
 @dataclass(frozen=True)

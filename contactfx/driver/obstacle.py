@@ -256,7 +256,9 @@ class ObstaclePost:
             self.measure_form = dolfinx.fem.form(self.status * pb.dsc)
         else:
             self.reaction = None
-            self.force_form = dolfinx.fem.form(p * n[gdim - 1] * pb.dsc)
+            # the force along e_d the obstacle takes (a floor below the body: along -e_d)
+            n_d = -n[gdim - 1] if getattr(pb.obstacle, "below", False) else n[gdim - 1]
+            self.force_form = dolfinx.fem.form(p * n_d * pb.dsc)
             self.p_form = self.nodal.form(p)
             closed = method.contact_indicator(s)
             self.measure_form = dolfinx.fem.form(active(closed) * pb.dsc_fine)

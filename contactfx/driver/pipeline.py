@@ -522,6 +522,9 @@ class _Run:
             t_start = 0.0 if restart is None else restart.load
             a0 = solver.timer.assembly
             stepper = self.stepper(problem, solver)
+            if self.energy is not None and restart is None:  # the balance at t = 0
+                problem.apply_load(t_start)
+                self.energy.record(t_start)
             with StopRequest(self.comm) as stop:
                 try:
                     march(

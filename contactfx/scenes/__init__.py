@@ -6,6 +6,7 @@ from contactfx.numerics import Numerics
 from contactfx.scenes.bar import Bar1D, BarImpact
 from contactfx.scenes.base import Scene
 from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, ProppedFracture
+from contactfx.scenes.disc_drop import DiscDrop
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D, HertzAxi
 from contactfx.scenes.ironing import ShallowIroning
@@ -31,6 +32,7 @@ SCENES: dict[str, type[Scene]] = {
         SlidingBlock,
         Bar1D,
         BarImpact,
+        DiscDrop,
         CrackSneddon,
         CrackInclined,
         ProppedFracture,

@@ -180,6 +180,7 @@ NO_PROBLEM_FILE = {
     "fault-block": "problem files carry 2D interfaces only",
     "crack-set": "problem files carry fitted interfaces only",
     "bar-impact": "problem files carry no time integration yet",
+    "disc-drop": "problem files carry no time integration yet",
 }
 
 

@@ -1,0 +1,65 @@
+"""A disc dropped on a rigid plane (scene ``disc-drop``; the 2D test of Chouly, Hild and
+Renard 2015, doi:10.1051/m2an/2014046; docs/verification.md section 18): radius 20, E = 50,
+nu = 0.25, rho = 1, gravity 0.1, released at rest 5 above the plane. A coarse mesh (h 2 at the
+bottom, 5 elsewhere) and dt = 0.2 keep the test short; the scene's default is in the docs.
+
+1. The free fall is exact: the impact at t = sqrt(2 H / g) = 10 (the first closed step ends
+   within one step after it) with the speed sqrt(2 g H) = 1 (the kinetic energy at t = 10 is
+   1/2 m_h of the mesh's mass m_h = int rho dx to 1e-9: Newmark's average acceleration
+   integrates a constant acceleration exactly).
+2. The energy balance: kinetic + strain + the Nitsche term - the work of gravity stays within
+   1 % of the kinetic energy at impact over the contact and the rebound (Nitsche theta = 1
+   conserves it but for the contact status changes).
+3. One rank against two: the same steps, the contact force at every step to 1e-8 relative to
+   its largest value.
+"""
+
+from __future__ import annotations
+
+import dolfinx
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+from contactfx.scenes.disc_drop import DiscDrop
+
+COMM = MPI.COMM_WORLD
+PARAMS = dict(h_contact=2.0, h_far=5.0)
+
+
+def run(comm, t_end: float = 30.0):
+    scene = DiscDrop(DiscDrop.Params(**PARAMS))
+    num = scene.default_numerics(dt=0.2, t_end=t_end)
+    return scene, scene.run(num, comm=comm, verbose=False)
+
+
+def test_disc_drop_impact_and_energy():
+    scene, res = run(COMM)
+    t = np.array([s.load for s in res.steps])
+    force = np.array([s.quantities.force for s in res.steps])
+    energy = [s.energy for s in res.steps]
+    ref = scene.impact()
+    assert ref["impact_time"] == pytest.approx(10.0, rel=1e-12)
+    assert ref["impact_speed"] == pytest.approx(1.0, rel=1e-12)
+    first = t[np.flatnonzero(force > 0.0)[0]]
+    assert ref["impact_time"] < first <= ref["impact_time"] + 0.2 + 1e-9
+    # the mesh's mass (the discrete disc's area, not pi R^2)
+    mesh, _ = DiscDrop(DiscDrop.Params(**PARAMS)).build_mesh(COMM)
+    one = dolfinx.fem.Constant(mesh, 1.0)
+    mass = COMM.allreduce(dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * ufl.dx(mesh))))
+    k10 = next(e["kinetic"] for e in energy if abs(e["time"] - 10.0) < 1e-9)
+    assert k10 == pytest.approx(0.5 * mass * ref["impact_speed"] ** 2, rel=1e-9)
+    balance = np.array([e["total"] - e["external_work"] for e in energy])
+    assert np.max(np.abs(balance - balance[0])) <= 0.01 * k10
+    assert np.max(force) > 0.0 and force[-1] == 0.0  # contact, then rebound into flight
+
+
+@pytest.mark.skipif(COMM.size == 1, reason="compares the run on all ranks with one rank")
+def test_disc_drop_one_rank_against_two():
+    _, alone = run(MPI.COMM_SELF, t_end=14.0)
+    _, together = run(COMM, t_end=14.0)
+    f1 = np.array([s.quantities.force for s in alone.steps])
+    f2 = np.array([s.quantities.force for s in together.steps])
+    assert len(f1) == len(f2) == 70
+    assert np.max(np.abs(f1 - f2)) <= 1e-8 * np.max(f1)
