@@ -14,9 +14,10 @@ has none of this (no mass matrix, no velocity field).
 :class:`EnergyLedger` keeps the balance at every step: the kinetic energy 1/2 v . M v, the
 strain energy (the material's density), the energy the contact terms store (the method's, e.g.
 Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_+^2), the work
-of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), and the
-remainder W_ext - (E - E_0): what the scheme dissipated (or gained: the error of a
-non-conserving discretisation). The supports are fixed in the scenes that use it (no work);
+of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), friction's
+dissipation (the sum over the steps of -int t_T . du_T ds, the traction at the step's end on
+its slip increment: backward Euler's), and the remainder W_ext - D_friction - (E - E_0): what
+the scheme dissipated (or gained: the error of a non-conserving discretisation). The supports are fixed in the scenes that use it (no work);
 a moving support's or obstacle's work is not counted (it would appear in the remainder).
 """
 
@@ -156,6 +157,7 @@ class EnergyLedger:
         "contact",
         "total",
         "external_work",
+        "friction_dissipation",
         "remainder",
     )
 
@@ -170,6 +172,15 @@ class EnergyLedger:
         #: whether the contact's stored energy is counted (else it is in the remainder)
         self.contact_counted = energy is not None
         self.contact = None if energy is None else dolfinx.fem.form(energy * problem.surface.ds)
+        #: friction's dissipation per step, -int t_T . du_T ds (the work the friction
+        #: traction t_T on the body does on the step's slip), or None without friction
+        self.friction = None
+        surface = problem.surface
+        if surface is not None and problem.friction is not None:
+            t_T = problem.method.tangential_traction(surface)
+            slip = surface.slip_increment(surface.normal())
+            self.friction = dolfinx.fem.form(-ufl.dot(t_T, slip) * surface.ds)
+        self.dissipated = 0.0
         self.load_form = load_form
         self.f = _compat.create_vector(load_form)
         self.f_prev = self.f.duplicate()
@@ -191,6 +202,8 @@ class EnergyLedger:
             du.destroy()
         u.copy(self.u_prev)
         self.f.copy(self.f_prev)
+        if self.friction is not None and self.rows:
+            self.dissipated += global_sum(self.friction, self.comm)
         kin = global_sum(self.kinetic, self.comm)
         strain = global_sum(self.strain, self.comm)
         contact = 0.0 if self.contact is None else global_sum(self.contact, self.comm)
@@ -203,7 +216,8 @@ class EnergyLedger:
             "contact": contact,
             "total": total,
             "external_work": self.work,
-            "remainder": self.work - (total - e0),
+            "friction_dissipation": self.dissipated,
+            "remainder": self.work - self.dissipated - (total - e0),
         }
         self.rows.append(row)
         return row
@@ -220,6 +234,7 @@ class EnergyLedger:
             "initial_total": self.rows[0]["total"],
             "final_total": self.rows[-1]["total"],
             "external_work": self.rows[-1]["external_work"],
+            "friction_dissipation": self.rows[-1]["friction_dissipation"],
             "largest_remainder": worst,
             "largest_remainder_relative": worst / scale,
             "contact_counted": self.contact_counted,
@@ -245,8 +260,11 @@ class EnergyLedger:
 
         t = np.array([r["time"] for r in self.rows])
         fig, ax = plt.subplots(figsize=(7, 4))
-        for key in ("kinetic", "strain", "contact", "total", "external_work", "remainder"):
-            if key == "contact" and not self.contact_counted:
+        keys = ("kinetic", "strain", "contact", "total", "external_work")
+        for key in keys + ("friction_dissipation", "remainder"):
+            if (key == "contact" and not self.contact_counted) or (
+                key == "friction_dissipation" and self.friction is None
+            ):
                 continue
             ax.plot(t, [r[key] for r in self.rows], label=key.replace("_", " "))
         ax.set_xlabel("time")

@@ -486,6 +486,8 @@ class _Run:
                         quantities,
                     )
                 )
+                if self.energy is not None:  # (before the friction history moves on)
+                    steps[-1] = dataclasses.replace(steps[-1], energy=self.energy.record(rec.time))
                 if writer is not None:
                     with self.timed("output"):
                         writer.write(rec.time, post.fields())
@@ -494,8 +496,6 @@ class _Run:
                 if checkpoints is not None and checkpoints.due(rec.step, stepper.done()):
                     with self.timed("checkpoint"):
                         checkpoints.write(rec.step, rec.time, roots(), steps, writer)
-                if self.energy is not None:
-                    steps[-1] = dataclasses.replace(steps[-1], energy=self.energy.record(rec.time))
                 elapsed = time.perf_counter() - t0
                 self.progress(
                     _progress(steps[-1], problem.method.multiplier.nodal)
@@ -568,6 +568,9 @@ class _Run:
             )
         inertia = problem.inertia
         assert inertia is not None  # built by the problem for a dynamic run
+        self.scene.initial_velocity(inertia.v)
+        if problem.prev is not None:  # the friction history starts at the initial state
+            problem.prev.x.array[:] = problem.state.x.array
         self.energy = EnergyLedger(problem, inertia, problem.load_form)
         vec = _compat.petsc_vec
         return Dynamic(

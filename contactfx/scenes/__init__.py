@@ -13,6 +13,7 @@ from contactfx.scenes.ironing import ShallowIroning
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
+from contactfx.scenes.sliding_stop import SlidingStop
 from contactfx.scenes.sphere_slide import SphereSlide
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
@@ -30,6 +31,7 @@ SCENES: dict[str, type[Scene]] = {
         FlatPunch2D,
         FlatPunch3D,
         SlidingBlock,
+        SlidingStop,
         Bar1D,
         BarImpact,
         DiscDrop,

@@ -207,7 +207,12 @@ class ObstacleScene(Scene):
         return None
 
     def initial_guess(self, u, t: float) -> None:
-        """Set a starting state before the first load step (default: zero)."""
+        """Set a starting state before the first load step (default: zero); a dynamic run's
+        initial displacement."""
+
+    def initial_velocity(self, v) -> None:
+        """Set a dynamic run's initial velocity ``v`` (a Function of the unknown's space;
+        default: at rest)."""
 
     def contact_size(self, measure: float) -> float:
         """Contact half-width / radius from the measure of the contact set (full model)."""

@@ -181,6 +181,7 @@ NO_PROBLEM_FILE = {
     "crack-set": "problem files carry fitted interfaces only",
     "bar-impact": "problem files carry no time integration yet",
     "disc-drop": "problem files carry no time integration yet",
+    "sliding-stop": "problem files carry no time integration yet",
 }
 
 
