@@ -17,8 +17,10 @@ Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_
 of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), friction's
 dissipation (the sum over the steps of -int t_T . du_T ds, the traction at the step's end on
 its slip increment: backward Euler's), and the remainder W_ext - D_friction - (E - E_0): what
-the scheme dissipated (or gained: the error of a non-conserving discretisation). The supports are fixed in the scenes that use it (no work);
-a moving support's or obstacle's work is not counted (it would appear in the remainder).
+the scheme dissipated (or gained: the error of a non-conserving discretisation). The supports
+are fixed in the scenes that use it (no work); a moving support's or obstacle's work is not
+counted (it would appear in the remainder), nor the energy a penalty or Nitsche friction
+term stores while sticking.
 """
 
 from __future__ import annotations
