@@ -176,6 +176,15 @@ BAD = [
     (["init", "nosuch", "--out", "x"], "unknown scene 'nosuch'"),
     (["init", "hertz2d"], "give the output folder with --out DIR"),
     (["init", "hertz2d", "--nu", "0.5", "--out", "x"], "Poisson's ratio nu must lie in"),
+    # dynamics (docs/verification.md section 18)
+    (["run", "bar-impact", "--dt", "0"], "--dynamic needs a time step --dt > 0"),
+    (["run", "bar-impact", "--t-end", "0.001"], "must be at least one time step"),
+    (["run", "bar-impact", "--rho-inf", "1.5"], "--rho-inf must lie in [0, 1]"),
+    (["run", "bar-impact", "--scheme", "hht", "--rho-inf", "0.3"], "needs --rho-inf in [0.5, 1]"),
+    (["run", "hertz2d", "--dynamic", "--dt", "0.1", "--t-end", "1"], "needs the body's density"),
+    (["run", "patch-test", "--dynamic", "--dt", "0.1", "--t-end", "1"], "offered static only"),
+    (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
+    (["run", "bar-impact", "--mass", "lumped", "--degree", "2"], "is a P1 lumping"),
 ]
 
 
