@@ -10,7 +10,8 @@ The state is captured from the run's objects (the problem, its post-processor, t
 and its wrappers, the stepper, the scene) by :func:`capture`: every dolfinx Function's
 values, every Constant's, every PETSc vector's owned values, the nonzero pattern of the
 matrices an object names in its ``checkpoint_patterns`` (:func:`_grow`: a two-body
-Jacobian's), and the plain data (but the attributes it names in ``checkpoint_skip``: this
+Jacobian's) and the values of those it names in ``checkpoint_values`` (a kept
+preconditioner's matrix), and the plain data (but the attributes it names in ``checkpoint_skip``: this
 run's clock, not state) (numbers,
 arrays, tuples, lists and dicts of them) of every contactfx object they hold, by attribute
 path. :func:`restore` puts them back into the same objects of a run built again from the
@@ -87,12 +88,16 @@ def _item(v: Any, seen: set[int]) -> tuple[str, Any] | None:
 def _capture(obj: Any, seen: set[int]) -> dict[str, Any]:
     out = {}
     grown = getattr(obj, "checkpoint_patterns", ())
+    valued = getattr(obj, "checkpoint_values", ())
     skip = getattr(obj, "checkpoint_skip", ())
     for name, v in vars(obj).items():
         if name in skip:
             continue
         if name in grown and isinstance(v, PETSc.Mat) and v.isAssembled():
             out[name] = ("M", _pattern(v))
+            continue
+        if name in valued and isinstance(v, PETSc.Mat) and v.isAssembled():
+            out[name] = ("MV", (_pattern(v), v.getValuesCSR()[2].copy()))
             continue
         item = _item(v, seen)
         if item is not None:
@@ -128,6 +133,8 @@ def _put(target: Any, item: tuple[str, Any], grows: list) -> Any:
             target.setArray(value)
     elif kind == "M" and isinstance(target, PETSc.Mat):
         grows.append((target, value))  # collective: after the walk
+    elif kind == "MV" and isinstance(target, PETSc.Mat):
+        grows.append((target, value))  # (its pattern, its values)
     elif kind == "P":
         return copy.deepcopy(value)
     elif kind == "L" and isinstance(target, list | tuple):
@@ -211,8 +218,29 @@ def restore(roots: dict[str, Any], saved: dict[str, Any], comm) -> None:
             _put(roots[name], item, grows)
     if comm.allreduce(len(grows), op=MPI.MIN) != comm.allreduce(len(grows), op=MPI.MAX):
         raise ValueError("the checkpoint's matrices differ between the ranks: cannot restart")
-    for A, pattern in grows:
-        _grow(A, pattern)
+    for A, saved in grows:
+        if len(saved) == 2:  # a matrix whose values are state
+            _set_values(A, *saved)
+        else:
+            _grow(A, saved)
+
+
+def _set_values(A: PETSc.Mat, pattern: tuple, values: np.ndarray) -> None:
+    """Put a matrix's saved values back (``checkpoint_values``: a kept preconditioner's
+    matrix, whose factorisation a restarted run must rebuild to continue with the same bits);
+    left alone where its pattern differs from the saved one on some rank (collective)."""
+    (start, shape), indptr, indices = pattern
+    now = _pattern(A) if A.isAssembled() else None
+    same = now is not None and (
+        (now[0] == (start, tuple(shape)) or now[0] == (start, shape))
+        and np.array_equal(now[1], indptr)
+        and np.array_equal(now[2], indices)
+    )
+    if not A.getComm().tompi4py().allreduce(same, op=MPI.LAND):
+        return
+    A.zeroEntries()
+    A.setValuesCSR(indptr, indices, values)
+    A.assemble()
 
 
 def mesh_hash(mesh) -> str:

@@ -106,8 +106,9 @@ class Solver(Protocol):
     def bulk_residual(self) -> PETSc.Vec:
         """R(u) = f_int(u) - f_ext without the contact terms."""
 
-    def reassemble_bulk(self) -> None:
-        """The bulk's forms changed their constants: assemble its Jacobian again."""
+    def reassemble_bulk(self, keep_preconditioner: bool = False) -> None:
+        """The bulk's forms changed their constants: assemble its Jacobian again
+        (``keep_preconditioner``: for the constants it had, a restarted run's)."""
 
     def reuse_factorisation(self, across_solves: bool = False) -> None:
         """Keep an LU factorisation across Newton iterations (starts close to the solution),
@@ -143,8 +144,8 @@ class SolverWrapper:
     def bulk_residual(self) -> PETSc.Vec:
         return self.inner.bulk_residual()
 
-    def reassemble_bulk(self) -> None:
-        self.inner.reassemble_bulk()
+    def reassemble_bulk(self, keep_preconditioner: bool = False) -> None:
+        self.inner.reassemble_bulk(keep_preconditioner)
 
     def reuse_factorisation(self, across_solves: bool = False) -> None:
         self.inner.reuse_factorisation(across_solves)

@@ -95,13 +95,18 @@ class Dynamic:
     with half the step, up to ``max_cutbacks`` halvings in a row; after a converged step the
     step doubles back towards ``dt`` (a fixed step with cut-back). Each change of the step size
     changes c: ``set_mass_factor(c)`` sets it in the forms and ``reassemble()`` re-assembles
-    the bulk (K + c M).
+    the bulk (K + c M); ``reassemble(keep_preconditioner=True)`` after a restart, whose c is
+    the checkpoint's.
 
     ``v``, ``a``, ``a_star``: the (ghosted) vectors of the velocity, acceleration and inertia
     load Functions, in the unknown's layout; ``initial_acceleration(x, a)``: a_0 from the
     balance at the initial state (collective), called at :meth:`start` unless ``a`` holds
     it already (``a0_given``). ``fields``: other vectors restored on a cut-back (a multiplier).
     """
+
+    #: not restored by a restart: the restarted run's bulk was assembled with c = 0, and is
+    #: assembled again at its first step (its kept preconditioner, restored, stays)
+    checkpoint_skip = ("_ready",)
 
     def __init__(
         self,
@@ -113,7 +118,7 @@ class Dynamic:
         a: PETSc.Vec,
         a_star: PETSc.Vec,
         set_mass_factor: Callable[[float], None],
-        reassemble: Callable[[], None],
+        reassemble: Callable[..., None],
         initial_acceleration: Callable[[PETSc.Vec, PETSc.Vec], None] | None = None,
         max_cutbacks: int = 6,
         fields: Sequence[PETSc.Vec] = (),
@@ -142,6 +147,7 @@ class Dynamic:
         self.dt = self.dt_base
         self.dt_min = self.dt / 2**self.max_cutbacks
         self._c: float | None = None
+        self._ready = False  # the bulk assembled with the mass factor _c
         self.cutbacks = 0
         self.step = 0
 
@@ -172,7 +178,11 @@ class Dynamic:
         if c != self._c:  # K + c M assembled again (the first time: it had c = 0)
             self.set_mass_factor(c)
             self.reassemble()
-            self._c = c
+            self._c, self._ready = c, True
+        elif not self._ready:  # a restarted run: c restored, the bulk not yet assembled
+            self.set_mass_factor(c)
+            self.reassemble(keep_preconditioner=True)
+            self._ready = True
         u_n, v_n, a_n = self.previous.copies[:3]
         af, am, b = s.alpha_f, s.alpha_m, s.beta
         # a* = (1 - am) / (b dt^2) (u_n / (1 - af) + dt v_n) + ((1 - am)(1/(2b) - 1) - am) a_n

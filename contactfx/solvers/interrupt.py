@@ -28,12 +28,15 @@ class Interrupted(Exception):
     """The load program stopped on a signal after its last complete step ``step`` (0: none)
     at load factor ``load``; ``records`` the complete steps' records."""
 
-    def __init__(self, signum: int, step: int, load: float, records: list[Any]) -> None:
+    def __init__(
+        self, signum: int, step: int, load: float, records: list[Any], when: str | None = None
+    ) -> None:
         self.signum, self.step, self.load, self.records = signum, step, load, records
         self.signal = signal.Signals(signum).name
-        super().__init__(
-            f"interrupted by {self.signal} after load step {step} (load factor {load:.6g})"
-        )
+        # ``when``: the stepper's words for the time (a dynamic run's "time 0.5")
+        when = when or f"load factor {load:.6g}"
+        kind = "load step" if "load" in when else "time step"
+        super().__init__(f"interrupted by {self.signal} after {kind} {step} ({when})")
 
 
 class StopRequest:

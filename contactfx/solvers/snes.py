@@ -146,7 +146,10 @@ class _KeptPreconditioner:
     PCSetUp compares the matrix state). ``coupled``: J's pattern may grow between refreshes
     (a two-body coupling's search). ``every_solve`` False: not refreshed at a solve's first
     iteration either (a dynamic run's steps, whose Jacobian changes with the contact status
-    only); ``stale``: refreshed at the next Jacobian (the bulk was re-assembled)."""
+    only); ``stale``: refreshed at the next Jacobian (the bulk was re-assembled). A
+    checkpoint holds P's values (a restarted run factorises the same matrix)."""
+
+    checkpoint_values = ("P",)
 
     def __init__(
         self,
@@ -545,16 +548,17 @@ class ContactSNES:
         self._unconstrained_residual(x, R, search=False)
         return R
 
-    def reassemble_bulk(self) -> None:
+    def reassemble_bulk(self, keep_preconditioner: bool = False) -> None:
         """The bulk's forms changed their constants (a dynamic stepper's step size): K is
         assembled again (the kept block of the reduced system with it) and the preconditioner
-        is set up anew at the next solve."""
+        is set up anew at the next solve. ``keep_preconditioner``: K is assembled for the
+        values its forms had already (a restarted run's bulk), a kept preconditioner stays."""
         t0 = time.perf_counter()
         self.bulk.reassemble()
         K = self.bulk.jacobian(_compat.petsc_vec(self.u))
         if self.reduced is not None and self.bulk.constant_jacobian:
             self.reduced.bulk_block(K)
-        if self.kept is not None:
+        if self.kept is not None and not keep_preconditioner:
             self.kept.stale = True
         self.snes.getKSP().getPC().reset()
         self.timer.assembly += time.perf_counter() - t0

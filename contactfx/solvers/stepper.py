@@ -300,7 +300,7 @@ def march(
             PETSc.garbage_cleanup(solver.u.function_space.mesh.comm)
             signum = stop.requested() if stop is not None else 0
             if signum and not stepper.done():
-                raise Interrupted(signum, stepper.step, t, records)
+                raise Interrupted(signum, stepper.step, t, records, stepper.describe(t))
     finally:
         stepper.destroy()
     return records

@@ -57,7 +57,7 @@ class Oscillator:
     def set_mass_factor(self, c: float) -> None:
         self.c = c
 
-    def reassemble(self) -> None:
+    def reassemble(self, keep_preconditioner: bool = False) -> None:
         self.reassembled += 1
 
     def initial_acceleration(self, x, a) -> None:
