@@ -11,9 +11,9 @@ and its wrappers, the stepper, the scene) by :func:`capture`: every dolfinx Func
 values, every Constant's, every PETSc vector's owned values, the nonzero pattern of the
 matrices an object names in its ``checkpoint_patterns`` (:func:`_grow`: a two-body
 Jacobian's) and the values of those it names in ``checkpoint_values`` (a kept
-preconditioner's matrix), and the plain data (but the attributes it names in ``checkpoint_skip``: this
-run's clock, not state) (numbers,
-arrays, tuples, lists and dicts of them) of every contactfx object they hold, by attribute
+preconditioner's matrix), and the plain data (but the attributes it names in
+``checkpoint_skip``: this run's clock, not state) (numbers, arrays, tuples, lists and dicts
+of them) of every contactfx object they hold, by attribute
 path. :func:`restore` puts them back into the same objects of a run built again from the
 same input, so a restarted run continues with the same bits: the unknowns, multipliers,
 friction histories, the couplings' closed sets and slip histories, the stepper's last two
