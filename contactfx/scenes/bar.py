@@ -18,7 +18,7 @@ from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import interval
 from contactfx.params import param
 from contactfx.scenes import export
-from contactfx.scenes._common import fix
+from contactfx.scenes._common import fix, no_problem_file
 from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["Bar1D"]
@@ -138,10 +138,7 @@ class BarImpact(ObstacleScene):
         return fix(V, facet_tags, LEFT)
 
     def problem_data(self, numerics) -> dict:
-        raise ValueError(
-            f"scene '{self.name}': problem files carry no time integration yet (no [dynamics] "
-            "section); run the scene itself"
-        )
+        raise no_problem_file(self.name)
 
     def initial_guess(self, u, t: float) -> None:
         """The initial state U(X, 0) = -(1 + X) / 2 (a dynamic run's, not a guess)."""

@@ -19,6 +19,7 @@ from contactfx.contact.obstacles import Floor, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import DiscFacets, disc
 from contactfx.params import param
+from contactfx.scenes._common import no_problem_file
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["DiscDrop"]
@@ -77,7 +78,4 @@ class DiscDrop(ObstacleScene):
         }
 
     def problem_data(self, numerics) -> dict:
-        raise ValueError(
-            f"scene '{self.name}': problem files carry no time integration yet (no [dynamics] "
-            "section); run the scene itself"
-        )
+        raise no_problem_file(self.name)

@@ -20,6 +20,7 @@ from contactfx.contact.obstacles import Floor, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
+from contactfx.scenes._common import no_problem_file
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["SlidingStop"]
@@ -139,7 +140,4 @@ class SlidingStop(ObstacleScene):
         return out
 
     def problem_data(self, numerics) -> dict:
-        raise ValueError(
-            f"scene '{self.name}': problem files carry no time integration yet (no [dynamics] "
-            "section); run the scene itself"
-        )
+        raise no_problem_file(self.name)

@@ -44,7 +44,7 @@ from dataclasses import dataclass
 from petsc4py import PETSc
 
 from contactfx.solvers.snes import SolveStats
-from contactfx.solvers.stepper import Snapshot, StepRecord
+from contactfx.solvers.stepper import CutBack, Snapshot, StepRecord
 
 __all__ = ["Scheme", "SCHEMES", "Dynamic"]
 
@@ -88,7 +88,7 @@ class Scheme:
         return (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
 
 
-class Dynamic:
+class Dynamic(CutBack):
     """The time steps t = dt, 2 dt, ..., t_end of a :class:`Scheme` (see the module
     docstring): holds u_n, v_n, a_n, sets the inertia load a* and the mass factor c for each
     step, and on a converged step computes u_{n+1}, v_{n+1}, a_{n+1}. A failed step is retried
@@ -228,16 +228,6 @@ class Dynamic:
             self.dt = min(self.dt_base, 2.0 * self.dt)
         self.cutbacks = 0
         return record
-
-    def cut_back(self) -> bool:
-        self.cutbacks += 1
-        if self.cutbacks > self.max_cutbacks or 0.5 * self.dt < self.dt_min * (1.0 - 1e-12):
-            return False
-        self.dt *= 0.5
-        return True
-
-    def restore(self) -> None:
-        self.previous.restore()
 
     def describe(self, t: float) -> str:
         return f"time {t:.6g}"

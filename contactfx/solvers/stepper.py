@@ -29,7 +29,15 @@ from contactfx import _compat
 from contactfx.solvers.interrupt import Interrupted, StopRequest
 from contactfx.solvers.snes import ConvergenceError, SolveStats, TimeLimitExceeded
 
-__all__ = ["StepRecord", "Snapshot", "Stepper", "QuasiStatic", "march", "run_load_program"]
+__all__ = [
+    "StepRecord",
+    "Snapshot",
+    "Stepper",
+    "CutBack",
+    "QuasiStatic",
+    "march",
+    "run_load_program",
+]
 
 
 @dataclass
@@ -118,7 +126,28 @@ class Stepper(Protocol):
     def destroy(self) -> None: ...
 
 
-class QuasiStatic:
+class CutBack:
+    """What the steppers share on a failed step: halve the step, up to ``max_cutbacks`` in a
+    row and never below ``dt_min``, and put back the last accepted state (``previous``)."""
+
+    dt: float
+    dt_min: float
+    cutbacks: int
+    max_cutbacks: int
+    previous: Snapshot
+
+    def cut_back(self) -> bool:
+        self.cutbacks += 1
+        if self.cutbacks > self.max_cutbacks or 0.5 * self.dt < self.dt_min * (1.0 - 1e-12):
+            return False
+        self.dt *= 0.5
+        return True
+
+    def restore(self) -> None:
+        self.previous.restore()
+
+
+class QuasiStatic(CutBack):
     """Load factors t = 1/steps, 2/steps, ..., 1.
 
     Each step but the first starts from the secant extrapolation of the last two converged
@@ -224,16 +253,6 @@ class QuasiStatic:
                 self.dt = min(self.max_increment, self.growth * self.dt)
         self.cutbacks = 0
         return record
-
-    def cut_back(self) -> bool:
-        self.cutbacks += 1
-        if self.cutbacks > self.max_cutbacks or 0.5 * self.dt < self.dt_min * (1.0 - 1e-12):
-            return False
-        self.dt *= 0.5
-        return True
-
-    def restore(self) -> None:
-        self.previous.restore()
 
     def describe(self, t: float) -> str:
         return f"load factor {t:.6g}"
