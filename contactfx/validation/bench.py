@@ -191,6 +191,14 @@ CASES: dict[str, BenchCase] = {
     # the load steps, Newton iterations, times, memory and the equilibrium of the reactions
     # with the contact force. Level 1 is the scene's default mesh (penalty only); level 3
     # (about 100k dofs) is for --solver gamg on 2 ranks (--levels 4)
+    # implicit dynamics (no closed form at the levels: the columns to read are the time and
+    # Newton iterations per time step and the energy balance's largest remainder)
+    "disc-drop": BenchCase(
+        "disc-drop", {}, 1.0, "disc dropped on a plane, Nitsche, Newmark, t in [0, 40]"
+    ),
+    "sliding-stop": BenchCase(
+        "sliding-stop", {}, 1.0, "block stopped by Coulomb friction (v0^2 / (2 mu g))"
+    ),
     "sphere-slide": BenchCase(
         "sphere-slide",
         {},
@@ -317,6 +325,12 @@ def run_case(
         t_run=t["assembly"] + t["solve"],
         memory_mib=res.memory_mib,
     )
+    if res.energy:  # a dynamic run: per time step, and its energy balance
+        row["t_per_step"] = row["t_run"] / max(len(res.steps), 1)
+        row["newton_per_step"] = res.newton_iterations / max(len(res.steps), 1)
+        row["energy_remainder"] = float(res.energy["largest_remainder_relative"])
+        if "stop_distance_rel_error" in res.reference:
+            row["stop_distance_error"] = float(res.reference["stop_distance_rel_error"])
     if "contact" in t:  # two bodies: search + contact terms against bulk assembly + solve
         row["t_contact"] = t["contact"]
         row["contact_over_bulk"] = t["contact"] / max(row["t_run"] - t["contact"], 1e-12)
@@ -446,6 +460,8 @@ def run_bench(
                             row = again
                     # the yardstick: obstacle scenes and two bodies (not the interfaces)
                     yardstick = hasattr(scene, "contact_tag") or hasattr(scene, "body_material")
+                    # (not a dynamic run: a free body has no static linear solve)
+                    yardstick = yardstick and not (num is not None and num.dynamic)
                     if row["status"] == "ok" and linear and yardstick:
                         lin = min(
                             linear_elastic_time(scene, degree, comm, solver)[0]

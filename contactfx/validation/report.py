@@ -115,6 +115,10 @@ VALUE_COLUMNS = (
     ("contact_over_linear", "contact over linear"),
     ("newton_over_linear", "Newton over linear"),
     ("speedup", "speedup"),
+    ("t_per_step", "time per step"),
+    ("newton_per_step", "Newton per step"),
+    ("energy_remainder", "energy remainder"),
+    ("stop_distance_error", "stop distance error"),
 )
 
 
