@@ -37,7 +37,7 @@ from petsc4py import PETSc
 from contactfx import _compat
 from contactfx.driver.fields import global_sum, surface_mask, vertex_rule
 
-__all__ = ["Inertia", "EnergyLedger"]
+__all__ = ["Inertia", "EnergyLedger", "plot_contact"]
 
 
 class Inertia:
@@ -293,3 +293,25 @@ class EnergyLedger:
     def destroy(self) -> None:
         for v in (self.f, self.f_prev, self.u_prev):
             v.destroy()
+
+
+def plot_contact(times: list[float], force: list[float], peak: list[float], path: Path) -> Path:
+    """contact.png: a dynamic run's contact force and peak contact pressure over time (the
+    impacts, the contact phases, the chatter of a consistent mass). Rank 0."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    axes[0].plot(times, force, lw=1.0)
+    axes[0].set_ylabel("contact force")
+    axes[1].plot(times, peak, lw=1.0, color="C3")
+    axes[1].set_ylabel("peak contact pressure")
+    axes[1].set_xlabel("time")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

@@ -24,7 +24,7 @@ from mpi4py import MPI
 
 from contactfx import _compat
 from contactfx.contact.registry import methods_supporting
-from contactfx.driver.inertia import EnergyLedger, initial_acceleration
+from contactfx.driver.inertia import EnergyLedger, initial_acceleration, plot_contact
 from contactfx.driver.nested import NestedSolver, nested_levels
 from contactfx.driver.restart import Checkpoints, Restart, run_identity
 from contactfx.io.checkpoint import CHECKPOINT
@@ -626,6 +626,14 @@ class _Run:
         )
         if self.energy is not None and self.out is not None:
             self.energy.write(self.out)
+            if self.comm.rank == 0:
+                q = [s.quantities for s in steps]
+                plot_contact(
+                    [s.load for s in steps],
+                    [x.force for x in q],
+                    [x.peak_pressure for x in q],
+                    self.out / "contact.png",
+                )
         if self.out is not None:
             write_json(self.out / "run.json", summary.to_json(), self.comm)
         return summary
