@@ -37,7 +37,11 @@ class Probe(BarImpact):
     """bar-impact recording the contact node's displacement at every step."""
 
     def on_step(self, problem, solver, load, q) -> None:
-        V0, to = problem.state.function_space.sub(0).collapse()
+        V = problem.state.function_space
+        if V.num_sub_spaces == 0:  # a one-component space (1D on dolfinx 0.9)
+            V0, to = V, np.arange(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts)
+        else:
+            V0, to = V.sub(0).collapse()
         x = _compat.dof_coordinates(V0)[:, 0]
         near = np.flatnonzero(np.isclose(x, 0.0))
         local = [problem.state.x.array[to[i]] for i in near if to[i] < _owned(problem)]
