@@ -46,6 +46,7 @@ class Obstacle:
     """Base class: subclasses define ``phi`` (UFL) and ``height`` (NumPy)."""
 
     vertical: bool = False  # gap measured along e_d, pressure along e_d
+    below: bool = False  # below its body (a floor): the reported force is along -e_d
 
     def phi(self, y: Expr) -> Expr:
         raise NotImplementedError
@@ -88,7 +89,6 @@ class Floor(Obstacle):
     nowhere)."""
 
     level: float = 0.0
-    #: below its body: the contact force the post-processing reports is along -e_d
     below = True
 
     def phi(self, y: Expr) -> Expr:

@@ -74,7 +74,6 @@ class Inertia:
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.a_star = dolfinx.fem.Function(W, name="inertia_load")
         self.c = dolfinx.fem.Constant(problem.mesh, 0.0)
-        self.mesh = problem.mesh
         self.dx, self.rho = self._mass(problem, rho)
 
     @staticmethod
@@ -199,6 +198,7 @@ class EnergyLedger:
         self.f = _compat.create_vector(load_form)
         self.f_prev = self.f.duplicate()
         self.u_prev = _compat.petsc_vec(self.u).copy()
+        self.du = self.u_prev.duplicate()  # a step's displacement (work vector)
         self.rows: list[dict[str, float]] = []
         self.work = 0.0
 
@@ -210,10 +210,10 @@ class EnergyLedger:
         u = _compat.petsc_vec(self.u)
         self._load(self.f)
         if self.rows:  # W += 1/2 (f_n + f_n+1) . (u_n+1 - u_n)
-            du = u.copy()
+            du = self.du
+            u.copy(du)
             du.axpy(-1.0, self.u_prev)
             self.work += 0.5 * (self.f.dot(du) + self.f_prev.dot(du))
-            du.destroy()
         u.copy(self.u_prev)
         self.f.copy(self.f_prev)
         if self.friction is not None and self.rows:
@@ -291,7 +291,7 @@ class EnergyLedger:
         return path
 
     def destroy(self) -> None:
-        for v in (self.f, self.f_prev, self.u_prev):
+        for v in (self.f, self.f_prev, self.u_prev, self.du):
             v.destroy()
 
 

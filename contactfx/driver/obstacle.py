@@ -257,7 +257,7 @@ class ObstaclePost:
         else:
             self.reaction = None
             # the force along e_d the obstacle takes (a floor below the body: along -e_d)
-            n_d = -n[gdim - 1] if getattr(pb.obstacle, "below", False) else n[gdim - 1]
+            n_d = -n[gdim - 1] if pb.obstacle.below else n[gdim - 1]
             self.force_form = dolfinx.fem.form(p * n_d * pb.dsc)
             self.p_form = self.nodal.form(p)
             closed = method.contact_indicator(s)

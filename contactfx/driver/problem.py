@@ -385,12 +385,12 @@ class Problem:
             )
         L = self.extra_load(L)
         #: the compiled external load f_ext (a dynamic run's energy balance reads it)
-        self.load_form = dolfinx.fem.form(L)
-        if self.inertia is not None:  # + M a*
-            L = L + self.inertia.load_term(self.V_test)
+        self.load_form = load = dolfinx.fem.form(L)
+        if self.inertia is not None:  # the bulk's load: + M a*
+            load = dolfinx.fem.form(L + self.inertia.load_term(self.V_test))
         # two bodies: no UFL surface, the contact terms are the solver's coupling
         F = None if self.surface is None else self.contact_residual()
-        bulk = self.bulk(dolfinx.fem.form(L))
+        bulk = self.bulk(load)
         if F is None:
             return Forms(bulk, None, None)
         J = ufl.derivative(F, self.state, self.trial)
