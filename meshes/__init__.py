@@ -85,6 +85,7 @@ from contactfx.meshes.two_body import (
 #: ``mesh.builder``) with their dimension
 BUILDERS = {
     "interval": (interval, 1),
+    "disc": (disc, 2),
     "rectangle": (rectangle, 2),
     "box": (box, 3),
     "crack-plate": (crack_plate, 2),

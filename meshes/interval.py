@@ -1,4 +1,4 @@
-"""The interval [0, length] with ``cells`` equal elements (a 1D bar)."""
+"""The interval [x0, x0 + length] with ``cells`` equal elements (a 1D bar)."""
 
 from __future__ import annotations
 
@@ -26,13 +26,13 @@ class IntervalFacets(IntEnum):
     RIGHT = 2
 
 
-def interval(model: type[gmsh.model], *, length: float, cells: int) -> None:
-    """Build and mesh [0, length] with ``cells`` elements of equal size in ``model``; the end
-    points are the physical groups ``left`` and ``right``, the line ``bar``."""
-    check_finite(length=length)
+def interval(model: type[gmsh.model], *, length: float, cells: int, x0: float = 0.0) -> None:
+    """Build and mesh [x0, x0 + length] with ``cells`` elements of equal size in ``model``;
+    the end points are the physical groups ``left`` and ``right``, the line ``bar``."""
+    check_finite(length=length, x0=x0)
     check_positive(length=length, cells=cells)
-    left = model.geo.addPoint(0.0, 0.0, 0.0)
-    right = model.geo.addPoint(length, 0.0, 0.0)
+    left = model.geo.addPoint(x0, 0.0, 0.0)
+    right = model.geo.addPoint(x0 + length, 0.0, 0.0)
     line = model.geo.addLine(left, right)
     model.geo.mesh.setTransfiniteCurve(line, int(cells) + 1)
     model.geo.synchronize()

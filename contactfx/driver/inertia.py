@@ -66,9 +66,11 @@ class Inertia:
         if rho is None:
             raise ValueError(
                 f"--dynamic needs the body's density: scene '{problem.scene.name}' gives none "
-                "(the dynamic scenes bar-impact, disc-drop and sliding-stop do)"
+                "(the dynamic scenes bar-impact, disc-drop and sliding-stop do; a problem "
+                "file gives it per body, with [dynamics])"
             )
-        self.rho = rho
+        field = problem.scene.density_field(problem.mesh)
+        rho = rho if field is None else field
         W = problem.state.function_space
         self.v = dolfinx.fem.Function(W, name="velocity")
         self.a = dolfinx.fem.Function(W, name="acceleration")
@@ -77,7 +79,7 @@ class Inertia:
         self.dx, self.rho = self._mass(problem, rho)
 
     @staticmethod
-    def _mass(problem: Any, rho: float) -> tuple[ufl.Measure, Any]:
+    def _mass(problem: Any, rho: Any) -> tuple[ufl.Measure, Any]:
         """The mass's measure and density (``--mass``): consistent (dx, rho); lumped (the
         P1 cells' vertex rule: M_ii = the row sums); redistributed (lumped, with the density
         weighted by (1 - chi) / (1 - mean_K chi) at the vertices of cell K, chi the indicator

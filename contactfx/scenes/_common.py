@@ -16,7 +16,6 @@ __all__ = [
     "fix_component",
     "prescribe_component",
     "reaction_forces",
-    "no_problem_file",
 ]
 
 
@@ -78,12 +77,3 @@ def reaction_forces(V, facet_tags, tags: dict, reactions, scale=1.0) -> dict:
             total[c] = float(np.sum(values[dofs[dofs < n_owned]]))
         out[name] = comm.allreduce(total, op=MPI.SUM) * scale + 0.0  # no -0.0
     return out
-
-
-def no_problem_file(name: str) -> ValueError:
-    """The refusal of ``contactfx init`` for a dynamic scene (problem files have no
-    [dynamics] section yet)."""
-    return ValueError(
-        f"scene '{name}': problem files carry no time integration yet (no [dynamics] "
-        "section); run the scene itself"
-    )

@@ -18,7 +18,7 @@ from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import interval
 from contactfx.params import param
 from contactfx.scenes import export
-from contactfx.scenes._common import fix, no_problem_file
+from contactfx.scenes._common import fix
 from contactfx.scenes.base import ObstacleScene, SceneParams
 
 __all__ = ["Bar1D"]
@@ -137,8 +137,18 @@ class BarImpact(ObstacleScene):
     def dirichlet(self, V, facet_tags):
         return fix(V, facet_tags, LEFT)
 
+    def mesh_builder(self):
+        """The same bar for ``contactfx init`` (the run meshes it with dolfinx: the same
+        vertices, numbered otherwise)."""
+        return functools.partial(interval, length=1.0, cells=self.p.cells, x0=-1.0), 1
+
     def problem_data(self, numerics) -> dict:
-        raise no_problem_file(self.name)
+        return {
+            "bodies": [export.body("bar", self.material(), density=self.material().density)],
+            "boundary": [export.fixed("left", (0,))],
+            "obstacle": {"shape": "plane", "contact": "right", "h": self.h_contact()},
+            "initial": {"displacement": ["-0.5 * (1.0 + x)"]},
+        }
 
     def initial_guess(self, u, t: float) -> None:
         """The initial state U(X, 0) = -(1 + X) / 2 (a dynamic run's, not a guess)."""

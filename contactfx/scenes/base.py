@@ -206,6 +206,11 @@ class ObstacleScene(Scene):
         the homogeneous ``material().E``."""
         return None
 
+    def density_field(self, mesh):
+        """The density as a field over ``mesh`` (UFL) for bodies of different densities, or
+        None for the homogeneous ``material().density``."""
+        return None
+
     def initial_guess(self, u, t: float) -> None:
         """Set a starting state before the first load step (default: zero); a dynamic run's
         initial displacement."""

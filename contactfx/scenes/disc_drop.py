@@ -19,7 +19,7 @@ from contactfx.contact.obstacles import Floor, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import DiscFacets, disc
 from contactfx.params import param
-from contactfx.scenes._common import no_problem_file
+from contactfx.scenes import export
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["DiscDrop"]
@@ -78,4 +78,14 @@ class DiscDrop(ObstacleScene):
         }
 
     def problem_data(self, numerics) -> dict:
-        raise no_problem_file(self.name)
+        p = self.p
+        return {
+            "bodies": [export.body("disc", self.material(), density=p.density)],
+            "obstacle": {
+                "shape": "floor",
+                "contact": "lower",
+                "h": self.h_contact(),
+                "position": [0.0, -p.drop],
+            },
+            "dynamics": {"gravity": [0.0, -p.gravity]},
+        }

@@ -20,6 +20,7 @@ from mpi4py import MPI
 from contactfx.io.toml import dumps
 from contactfx.meshes import write_msh
 from contactfx.numerics import Numerics
+from contactfx.scenes.problem_file.sections import DYNAMICS_NUMERICS
 from contactfx.scenes.problem_file.specs import SECTIONS
 
 __all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
@@ -37,6 +38,19 @@ def numerics_table(numerics: Numerics) -> dict:
         if f.name in ("method", "steps") or value != getattr(default, f.name):
             out[f.name] = value
     return out
+
+
+def _numerics_tables(numerics: Numerics, dynamics: dict | None) -> dict:
+    """``[numerics]``, and for a dynamic run ``[dynamics]``: the scene's table (gravity,
+    initial velocity) with the time scheme, step and end time of the numerics (a [dynamics]
+    section makes the run dynamic)."""
+    table = numerics_table(numerics)
+    if not numerics.dynamic:
+        return {"numerics": table}
+    table.pop("dynamic")
+    table.pop("steps")  # a dynamic run steps in time
+    timing = {k: table.pop(k) for k in DYNAMICS_NUMERICS if k in table}
+    return {"dynamics": {**timing, **(dynamics or {})}, "numerics": table}
 
 
 def write_problem(
@@ -63,7 +77,7 @@ def write_problem(
                     **({"axisymmetric": True} if scene.axisymmetric else {}),
                 },
                 **tables,
-                "numerics": numerics_table(numerics),
+                **_numerics_tables(numerics, tables.get("dynamics")),
             }
             doc = {k: doc[k] for k in ORDER if k in doc}
             head = (

@@ -20,7 +20,7 @@ from contactfx.contact.obstacles import Floor, Obstacle
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import RectangleFacets, rectangle
 from contactfx.params import param
-from contactfx.scenes._common import no_problem_file
+from contactfx.scenes import export
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["SlidingStop"]
@@ -140,4 +140,14 @@ class SlidingStop(ObstacleScene):
         return out
 
     def problem_data(self, numerics) -> dict:
-        raise no_problem_file(self.name)
+        p = self.p
+        k = (1.0 - p.nu**2) * p.density * p.gravity / p.E
+        return {
+            "bodies": [export.body("domain", self.material(), density=p.density)],
+            "obstacle": {"shape": "floor", "contact": "bottom", "h": p.h},
+            "initial": {"displacement": ["0.0", f"-{k!r} * ({p.height!r} * y - 0.5 * y ** 2)"]},
+            "dynamics": {
+                "gravity": [0.0, -p.gravity],
+                "initial_velocity": {"domain": [p.speed, 0.0]},
+            },
+        }

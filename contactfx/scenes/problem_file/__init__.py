@@ -32,7 +32,8 @@ force is then the full model's, 2^n times the model's along the planes, 0 normal
     amplitude = [[0.0, 0.0], [1.0, 1.0]]   # (load factor, multiplier) pairs; default t
 
     [obstacle]
-    shape = "plane"                    # plane, circle / cylinder (2D), sphere (3D)
+    shape = "plane"                    # plane, circle / cylinder (2D), sphere (3D); floor:
+                                       # a plane below its body (a body dropped on it)
     contact = "top"
     position = [0.0, 0.0]              # the obstacle's lowest point at the start
     motion = [0.0, -0.01]              # its rigid displacement at the end of the program
@@ -52,6 +53,13 @@ proppant_thickness with an optional proppant_zone, joint, h, origin, direction) 
 obstacle; a plate held by tractions only takes ``[[pins]]`` (point: a mesh vertex, fix), and a
 boundary may carry the traction sigma n of a ``stress`` tensor (numbers or expressions in x, y,
 z) integrated with its ``quadrature_degree``.
+
+A ``[dynamics]`` section makes the run dynamic (against an obstacle): ``dt``, ``t_end``,
+``scheme``, ``rho_inf`` and ``mass`` as the numerics of the same names, ``gravity`` (an
+acceleration: rho g on each body, constant in time) and ``initial_velocity`` (per body, ``{
+ball = [0.0, -1.0] }``, or a field of expressions in x, y, z); each body then needs its
+``density`` in ``[[bodies]]``, and ``[initial] displacement`` is the initial state. The
+obstacle shape ``floor`` is the plane below its body, through ``position``.
 
 Groups are the gmsh physical names. Everything is validated before anything is computed: an
 unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error

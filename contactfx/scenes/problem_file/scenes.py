@@ -17,11 +17,13 @@ from contactfx import _compat
 from contactfx.contact.obstacles import (
     Ball,
     FlatPunch,
+    Floor,
     HalfSpace,
     Obstacle,
     Paraboloid,
     Sinusoid,
 )
+from contactfx.mechanics.axisymmetric import measure
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import BUILDERS, build_file, build_grouped, builder_groups
 from contactfx.params import Params, param
@@ -155,6 +157,7 @@ class _FileMesh:
                 self._fail(f"pins.{i}.fix", f"component z in a {self.gdim}D problem")
         for name, (group, _) in pb.output.mean_displacement.items():
             self.tag(f"output.mean_displacement.{name}", group, fdim)
+        self._check_dynamics()
         touching = set() if pb.pair is None else {pb.pair.slave, pb.pair.master}
         if pb.obstacle is not None:
             touching.add(pb.obstacle.contact)
@@ -168,6 +171,7 @@ class _FileMesh:
                 )
         if (
             pb.pair is None
+            and pb.dynamics is None  # in time, its mass holds it
             and not pb.pins
             and not any(b.fix or b.displacement for b in pb.boundary)
         ):
@@ -175,13 +179,30 @@ class _FileMesh:
                 "boundary",
                 "the body has no support (fix or displacement on a group): "
                 "frictionless contact alone leaves it free to slide, the solve would be "
-                "singular",
+                "singular (a free body needs [dynamics]: its mass holds it)",
             )
         for i, g in enumerate(pb.output.reactions):
             self.tag(f"output.reactions.{i}", g, fdim)
         for i, q in enumerate(pb.output.probes):
             if len(q) != self.gdim:
                 self._fail(f"output.probes.{i}", f"expected {self.gdim} coordinates, got {list(q)}")
+
+    def _check_dynamics(self) -> None:
+        """The [dynamics] vectors against the mesh's dimension."""
+        dyn = self.spec.dynamics
+        if dyn is None:
+            return
+        vectors = {f"initial_velocity.{g}": v for g, v in dyn.velocity.items()}
+        if dyn.gravity is not None:
+            vectors["gravity"] = dyn.gravity
+        if dyn.velocity_field is not None:
+            vectors["initial_velocity"] = dyn.velocity_field
+        for key, value in vectors.items():
+            if len(value) != self.gdim:
+                self._fail(
+                    f"dynamics.{key}",
+                    f"expected {self.gdim} components (a {self.gdim}D mesh), got {len(value)}",
+                )
 
     # -- supports and loads -----------------------------------------------------------------
     def dirichlet(self, V, facet_tags) -> list:
@@ -204,8 +225,9 @@ class _FileMesh:
         return bcs
 
     def load(self, v, ds, t):
-        L = None
-        dx = ufl.Measure("dx", domain=self._mesh, subdomain_data=self.cell_tags)
+        L = self._gravity(v)
+        # weighted by r on an axisymmetric section, as the bulk's and the mass's integrals
+        dx = measure("dx", self._mesh, self.axisymmetric, subdomain_data=self.cell_tags)
         for i, body in enumerate(self.spec.bodies):
             if body.force is None:
                 continue
@@ -240,6 +262,19 @@ class _FileMesh:
             L = form if L is None else L + form
         return L
 
+    def _gravity(self, v):
+        """rho g . v over each body: ``dynamics.gravity``, constant in time (None without)."""
+        dyn = self.spec.dynamics
+        if dyn is None or dyn.gravity is None:
+            return None
+        dx = measure("dx", self._mesh, self.axisymmetric, subdomain_data=self.cell_tags)
+        g = ufl.as_vector(dyn.gravity.tolist())
+        terms = [
+            body.material.density * ufl.dot(g, v) * dx(self.groups[body.group].tag)
+            for body in self.spec.bodies
+        ]
+        return sum(terms[1:], terms[0])
+
     def set_load(self, t: float) -> None:
         for const, table, value in self._constants:
             const.value = value * amplitude_at(table, t)
@@ -260,19 +295,19 @@ class _FileMesh:
 
     def initial_guess(self, u, t: float) -> None:
         """The file's ``initial.displacement`` (expressions in x, y, z), else zero."""
-        exprs = self.spec.initial
-        if exprs is None:
-            return
+        if self.spec.initial is not None:
+            self._interpolate(u, self.spec.initial, "initial.displacement")
+
+    def _interpolate(self, u, exprs, key: str) -> None:
+        """``u`` = the expressions in x, y, z (one per component)."""
         if len(exprs) != self.gdim:
-            self._fail(
-                "initial.displacement", f"expected {self.gdim} expressions, got {len(exprs)}"
-            )
+            self._fail(key, f"expected {self.gdim} expressions, got {len(exprs)}")
         x = ufl.SpatialCoordinate(self._mesh)
         y = ufl.as_vector([x[i] for i in range(self.gdim)])
-        values = [e(y) for e in exprs]
-        values = [
-            v if isinstance(v, ufl.core.expr.Expr) else ufl.as_ufl(v) + 0.0 * x[0] for v in values
-        ]
+        # a zero Constant on the mesh: UFL folds 0 * x away, and an expression of constants
+        # alone (a uniform field) would have no domain to interpolate on
+        zero = dolfinx.fem.Constant(self._mesh, 0.0)
+        values = [e(y) + zero * x[0] for e in exprs]
         u.interpolate(_compat.expression(ufl.as_vector(values), u.function_space))
 
     def _facet_points(self, mesh, facets: np.ndarray) -> np.ndarray:
@@ -418,13 +453,38 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
     def modulus(self, mesh):
         if len(self.spec.bodies) == 1:
             return None
+        return self._per_body(mesh, [b.material.E for b in self.spec.bodies])
+
+    def _per_body(self, mesh, values: list[float]):
+        """A DG0 field with each body's value on its cells."""
         DG0 = _compat.function_space(mesh, "DG", 0)
-        E = dolfinx.fem.Function(DG0)
-        for tag, body in zip(self.body_tags, self.spec.bodies, strict=True):
+        f = dolfinx.fem.Function(DG0)
+        for tag, value in zip(self.body_tags, values, strict=True):
             cells = self.cell_tags.indices[self.cell_tags.values == tag]
-            E.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = body.material.E
-        E.x.scatter_forward()
-        return E
+            f.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = value
+        f.x.scatter_forward()
+        return f
+
+    def density_field(self, mesh):
+        """Each body's density as a DG0 field when they differ (None: one density)."""
+        if len({b.material.density for b in self.spec.bodies}) < 2:
+            return None
+        return self._per_body(mesh, [b.material.density for b in self.spec.bodies])
+
+    def initial_velocity(self, v) -> None:
+        """``dynamics.initial_velocity``: per body, its vector on the body's cells (a node
+        shared by two bodies takes the later body's), or a field of expressions in x, y, z."""
+        dyn = self.spec.dynamics
+        if dyn is None:
+            return
+        if dyn.velocity_field is not None:
+            self._interpolate(v, dyn.velocity_field, "dynamics.initial_velocity")
+            return
+        tags = dict(zip((b.group for b in self.spec.bodies), self.body_tags, strict=True))
+        for group, value in dyn.velocity.items():
+            cells = self.cell_tags.indices[self.cell_tags.values == tags[group]]
+            v.interpolate(_constant(value), cells)
+        v.x.scatter_forward()
 
     def contact_modulus(self) -> float:
         """The modulus of the body at the contact surface (the largest, if several touch)."""
@@ -434,6 +494,8 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         ob = self.spec.obstacle
         if ob.shape == "plane":
             return HalfSpace(0.0)
+        if ob.shape == "floor":  # the plane below its body, through position
+            return Floor(0.0)
         if ob.shape == "distance":
             return DistanceObstacle(ob.distance)
         if ob.shape in ("parabola", "paraboloid"):
@@ -690,3 +752,12 @@ class FileInterfaceScene(_FileMesh, InterfaceScene):
 def _compat_exterior(mesh) -> np.ndarray:
     """The exterior facets of this rank (local indices)."""
     return np.asarray(dolfinx.mesh.exterior_facet_indices(mesh.topology), dtype=np.int32)
+
+
+def _constant(value: np.ndarray):
+    """The interpolation callable of a constant vector."""
+
+    def f(x: np.ndarray) -> np.ndarray:
+        return np.tile(np.asarray(value, dtype=np.float64)[:, None], (1, x.shape[1]))
+
+    return f

@@ -32,6 +32,7 @@ from contactfx.scenes.problem_file.specs import (
     SECTIONS,
     BodySpec,
     BoundarySpec,
+    DynamicsSpec,
     InterfaceSpec,
     MeshSpec,
     ObstacleSpec,
@@ -41,6 +42,7 @@ from contactfx.scenes.problem_file.specs import (
     ProblemFile,
 )
 from contactfx.scenes.two_body_base import CONTACT_EDGES, INTERFERENCES, SMOOTHINGS
+from contactfx.solvers.dynamics import Scheme
 
 __all__ = ["SECTIONS", "KEYS", "SHAPES", "CONTACT_SIZES", "read", "check_materials"]
 
@@ -57,6 +59,7 @@ KEYS = {
         "c01",
         "body_force",
         "amplitude",
+        "density",
     ),
     "boundary": (
         "group",
@@ -104,6 +107,7 @@ KEYS = {
         "direction",
     ),
     "initial": ("displacement",),
+    "dynamics": ("scheme", "rho_inf", "dt", "t_end", "mass", "gravity", "initial_velocity"),
     "output": (
         "reactions",
         "probes",
@@ -118,6 +122,7 @@ KEYS = {
 OUTPUT_FORMATS = ("xdmf", "vtu")
 SHAPES = (
     "plane",
+    "floor",
     "circle",
     "cylinder",
     "sphere",
@@ -192,11 +197,13 @@ def _check_finite_strain(r: Reader, bodies: tuple[BodySpec, ...], kind: str) -> 
 def _material(r: Reader, b: dict, key: str) -> Elastic | Hyperelastic:
     """A body's material: ``material`` (linear, the default; neo-hookean, mooney-rivlin,
     svk) with its parameters (linear and svk: E, nu; neo-hookean: E, nu or mu, kappa;
-    mooney-rivlin: c10, c01 (default 0), kappa). Each body has its own: a problem with a
+    mooney-rivlin: c10, c01 (default 0), kappa) and its ``density`` (a dynamic run's mass
+    per unit volume). Each body has its own: a problem with a
     hyperelastic body is finite strain, and a linear body in a finite-strain pair keeps its
     small-strain stress (:mod:`contactfx.driver.two_body`)."""
     model = r.string(b, key, "material", tuple(MODELS), default="linear")
     allowed = MODELS[model]
+    kw = {"density": r.optional_number(b, key, "density", positive=True)}
     for k in ("E", "nu", "mu", "kappa", "c10", "c01"):
         if k in b and k not in allowed:
             r.fail(
@@ -211,22 +218,22 @@ def _material(r: Reader, b: dict, key: str) -> Elastic | Hyperelastic:
                 r.fail(f"{key}.{name}", f"must be >= 0, got {value}")
         if not c10 + c01 > 0.0:
             r.fail(f"{key}.c10", "c10 + c01 (half the shear modulus) must be > 0")
-        return MooneyRivlin(c10, c01, r.number(b, key, "kappa", positive=True))
+        return MooneyRivlin(c10, c01, r.number(b, key, "kappa", positive=True), **kw)
     if model == "neo-hookean" and ("mu" in b or "kappa" in b):
         for k in ("E", "nu"):
             if k in b:
                 r.fail(f"{key}.{k}", "give E and nu, or mu and kappa, not both")
         mu = r.number(b, key, "mu", positive=True)
-        return NeoHookean.from_mu_kappa(mu, r.number(b, key, "kappa", positive=True))
+        return NeoHookean.from_mu_kappa(mu, r.number(b, key, "kappa", positive=True), **kw)
     E = r.number(b, key, "E", positive=True)
     nu = r.number(b, key, "nu")
     if not -1.0 < nu < 0.5:
         r.fail(f"{key}.nu", f"Poisson's ratio must be in (-1, 0.5), got {nu}")
     if model == "neo-hookean":
-        return NeoHookean.from_E_nu(E, nu)
+        return NeoHookean.from_E_nu(E, nu, **kw)
     if model == "svk":
-        return SaintVenantKirchhoff.from_E_nu(E, nu)
-    return Elastic(E, nu)
+        return SaintVenantKirchhoff.from_E_nu(E, nu, **kw)
+    return Elastic(E, nu, **kw)
 
 
 def _boundary(r: Reader, b: Any, key: str) -> BoundarySpec:
@@ -521,6 +528,86 @@ def read_initial(r: Reader, data: dict) -> tuple | None:
         r.fail("initial.displacement", str(err))
 
 
+#: the keys of [dynamics] that are numerics (Numerics's fields of the same name)
+DYNAMICS_NUMERICS = ("scheme", "rho_inf", "dt", "t_end", "mass")
+_CHOICES = {f.name: f.metadata["choices"] for f in dataclasses.fields(Numerics)}
+
+
+def read_dynamics(
+    r: Reader, data: dict, bodies: tuple[BodySpec, ...], kind: str
+) -> tuple[DynamicsSpec | None, dict]:
+    """``[dynamics]`` (the file's run is then dynamic): its spec and its numerics (the time
+    scheme, rho_inf, dt, t_end, the mass matrix); each body needs its density. Offered
+    against an obstacle (two bodies and interfaces in time are not yet)."""
+    if "dynamics" not in data:
+        return None, {}
+    d = r.table(data["dynamics"], "dynamics", KEYS["dynamics"])
+    if kind != "obstacle":
+        r.fail(
+            "dynamics",
+            f"a dynamic run is offered against an [obstacle]; a problem with "
+            f"{'a [[contact]] pair' if kind == 'contact' else 'an [interface]'} is static",
+        )
+    for i, b in enumerate(bodies):
+        if b.material.density is None:
+            r.fail(
+                f"bodies.{i}.density",
+                "missing: a dynamic run ([dynamics]) needs each body's density (mass per unit "
+                "volume)",
+            )
+    numerics: dict[str, Any] = {"dynamic": True}
+    for k in DYNAMICS_NUMERICS:
+        if k not in d:
+            continue
+        if k in data.get("numerics", {}):
+            r.fail(f"numerics.{k}", f"given in [dynamics] too: give dynamics.{k} only")
+        if k in ("scheme", "mass"):
+            numerics[k] = r.string(d, "dynamics", k, _CHOICES[k])
+        else:
+            numerics[k] = r.number(d, "dynamics", k, positive=k != "rho_inf")
+    try:  # rho_inf's range for the scheme, one line naming the key
+        Scheme.named(numerics.get("scheme", "newmark"), numerics.get("rho_inf", 1.0))
+    except ValueError as err:
+        r.fail("dynamics.rho_inf", str(err).replace("--rho-inf", "rho_inf").replace("--", ""))
+    if "dt" in numerics and numerics.get("t_end", np.inf) < numerics["dt"] * (1.0 - 1e-12):
+        r.fail("dynamics.t_end", f"must be at least one time step (dt = {numerics['dt']})")
+    gravity = None
+    if "gravity" in d:
+        if not numbers(d["gravity"], (1, 2, 3)):
+            r.fail(
+                "dynamics.gravity", f"expected the acceleration's components, got {d['gravity']!r}"
+            )
+        gravity = np.asarray(d["gravity"], dtype=np.float64)
+    velocity, field = {}, None
+    given = d.get("initial_velocity")
+    if isinstance(given, dict):
+        groups = [b.group for b in bodies]
+        for group, value in given.items():
+            if group not in groups:
+                r.fail(
+                    f"dynamics.initial_velocity.{group}",
+                    f"not a body (the bodies: {', '.join(groups)})",
+                )
+            if not numbers(value, (1, 2, 3)):
+                r.fail(
+                    f"dynamics.initial_velocity.{group}",
+                    f"expected the velocity's components, got {value!r}",
+                )
+            velocity[group] = np.asarray(value, dtype=np.float64)
+    elif isinstance(given, list) and all(isinstance(e, str | int | float) for e in given):
+        try:
+            field = tuple(parse_expression(str(e)) for e in given)
+        except ValueError as err:
+            r.fail("dynamics.initial_velocity", str(err))
+    elif given is not None:
+        r.fail(
+            "dynamics.initial_velocity",
+            "expected a table body = [components] (e.g. { ball = [0.0, -1.0] }) or a list of "
+            f"expressions in x, y, z (one per component), got {given!r}",
+        )
+    return DynamicsSpec(gravity, velocity, field), numerics
+
+
 def read_numerics(r: Reader, data: dict) -> dict:
     """The ``[numerics]`` overrides (checked by Numerics itself in :func:`load_problem`)."""
     allowed = tuple(f.name for f in dataclasses.fields(Numerics))
@@ -624,6 +711,7 @@ def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         pair = read_pair(r, data, bodies)
     output = read_output(r, data)
     initial = read_initial(r, data)
+    dynamics, dynamic_numerics = read_dynamics(r, data, bodies, kind)
     if output.mean_displacement and interface is None:
         r.fail("output.mean_displacement", "reported with an [interface] only")
     title = data.get("title", path.stem)
@@ -641,5 +729,6 @@ def read(path: Path, sets: list[str]) -> tuple[ProblemFile, dict, dict]:
         interface=interface,
         initial=initial,
         output=output,
+        dynamics=dynamics,
     )
-    return problem, read_numerics(r, data), read_petsc(r, data)
+    return problem, {**read_numerics(r, data), **dynamic_numerics}, read_petsc(r, data)

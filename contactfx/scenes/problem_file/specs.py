@@ -24,6 +24,7 @@ __all__ = [
     "PairSpec",
     "InterfaceSpec",
     "OutputSpec",
+    "DynamicsSpec",
     "ProblemFile",
 ]
 
@@ -39,6 +40,7 @@ SECTIONS = (
     "contact",
     "interface",
     "initial",
+    "dynamics",
     "numerics",
     "petsc",
     "output",
@@ -172,6 +174,18 @@ class OutputSpec:
 
 
 @dataclass(frozen=True)
+class DynamicsSpec:
+    """``[dynamics]``: what a dynamic run adds to the bodies (their density is in
+    ``[[bodies]]``): a gravity acceleration (constant in time, rho g per body), the initial
+    velocity per body (group: its components) or as a field (expressions in x, y, z); the time
+    scheme, the step and the end time go to the numerics."""
+
+    gravity: np.ndarray | None = None
+    velocity: dict[str, np.ndarray] = field(default_factory=dict)
+    velocity_field: tuple[Expression, ...] | None = None
+
+
+@dataclass(frozen=True)
 class ProblemFile:
     """A validated problem file: one spec per section (exactly one of obstacle, pair and
     interface)."""
@@ -187,6 +201,7 @@ class ProblemFile:
     interface: InterfaceSpec | None = None
     initial: tuple[Expression, ...] | None = None
     output: OutputSpec = field(default_factory=OutputSpec)
+    dynamics: DynamicsSpec | None = None
 
     @property
     def materials(self) -> dict[str, Elastic]:
