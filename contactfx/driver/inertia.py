@@ -36,8 +36,9 @@ from petsc4py import PETSc
 
 from contactfx import _compat
 from contactfx.driver.fields import global_sum, surface_mask, vertex_rule
+from contactfx.solvers.base import ConvergenceError
 
-__all__ = ["Inertia", "EnergyLedger", "plot_contact"]
+__all__ = ["Inertia", "EnergyLedger", "EnergyBlowUp", "plot_contact"]
 
 
 class Inertia:
@@ -162,6 +163,21 @@ def initial_acceleration(
     return solve
 
 
+class EnergyBlowUp(ConvergenceError):
+    """A dynamic run whose energy grew without bound (:meth:`EnergyLedger.check_stable`)."""
+
+    def __init__(self, step: int, t: float, total: float, given: float) -> None:
+        RuntimeError.__init__(
+            self,
+            f"unstable at time step {step} (time {t:.6g}): the energy grew to {total:.3g}, more "
+            f"than {EnergyLedger.BLOW_UP:g} times what the run was given ({given:.3g}: its "
+            "initial energy and the work of its loads); a smaller --dt, or with Nitsche "
+            "theta = 1 a larger --gamma0",
+        )
+        self.reason, self.step, self.load, self.stats = "energy blow-up", step, t, None
+        self.detail = ""
+
+
 class EnergyLedger:
     """The energy balance of a dynamic run, one row per step (module docstring)."""
 
@@ -237,6 +253,20 @@ class EnergyLedger:
         }
         self.rows.append(row)
         return row
+
+    #: the energy gained beyond what the run was given (its initial energy, the work of its
+    #: loads and friction's dissipation) at which the run counts as unstable: a stable scheme
+    #: gains at most its balance error, a small fraction of that
+    BLOW_UP = 10.0
+
+    def check_stable(self, step: int) -> None:
+        """Raise :class:`EnergyBlowUp` if the last step's energy grew beyond BLOW_UP times
+        what the run was given (the growth: minus the balance's remainder)."""
+        row = self.rows[-1]
+        given = abs(self.rows[0]["total"]) + max(abs(r["external_work"]) for r in self.rows)
+        given += row["friction_dissipation"]
+        if -row["remainder"] > self.BLOW_UP * given and given > 0.0:
+            raise EnergyBlowUp(step, row["time"], row["total"], given)
 
     def summary(self) -> dict[str, Any]:
         """run.json's ``energy``: initial and final total, the largest |remainder| (absolute

@@ -488,6 +488,7 @@ class _Run:
                 )
                 if self.energy is not None:  # (before the friction history moves on)
                     steps[-1] = dataclasses.replace(steps[-1], energy=self.energy.record(rec.time))
+                    self.energy.check_stable(rec.step)
                 if writer is not None:
                     with self.timed("output"):
                         writer.write(rec.time, post.fields())

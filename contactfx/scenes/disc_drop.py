@@ -31,6 +31,7 @@ class DiscDropParams(elastic(50.0, 0.25)):
     density: float = param(1.0, "density rho", positive=True)
     gravity: float = param(0.1, "gravity g (downwards)", nonnegative=True)
     drop: float = param(5.0, "height of the lowest point above the plane at t = 0", positive=True)
+    speed: float = param(0.0, "initial downward speed v0", nonnegative=True)
     h_contact: float = param(1.0, "element size near the lowest point", positive=True)
     h_far: float = param(4.0, "element size far from it", positive=True)
     contact_width: float = param(16.0, "width of the refined zone at the bottom", positive=True)
@@ -67,15 +68,21 @@ class DiscDrop(ObstacleScene):
         return []  # a free body: its mass holds it (a dynamic run only)
 
     def load(self, v, ds, t):
+        if not self.p.gravity:
+            return None  # thrown without gravity (--speed): no load
         return -self.p.density * self.p.gravity * v[1] * ufl.dx
 
+    def initial_velocity(self, v) -> None:
+        if self.p.speed:
+            v.interpolate(lambda x: np.vstack([0.0 * x[0], np.full(x.shape[1], -self.p.speed)]))
+
     def impact(self) -> dict[str, float]:
-        """The free fall's impact time sqrt(2 H / g) and speed sqrt(2 g H)."""
+        """The free fall's impact speed sqrt(v0^2 + 2 g H) and time (speed - v0) / g (from
+        rest: sqrt(2 H / g); without gravity H / v0)."""
         p = self.p
-        return {
-            "impact_time": float(np.sqrt(2.0 * p.drop / p.gravity)),
-            "impact_speed": float(np.sqrt(2.0 * p.gravity * p.drop)),
-        }
+        speed = float(np.sqrt(p.speed**2 + 2.0 * p.gravity * p.drop))
+        time = (speed - p.speed) / p.gravity if p.gravity > 0.0 else p.drop / p.speed
+        return {"impact_time": float(time), "impact_speed": speed}
 
     def problem_data(self, numerics) -> dict:
         p = self.p
@@ -87,5 +94,8 @@ class DiscDrop(ObstacleScene):
                 "h": self.h_contact(),
                 "position": [0.0, -p.drop],
             },
-            "dynamics": {"gravity": [0.0, -p.gravity]},
+            "dynamics": {
+                "gravity": [0.0, -p.gravity],
+                **({"initial_velocity": {"disc": [0.0, -p.speed]}} if p.speed else {}),
+            },
         }

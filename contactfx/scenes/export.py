@@ -20,8 +20,7 @@ from mpi4py import MPI
 from contactfx.io.toml import dumps
 from contactfx.meshes import write_msh
 from contactfx.numerics import Numerics
-from contactfx.scenes.problem_file.sections import DYNAMICS_NUMERICS
-from contactfx.scenes.problem_file.specs import SECTIONS
+from contactfx.scenes.problem_file.specs import DYNAMICS_NUMERICS, SECTIONS
 
 __all__ = ["write_problem", "numerics_table", "Symbol", "SYMBOLIC"]
 

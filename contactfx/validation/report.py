@@ -117,6 +117,7 @@ VALUE_COLUMNS = (
     ("speedup", "speedup"),
     ("t_per_step", "time per step"),
     ("newton_per_step", "Newton per step"),
+    ("step_over_linear", "step over linear"),
     ("energy_remainder", "energy remainder"),
     ("stop_distance_error", "stop distance error"),
 )
@@ -378,7 +379,9 @@ def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[
         "penetration / h: largest nodal penetration over the contact element size; "
         "|g p| / (p0 h): nodal complementarity residual; error: against the closed form at "
         "the computed force (p L2: pressure in L2 on the contact boundary; punch p: "
-        "pi sqrt(a^2 - x^2) p / P - 1 on |x| <= 0.8 a; Q = mu P: gross-slip force).",
+        "pi sqrt(a^2 - x^2) p / P - 1 on |x| <= 0.8 a; Q = mu P: gross-slip force); energy "
+        "balance error: a dynamic run's largest remainder of its energy balance over the "
+        "largest energy (the scheme's dissipation and the balance's error).",
     ]
     cols = [
         ("case", "case"),
@@ -391,6 +394,7 @@ def write_stress(rows: list[dict], out: Path, ranks: int, total: float) -> list[
         ("error_measure", "error of"),
         ("error", "error"),
         ("p0_error", "p0 error"),
+        ("energy_remainder", "energy balance error"),
         ("time", "time [s]"),
         ("reason", "reason"),
     ]

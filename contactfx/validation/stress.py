@@ -218,6 +218,7 @@ def cases() -> list[StressCase]:
         )
     out += _interface_cases()
     out += _finite_strain_cases()
+    out += _dynamic_cases()
     for ranks in (1, 2, 3):
         out.append(
             StressCase(
@@ -300,6 +301,65 @@ def _finite_strain_cases() -> list[StressCase]:
                 {"press": 5e-3},
                 {**fs, "method": "penalty", "steps": 25, **friction},
                 quick=mu == 0.3,
+            )
+        )
+    return out
+
+
+def _dynamic_cases() -> list[StressCase]:
+    """Implicit dynamics (``--dynamic``): the bar against a wall (contact duration 1) with
+    the time step from a tenth of the contact down to a thousandth, the penalty parameter and
+    Nitsche's gamma0 (theta = 1) over five decades, rho_infinity of generalised-alpha from 0
+    to 1; the disc thrown onto a plane without gravity at impact speeds over three decades
+    (0.01 to 10, wave speed 7). The energy balance's largest remainder is a column."""
+    out: list[StressCase] = []
+    axis = "dynamics: time step"
+    for dt in (0.1, 0.03, 0.01, 0.003, 0.001):
+        out.append(
+            StressCase(f"bar, dt={dt:g}", axis, "bar-impact", {}, {"dt": dt}, quick=dt == 0.01)
+        )
+    for kappa in (1.0, 10.0, 100.0, 1e3, 1e4):
+        out.append(
+            StressCase(
+                f"bar, penalty={kappa:g}",
+                "dynamics: penalty",
+                "bar-impact",
+                {},
+                {"method": "penalty", "penalty": kappa, "dt": 0.01},
+                quick=kappa == 100.0,
+            )
+        )
+    for g in (0.1, 1.0, 10.0, 100.0, 1e3):
+        out.append(
+            StressCase(
+                f"bar, gamma0={g:g}",
+                "dynamics: gamma0",
+                "bar-impact",
+                {},
+                {"method": "nitsche", "theta": 1, "gamma0": g, "dt": 0.01},
+            )
+        )
+    for rho in (0.0, 0.25, 0.5, 0.75, 1.0):
+        out.append(
+            StressCase(
+                f"bar, rho_inf={rho:g}",
+                "dynamics: rho_inf",
+                "bar-impact",
+                {},
+                {"scheme": "generalized-alpha", "rho_inf": rho, "dt": 0.01},
+                quick=rho == 0.5,
+            )
+        )
+    disc = {"h_contact": 2.0, "h_far": 6.0, "gravity": 0.0, "drop": 0.1}
+    for speed in (0.01, 0.1, 1.0, 10.0):
+        out.append(
+            StressCase(
+                f"disc, speed {speed:g}",
+                "dynamics: impact speed",
+                "disc-drop",
+                {**disc, "speed": speed},
+                {"dt": 0.1, "t_end": 40.0},
+                quick=speed == 1.0,
             )
         )
     return out
@@ -442,6 +502,8 @@ def _row(case: StressCase, res: RunSummary | None, error: str, wall: float) -> d
         error=value,
         p0_error=measure(res, "err_p0"),
         force=res.force,
+        # a dynamic run's energy balance: its largest remainder over the largest energy
+        energy_remainder=(res.energy or {}).get("largest_remainder_relative", math.nan),
         time=wall,
     )
     return row
@@ -531,6 +593,8 @@ def _format(row: dict) -> str:
     if row["status"] != "converged":
         return f"{head} {row['status'].upper()}: {row['reason']}"
     err = f"{row['error_measure']} {row['error']:.2e}" if np.isfinite(row["error"]) else ""
+    if np.isfinite(row.get("energy_remainder", np.nan)):
+        err += f" energy {row['energy_remainder']:.1e}"
     return (
         f"{head} newton {row['newton']:3d} cutbacks {row['cutbacks']} pen/h "
         f"{row['penetration_over_h']:.1e} |gp|/(p0 h) {row['complementarity']:.1e} {err} "

@@ -52,6 +52,7 @@ def test_penalty_and_finite_strain():
     assert -0.3 * 0.1 < nh.peak_pressure / lin.peak_pressure - 1.0 < 0.0
 
 
+@pytest.mark.ranks_compare
 def test_serial_and_parallel_agree():
     scene = HertzAxi(HertzAxi.Params())
     serial = scene.run(Numerics(), comm=MPI.COMM_SELF, verbose=False)

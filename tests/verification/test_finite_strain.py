@@ -282,6 +282,7 @@ def test_small_load_limit_hertz2d():
     assert abs(deviations[0][1]) < 5e-3
 
 
+@pytest.mark.ranks_compare
 def test_serial_and_parallel_agree():
     _, serial = solve(MPI.COMM_SELF, method="nitsche", material="neo-hookean")
     _, parallel = solve(MPI.COMM_WORLD, method="nitsche", material="neo-hookean")
@@ -392,6 +393,7 @@ def test_inverting_first_step_is_halved():
         assert getattr(unchecked, key) == pytest.approx(getattr(reference, key), rel=1e-8), key
 
 
+@pytest.mark.ranks_compare
 def test_inverting_first_step_serial_and_parallel_agree():
     serial = indentation("halve", 1, MPI.COMM_SELF)
     parallel = indentation("halve", 1, MPI.COMM_WORLD)

@@ -58,6 +58,7 @@ def test_mixed_other_methods(method):
     assert res.force == pytest.approx(nit.force, rel=5e-3 if method == "al-uzawa" else 1e-2)
 
 
+@pytest.mark.ranks_compare
 def test_mixed_serial_and_parallel_agree():
     scene = Hertz2D(INCOMPRESSIBLE)
     serial = scene.run(MIXED, comm=MPI.COMM_SELF, verbose=False)

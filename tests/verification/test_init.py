@@ -252,7 +252,7 @@ def test_mesh_from_a_builder_gives_the_scene(tmp_path):
 @pytest.mark.parametrize(
     "mesh, message",
     [
-        ('builder = "triangle"', "mesh.builder: must be one of interval, rectangle"),
+        ('builder = "triangle"', "mesh.builder: must be one of interval, disc, rectangle"),
         (
             _RECTANGLE.replace("x1 = 1.0", "x1 = -2.0"),
             "mesh.parameters: rectangle: x0 must be < x1",

@@ -340,6 +340,7 @@ def test_large_sliding_coulomb_slips_at_mu(method):
     assert max(s.newton for s in res.steps[-6:]) <= 4
 
 
+@pytest.mark.ranks_compare
 @pytest.mark.parametrize("method", ["penalty", "nitsche"])
 def test_large_sliding_serial_and_parallel_agree(method):
     serial, _ = slide("coulomb", comm=MPI.COMM_SELF, method=method)

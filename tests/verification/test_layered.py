@@ -67,6 +67,7 @@ def test_extreme_contrast_converges(contrast, theta):
     assert result.max_penetration < 1e-2 * params.depth
 
 
+@pytest.mark.ranks_compare
 def test_layered_serial_and_parallel_agree():
     scene = Hertz2D(_layered(COARSE.E / 1e3))
     serial = scene.run(Numerics(), comm=MPI.COMM_SELF, verbose=False)

@@ -187,6 +187,7 @@ def test_mortar_large_sliding_coulomb_slips_at_mu():
         assert r["closed"] >= 12
 
 
+@pytest.mark.ranks_compare
 def test_mortar_large_sliding_serial_and_parallel_agree():
     serial, _ = slide("coulomb", comm=MPI.COMM_SELF)
     parallel, _ = slide("coulomb", comm=MPI.COMM_WORLD)

@@ -1,8 +1,9 @@
 """Contact quantities must not depend on the number of ranks.
 
 Under ``mpirun -n 2`` every rank solves the scene alone (COMM_SELF) and together (COMM_WORLD)
-on the same gmsh mesh; in a serial session both are the same run and the test is a no-op
-comparison, the real check happens in the MPI session that ``make test`` runs.
+on the same gmsh mesh; in a serial session both would be the same run, so the tests are
+skipped there (``ranks_compare``): the check happens in the MPI session that ``make test``
+runs.
 """
 
 import pytest
@@ -11,6 +12,8 @@ from mpi4py import MPI
 from contactfx.scenes import Numerics
 from contactfx.scenes.hertz import Hertz2D, Hertz2DParams, Hertz3D, Hertz3DParams
 from contactfx.scenes.sliding_block import SlidingBlock, SlidingBlockParams
+
+pytestmark = pytest.mark.ranks_compare
 
 
 @pytest.mark.parametrize(

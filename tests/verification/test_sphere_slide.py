@@ -90,6 +90,7 @@ def test_sphere_slide_gross_slip_q_over_p(run):
     assert res.scores["Q_over_P_over_mu"] == pytest.approx(Q / P / MU, rel=1e-12)
 
 
+@pytest.mark.ranks_compare
 def test_sphere_slide_serial_and_parallel_agree(run):
     parallel = run[0]  # on COMM_WORLD: two ranks under mpirun -n 2
     serial, _ = slide(comm=MPI.COMM_SELF)

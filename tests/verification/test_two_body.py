@@ -132,6 +132,7 @@ def test_mortar_patch_test_searched_each_newton(dim):
 _COARSE_SPHERES = HertzSpheres.Params(h_contact=0.04, h_far=0.5, refine=0.2, depth=0.03)
 
 
+@pytest.mark.ranks_compare
 @pytest.mark.parametrize(
     "scene, num",
     [
@@ -566,6 +567,7 @@ def test_sliding_contact_coulomb(method):
     assert f.excess < 1e-10
 
 
+@pytest.mark.ranks_compare
 @pytest.mark.parametrize("method", ["nitsche", "mortar"])
 def test_sliding_contact_coulomb_serial_and_parallel_agree(method):
     scene, num = _sliding_coulomb(method)

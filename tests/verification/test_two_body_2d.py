@@ -110,6 +110,7 @@ def test_pressure_plot_written(tmp_path):
     assert forces[0, 2] == pytest.approx(res.force, rel=1e-3)
 
 
+@pytest.mark.ranks_compare
 def test_punch_foundation_serial_and_parallel_agree():
     scene = PunchFoundation(PunchFoundation.Params())
     serial = scene.run(MORTAR, comm=MPI.COMM_SELF, verbose=False)

@@ -301,6 +301,7 @@ def test_lost_contact_is_detected():
     assert found[-0.02] is None
 
 
+@pytest.mark.ranks_compare
 @pytest.mark.parametrize("method", ["penalty", "nitsche"])
 def test_finite_strain_serial_and_parallel_agree(method):
     serial_scene, serial = solve(comm=MPI.COMM_SELF, method=method)

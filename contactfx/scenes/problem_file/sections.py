@@ -29,6 +29,7 @@ from contactfx.scenes.problem_file.expressions import parse_expression
 from contactfx.scenes.problem_file.reader import ProblemError, Reader, apply_sets, numbers
 from contactfx.scenes.problem_file.specs import (
     AXES,
+    DYNAMICS_NUMERICS,
     SECTIONS,
     BodySpec,
     BoundarySpec,
@@ -528,8 +529,6 @@ def read_initial(r: Reader, data: dict) -> tuple | None:
         r.fail("initial.displacement", str(err))
 
 
-#: the keys of [dynamics] that are numerics (Numerics's fields of the same name)
-DYNAMICS_NUMERICS = ("scheme", "rho_inf", "dt", "t_end", "mass")
 _CHOICES = {f.name: f.metadata["choices"] for f in dataclasses.fields(Numerics)}
 
 

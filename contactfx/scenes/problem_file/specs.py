@@ -16,6 +16,7 @@ from contactfx.mechanics.elasticity import Elastic
 __all__ = [
     "AXES",
     "SECTIONS",
+    "DYNAMICS_NUMERICS",
     "MeshSpec",
     "BodySpec",
     "BoundarySpec",
@@ -45,6 +46,9 @@ SECTIONS = (
     "petsc",
     "output",
 )
+
+#: the keys of [dynamics] that are numerics (Numerics's fields of the same name)
+DYNAMICS_NUMERICS = ("scheme", "rho_inf", "dt", "t_end", "mass")
 
 #: a (load factor, multiplier) table
 Amplitude = tuple[tuple[float, float], ...]
