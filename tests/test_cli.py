@@ -182,7 +182,9 @@ BAD = [
     (["run", "bar-impact", "--rho-inf", "1.5"], "--rho-inf must lie in [0, 1]"),
     (["run", "bar-impact", "--scheme", "hht", "--rho-inf", "0.3"], "needs --rho-inf in [0.5, 1]"),
     (["run", "hertz2d", "--dynamic", "--dt", "0.1", "--t-end", "1"], "needs the body's density"),
-    (["run", "patch-test", "--dynamic", "--dt", "0.1", "--t-end", "1"], "offered static only"),
+    (["run", "patch-test", "--dynamic", "--dt", "0.1", "--t-end", "1"], "needs the body's density"),
+    (["run", "crack-sneddon", "--dynamic", "--dt", "0.1", "--t-end", "1"], "offered static only"),
+    (["run", "two-bars", "--mass", "redistributed"], "between two bodies use --mass consistent"),
     (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
     (["run", "bar-impact", "--mass", "lumped", "--degree", "2"], "is a P1 lumping"),
 ]

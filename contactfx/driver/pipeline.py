@@ -243,7 +243,7 @@ def _checked_method(scene: Scene, numerics: Numerics) -> Method:
     if numerics.dynamic and not scene.problem.dynamic:
         raise ValueError(
             f"--dynamic: scene '{scene.name}': its problem kind is offered static only (time "
-            "integration is offered against rigid obstacles)"
+            "integration is offered against rigid obstacles and between two bodies)"
         )
     scene.configure(numerics)
     return method

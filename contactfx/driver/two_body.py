@@ -96,6 +96,10 @@ class TwoBodyProblem(Problem):
     _coupling: Any
     #: an interference fit's largest overlap at the start (0: none recorded)
     initial_overlap: float = 0.0
+    #: bodies in time (``--dynamic``): the contact's stored energy is not counted in the
+    #: energy balance (the coupling's terms are not UFL forms): it is in the remainder
+    #: while the bodies touch
+    dynamic = True
 
     @classmethod
     def check(cls, scene: Scene, numerics: Numerics, method: Method) -> None:
@@ -131,6 +135,11 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
+        if numerics.dynamic and numerics.mass == "redistributed":
+            raise ValueError(
+                "--mass redistributed is offered against a rigid obstacle; between two bodies "
+                "use --mass consistent or lumped"
+            )
         if scene.smoothing() == "normals" and method.name != "mortar":
             raise ValueError(
                 f'contact.0.smoothing = "{scene.smoothing()}" is mortar\'s (its weighted nodal '
@@ -363,7 +372,8 @@ class TwoBodyProblem(Problem):
         checks of the geometry at the start (collective, so that every rank raises alike):
         the bodies must not overlap by more than 1 % of the contact element size
         (:meth:`initial_gap`) unless the pair is an interference fit, and a body without any
-        support must touch the other one (else the first solve is singular). An interference
+        support must touch the other one (else the first solve is singular; in time its mass
+        holds it). An interference
         fit (``contact.interference = "ramp"``) records the initial gaps g0 in the coupling,
         whose law then takes g + (1 - t) max(-g0, 0) at the load factor t: at t = 0 the
         overlap is hidden, at t = 1 the whole interference acts."""
@@ -388,7 +398,7 @@ class TwoBodyProblem(Problem):
             supported = comm.allreduce(
                 bool(np.any(fixed[np.asarray(dofs, dtype=np.int64)])), op=MPI.LOR
             )
-            if not supported and not least <= tol:
+            if not supported and not least <= tol and not self.num.dynamic:
                 raise ValueError(
                     f"the {body} body has no support and does not touch the other "
                     f"one at the start (closest gap {least:.3g}): the solve would "

@@ -15,6 +15,7 @@ from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
 from contactfx.scenes.sliding_stop import SlidingStop
 from contactfx.scenes.sphere_slide import SphereSlide
+from contactfx.scenes.two_bars import TwoBars
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
 from contactfx.scenes.two_body_2d import CattaneoCylinders, PunchFoundation, SlidingContact
 from contactfx.scenes.westergaard import Westergaard
@@ -32,6 +33,7 @@ SCENES: dict[str, type[Scene]] = {
         FlatPunch3D,
         SlidingBlock,
         SlidingStop,
+        TwoBars,
         Bar1D,
         BarImpact,
         DiscDrop,

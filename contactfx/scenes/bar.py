@@ -144,7 +144,7 @@ class BarImpact(ObstacleScene):
 
     def problem_data(self, numerics) -> dict:
         return {
-            "bodies": [export.body("bar", self.material(), density=self.material().density)],
+            "bodies": [export.body("bar", self.material())],
             "boundary": [export.fixed("left", (0,))],
             "obstacle": {"shape": "plane", "contact": "right", "h": self.h_contact()},
             "initial": {"displacement": ["-0.5 * (1.0 + x)"]},

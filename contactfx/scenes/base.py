@@ -181,6 +181,11 @@ class Scene:
             checkpoint_every=checkpoint_every,
         )
 
+    def density_field(self, mesh):
+        """The density as a field over ``mesh`` (UFL) for bodies of different densities, or
+        None for the homogeneous ``material().density``."""
+        return None
+
 
 class ObstacleScene(Scene):
     """A body pressed against a rigid obstacle: geometry and supports, the obstacle and its
@@ -204,11 +209,6 @@ class ObstacleScene(Scene):
     def modulus(self, mesh):
         """Young's modulus as a field over ``mesh`` (UFL) for a heterogeneous body, or None for
         the homogeneous ``material().E``."""
-        return None
-
-    def density_field(self, mesh):
-        """The density as a field over ``mesh`` (UFL) for bodies of different densities, or
-        None for the homogeneous ``material().density``."""
         return None
 
     def initial_guess(self, u, t: float) -> None:

@@ -87,7 +87,7 @@ class DiscDrop(ObstacleScene):
     def problem_data(self, numerics) -> dict:
         p = self.p
         return {
-            "bodies": [export.body("disc", self.material(), density=p.density)],
+            "bodies": [export.body("disc", self.material())],
             "obstacle": {
                 "shape": "floor",
                 "contact": "lower",

@@ -98,8 +98,11 @@ AXES = ("x", "y", "z")
 
 
 def body(group: str, material, **extra) -> dict:
-    """A ``[[bodies]]`` table."""
-    return {"group": group, "E": float(material.E), "nu": float(material.nu), **extra}
+    """A ``[[bodies]]`` table (with the density of a material that has one)."""
+    out = {"group": group, "E": float(material.E), "nu": float(material.nu)}
+    if material.density is not None:
+        out["density"] = float(material.density)
+    return {**out, **extra}
 
 
 def fixed(group: str, components) -> dict:

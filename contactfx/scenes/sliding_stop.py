@@ -143,7 +143,7 @@ class SlidingStop(ObstacleScene):
         p = self.p
         k = (1.0 - p.nu**2) * p.density * p.gravity / p.E
         return {
-            "bodies": [export.body("domain", self.material(), density=p.density)],
+            "bodies": [export.body("domain", self.material())],
             "obstacle": {"shape": "floor", "contact": "bottom", "h": p.h},
             "initial": {"displacement": ["0.0", f"-{k!r} * ({p.height!r} * y - 0.5 * y ** 2)"]},
             "dynamics": {

@@ -132,7 +132,21 @@ class TwoBodyScene(Scene):
             nu.x.array[dofs] = mat.nu
         for f in (E, nu):
             f.x.scatter_forward()
-        return Elastic(self.material().E, self.material().nu, modulus=E, poisson=nu)
+        ref = self.material()
+        return Elastic(ref.E, ref.nu, modulus=E, poisson=nu, density=ref.density)
+
+    def density_field(self, mesh):
+        """Each body's density as a DG0 field when they differ (None: one density)."""
+        densities = {body: m.density for body, m in self.materials().items()}
+        if len(set(densities.values())) < 2:
+            return None
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        rho = dolfinx.fem.Function(DG0)
+        for body, value in densities.items():
+            cells = self.cell_tags.indices[self.cell_tags.values == self.cells[body]]
+            rho.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = value
+        rho.x.scatter_forward()
+        return rho
 
     def dirichlet(self, V, facet_tags) -> list:
         raise NotImplementedError

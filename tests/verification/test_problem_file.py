@@ -1092,9 +1092,17 @@ def test_bad_dynamics(tmp_path, edit, message):
 
 
 @pytest.mark.serial_only
-def test_dynamics_needs_an_obstacle(tmp_path):
+def test_dynamics_not_with_an_interface(tmp_path):
+    path = tmp_path / "crack.toml"
+    path.write_text(CRACK + "\n[dynamics]\ndt = 0.1\n")
+    with pytest.raises(ValueError, match=r"dynamics: .* a problem with an \[interface\] is static"):
+        load_problem(path)
+
+
+@pytest.mark.serial_only
+def test_dynamics_pair_needs_densities(tmp_path):
     path = _write_pair(tmp_path, PAIR + "\n[dynamics]\ndt = 0.1\n")
-    with pytest.raises(ValueError, match=r"dynamics: a dynamic run is offered against an \["):
+    with pytest.raises(ValueError, match=r"bodies.0.density: missing: a dynamic run"):
         load_problem(path)
 
 

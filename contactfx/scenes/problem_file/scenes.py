@@ -310,6 +310,37 @@ class _FileMesh:
         values = [e(y) + zero * x[0] for e in exprs]
         u.interpolate(_compat.expression(ufl.as_vector(values), u.function_space))
 
+    def density_field(self, mesh):
+        """Each body's density as a DG0 field when they differ (None: one density)."""
+        if len({b.material.density for b in self.spec.bodies}) < 2:
+            return None
+        return self._per_body(mesh, [b.material.density for b in self.spec.bodies])
+
+    def initial_velocity(self, v) -> None:
+        """``dynamics.initial_velocity``: per body, its vector on the body's cells (a node
+        shared by two bodies takes the later body's), or a field of expressions in x, y, z."""
+        dyn = self.spec.dynamics
+        if dyn is None:
+            return
+        if dyn.velocity_field is not None:
+            self._interpolate(v, dyn.velocity_field, "dynamics.initial_velocity")
+            return
+        tags = dict(zip((b.group for b in self.spec.bodies), self.body_tags, strict=True))
+        for group, value in dyn.velocity.items():
+            cells = self.cell_tags.indices[self.cell_tags.values == tags[group]]
+            v.interpolate(_constant(value), cells)
+        v.x.scatter_forward()
+
+    def _per_body(self, mesh, values: list[float]):
+        """A DG0 field with each body's value on its cells."""
+        DG0 = _compat.function_space(mesh, "DG", 0)
+        f = dolfinx.fem.Function(DG0)
+        for tag, value in zip(self.body_tags, values, strict=True):
+            cells = self.cell_tags.indices[self.cell_tags.values == tag]
+            f.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = value
+        f.x.scatter_forward()
+        return f
+
     def _facet_points(self, mesh, facets: np.ndarray) -> np.ndarray:
         """(m, vertices per facet, gdim) vertex coordinates of this rank's ``facets``."""
         tdim, fdim = mesh.topology.dim, mesh.topology.dim - 1
@@ -454,37 +485,6 @@ class FileObstacleScene(_FileMesh, ObstacleScene):
         if len(self.spec.bodies) == 1:
             return None
         return self._per_body(mesh, [b.material.E for b in self.spec.bodies])
-
-    def _per_body(self, mesh, values: list[float]):
-        """A DG0 field with each body's value on its cells."""
-        DG0 = _compat.function_space(mesh, "DG", 0)
-        f = dolfinx.fem.Function(DG0)
-        for tag, value in zip(self.body_tags, values, strict=True):
-            cells = self.cell_tags.indices[self.cell_tags.values == tag]
-            f.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = value
-        f.x.scatter_forward()
-        return f
-
-    def density_field(self, mesh):
-        """Each body's density as a DG0 field when they differ (None: one density)."""
-        if len({b.material.density for b in self.spec.bodies}) < 2:
-            return None
-        return self._per_body(mesh, [b.material.density for b in self.spec.bodies])
-
-    def initial_velocity(self, v) -> None:
-        """``dynamics.initial_velocity``: per body, its vector on the body's cells (a node
-        shared by two bodies takes the later body's), or a field of expressions in x, y, z."""
-        dyn = self.spec.dynamics
-        if dyn is None:
-            return
-        if dyn.velocity_field is not None:
-            self._interpolate(v, dyn.velocity_field, "dynamics.initial_velocity")
-            return
-        tags = dict(zip((b.group for b in self.spec.bodies), self.body_tags, strict=True))
-        for group, value in dyn.velocity.items():
-            cells = self.cell_tags.indices[self.cell_tags.values == tags[group]]
-            v.interpolate(_constant(value), cells)
-        v.x.scatter_forward()
 
     def contact_modulus(self) -> float:
         """The modulus of the body at the contact surface (the largest, if several touch)."""

@@ -537,15 +537,15 @@ def read_dynamics(
 ) -> tuple[DynamicsSpec | None, dict]:
     """``[dynamics]`` (the file's run is then dynamic): its spec and its numerics (the time
     scheme, rho_inf, dt, t_end, the mass matrix); each body needs its density. Offered
-    against an obstacle (two bodies and interfaces in time are not yet)."""
+    against an obstacle and between two bodies (interfaces in time are not yet)."""
     if "dynamics" not in data:
         return None, {}
     d = r.table(data["dynamics"], "dynamics", KEYS["dynamics"])
-    if kind != "obstacle":
+    if kind == "interface":
         r.fail(
             "dynamics",
-            f"a dynamic run is offered against an [obstacle]; a problem with "
-            f"{'a [[contact]] pair' if kind == 'contact' else 'an [interface]'} is static",
+            "a dynamic run is offered against an [obstacle] or between the bodies of a "
+            "[[contact]] pair; a problem with an [interface] is static",
         )
     for i, b in enumerate(bodies):
         if b.material.density is None:
