@@ -226,8 +226,10 @@ class _FileMesh:
 
     def load(self, v, ds, t):
         L = self._gravity(v)
-        # weighted by r on an axisymmetric section, as the bulk's and the mass's integrals
-        dx = measure("dx", self._mesh, self.axisymmetric, subdomain_data=self.cell_tags)
+        # weighted by r on an axisymmetric section, as the bulk's and the mass's integrals;
+        # a body's cells by its indicator, not a subdomain of dx: every volume integral of a
+        # form shares one subdomain data on dolfinx 0.9 (the mass's has none)
+        dx = measure("dx", self._mesh, self.axisymmetric)
         for i, body in enumerate(self.spec.bodies):
             if body.force is None:
                 continue
@@ -236,7 +238,8 @@ class _FileMesh:
             amp = dolfinx.fem.Constant(self._mesh, 0.0)
             self._constants.append((amp, body.amplitude, np.array(1.0)))
             force = ufl.as_vector(body.force.tolist())
-            form = amp * ufl.dot(force, v) * dx(self.groups[body.group].tag)
+            inside = self._per_body(self._mesh, [float(j == i) for j in range(len(self.body_tags))])
+            form = amp * ufl.dot(force, v) * inside * dx
             L = form if L is None else L + form
         for b in self.spec.boundary:
             if b.traction is None and b.pressure is None and b.stress is None:
@@ -267,13 +270,9 @@ class _FileMesh:
         dyn = self.spec.dynamics
         if dyn is None or dyn.gravity is None:
             return None
-        dx = measure("dx", self._mesh, self.axisymmetric, subdomain_data=self.cell_tags)
-        g = ufl.as_vector(dyn.gravity.tolist())
-        terms = [
-            body.material.density * ufl.dot(g, v) * dx(self.groups[body.group].tag)
-            for body in self.spec.bodies
-        ]
-        return sum(terms[1:], terms[0])
+        dx = measure("dx", self._mesh, self.axisymmetric)
+        rho = self._per_body(self._mesh, [b.material.density for b in self.spec.bodies])
+        return rho * ufl.dot(ufl.as_vector(dyn.gravity.tolist()), v) * dx
 
     def set_load(self, t: float) -> None:
         for const, table, value in self._constants:
