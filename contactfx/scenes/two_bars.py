@@ -85,10 +85,9 @@ class TwoBars(TwoBodyScene):
         return []
 
     def problem_data(self, numerics) -> dict:
-        return {
-            **super().problem_data(numerics),
-            "dynamics": {"initial_velocity": {"upper": [0.0, -self.p.speed]}},
-        }
+        data = super().problem_data(numerics)
+        del data["boundary"]  # free bodies
+        return {**data, "dynamics": {"initial_velocity": {"upper": [0.0, -self.p.speed]}}}
 
     def initial_velocity(self, v) -> None:
         cells = self.cell_tags.indices[self.cell_tags.values == self.cells["upper"]]
