@@ -84,7 +84,8 @@ for argv in json.load(sys.stdin):
         os.close(saved[0]); os.close(saved[1])
         o.seek(0); e.seek(0)
         out.append((status, o.read().decode(), e.read().decode()))
-print(json.dumps(out))
+with open(sys.argv[1], "w") as fh:  # not stdout: a library may print there at exit
+    json.dump(out, fh)
 """
 
 
@@ -92,16 +93,22 @@ def run_cli_batch(cases: list[list[str]], timeout: float = 600) -> list[tuple]:
     """(status, stdout, stderr) of ``contactfx`` with each argv of ``cases``, one after the
     other in a single process (one rank): for the many one-line refusals, which a process
     each would spend in imports."""
-    res = subprocess.run(
-        [sys.executable, "-c", _BATCH],
-        input=__import__("json").dumps(cases),
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env=clean_env(),
-    )
-    assert res.returncode == 0, res.stderr
-    return [tuple(r) for r in __import__("json").loads(res.stdout.splitlines()[-1])]
+    import json
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        out = f"{tmp}/refusals.json"
+        res = subprocess.run(
+            [sys.executable, "-c", _BATCH, out],
+            input=json.dumps(cases),
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            env=clean_env(),
+        )
+        assert res.returncode == 0, res.stdout + res.stderr
+        with open(out) as fh:
+            return [tuple(r) for r in json.load(fh)]
 
 
 def jacobian_check(

@@ -198,9 +198,9 @@ def one_rank_refusals():
 
 @pytest.mark.parametrize("ranks", [1, 2])
 @pytest.mark.parametrize("args, message", BAD, ids=[" ".join(a) for a, _ in BAD])
-def test_bad_input(args, message, ranks, one_rank_refusals):
+def test_bad_input(args, message, ranks, request):
     if ranks == 1:  # main's status, and all it printed (Python's and PETSc's output)
-        status, _, stderr = one_rank_refusals[" ".join(args)]
+        status, _, stderr = request.getfixturevalue("one_rank_refusals")[" ".join(args)]
     else:  # a process of its own: the exit status, no rank left waiting
         res = run_cli(*args, ranks=ranks, timeout=120)
         status, stderr = res.returncode, res.stderr
