@@ -123,15 +123,9 @@ class TwoBodyScene(Scene):
 
     def body_material(self, mesh) -> Elastic:
         """The material with DG0 fields of E and nu over the bodies' cells."""
-        DG0 = _compat.function_space(mesh, "DG", 0)
-        E, nu = dolfinx.fem.Function(DG0), dolfinx.fem.Function(DG0)
-        for body, mat in self.materials().items():
-            cells = self.cell_tags.indices[self.cell_tags.values == self.cells[body]]
-            dofs = np.array([DG0.dofmap.cell_dofs(c)[0] for c in cells], dtype=np.int64)
-            E.x.array[dofs] = mat.E
-            nu.x.array[dofs] = mat.nu
-        for f in (E, nu):
-            f.x.scatter_forward()
+        mats = self.materials()
+        E = self._body_field(mesh, {body: m.E for body, m in mats.items()})
+        nu = self._body_field(mesh, {body: m.nu for body, m in mats.items()})
         ref = self.material()
         return Elastic(ref.E, ref.nu, modulus=E, poisson=nu, density=ref.density)
 
@@ -140,13 +134,17 @@ class TwoBodyScene(Scene):
         densities = {body: m.density for body, m in self.materials().items()}
         if len(set(densities.values())) < 2:
             return None
+        return self._body_field(mesh, densities)
+
+    def _body_field(self, mesh, values: dict[str, float]) -> dolfinx.fem.Function:
+        """A DG0 field with each body's value on its cells."""
         DG0 = _compat.function_space(mesh, "DG", 0)
-        rho = dolfinx.fem.Function(DG0)
-        for body, value in densities.items():
+        f = dolfinx.fem.Function(DG0)
+        for body, value in values.items():
             cells = self.cell_tags.indices[self.cell_tags.values == self.cells[body]]
-            rho.x.array[[DG0.dofmap.cell_dofs(c)[0] for c in cells]] = value
-        rho.x.scatter_forward()
-        return rho
+            f.x.array[np.array([DG0.dofmap.cell_dofs(c)[0] for c in cells], dtype=np.int64)] = value
+        f.x.scatter_forward()
+        return f
 
     def dirichlet(self, V, facet_tags) -> list:
         raise NotImplementedError
