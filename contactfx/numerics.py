@@ -127,6 +127,15 @@ class _General:
     )
     dt: float = param(0.0, "time step of --dynamic (0: the scene's)", nonnegative=True)
     t_end: float = param(0.0, "end time of --dynamic (0: the scene's)", nonnegative=True)
+    dashpot: float = param(
+        0.0,
+        "contact dashpot C of the penalty method in time (--dynamic), against a rigid "
+        "obstacle: where the body penetrates, the normal traction gains C times the rate at "
+        "which the gap closes "
+        "(a Kelvin-Voigt contact; C is absolute: traction per unit gap rate, not scaled by E "
+        "or h); 0: none",
+        nonnegative=True,
+    )
 
 
 def method_parameters() -> dict[str, list[tuple[str, dataclasses.Field]]]:
@@ -252,6 +261,17 @@ class _Checks:
                 raise ValueError("--nested is offered for static load steps, not with --dynamic")
             if self.mass != "consistent" and self.degree != 1:
                 raise ValueError(f"--mass {self.mass} is a P1 lumping: use --degree 1")
+        if self.dashpot > 0.0:
+            if not self.dynamic:
+                raise ValueError(
+                    f"--dashpot {self.dashpot}: a contact dashpot acts in time, use it with "
+                    "--dynamic"
+                )
+            if self.method != "penalty":
+                raise ValueError(
+                    f"--dashpot {self.dashpot}: the dashpot is the penalty contact's, use "
+                    f"--method penalty (got --method {self.method})"
+                )
 
     def method_object(self):
         """The configured contact method."""

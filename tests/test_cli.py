@@ -187,6 +187,14 @@ BAD = [
     (["run", "two-bars", "--mass", "redistributed"], "between two bodies use --mass consistent"),
     (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
     (["run", "bar-impact", "--mass", "lumped", "--degree", "2"], "is a P1 lumping"),
+    # the penalty's contact dashpot (contactfx/contact/penalty.py)
+    (["run", "bar-impact", "--method", "penalty", "--dashpot", "-1"], "--dashpot must be >= 0"),
+    (["run", "hertz2d", "--method", "penalty", "--dashpot", "1"], "use it with --dynamic"),
+    (["run", "bar-impact", "--dashpot", "1"], "use --method penalty (got --method nitsche)"),
+    (
+        ["run", "two-bars", "--method", "penalty", "--dashpot", "1"],
+        "the contact dashpot is offered against a rigid obstacle only",
+    ),
 ]
 
 

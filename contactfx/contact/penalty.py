@@ -20,6 +20,30 @@ history the stick traction would restart from zero at every step. The history li
 nodes of the contact surface (a P1 field, :meth:`contactfx.driver.problem.Problem.converged`
 evaluates t_T there); with the vertex rule (``--quadrature nodal``) the return map is exact at
 every quadrature point, with Gauss points the history between nodes is its P1 interpolant.
+
+Contact dashpot (implicit dynamics against a rigid obstacle, ``--dashpot C``): a Kelvin-Voigt
+contact, a linear spring and a dashpot in parallel (Goldsmith 1960, Impact: the theory and
+physical behaviour of colliding solids, Edward Arnold, London; Hunt and Crossley 1975,
+doi:10.1115/1.3423596): while the point penetrates (g < 0) the normal traction is
+
+    p = kappa [-g]_+ + C (-dg/dt),
+
+0 where g >= 0, with dg/dt the gap's rate, the directional derivative of g(u) in the direction
+of the velocity (in a time step, the velocity at the force time c_v u - v*,
+:mod:`contactfx.solvers.dynamics`; its Jacobian is exact, through g and through the velocity).
+C is an absolute coefficient (traction per unit gap rate). The law is not restricted to
+compression: as the point recedes at the end of a contact phase (dg/dt > 0) the dashpot pulls
+(tension) until the gap reaches 0, where the traction jumps to 0 (the no-tension variant would
+end the contact where p reaches 0: Schwager and Poeschel 2007, doi:10.1103/PhysRevE.75.051304).
+For this law a rigid mass m on a spring k = int kappa ds and dashpot c = int C ds is a damped
+oscillator during the contact, separating when the gap returns to 0, and the coefficient of
+restitution has the closed form e = exp(-zeta pi / sqrt(1 - zeta^2)), zeta = c / (2 sqrt(k m))
+(zeta < 1; Hunt and Crossley 1975). A time step that the separation falls inside misses the
+tension over the rest of that step: e is first order in dt (tests/verification/
+test_dashpot.py). The reported contact quantities (force, pressure) are the spring's;
+a friction bound reads the spring's pressure; the gap rate is the body's (an obstacle's own
+motion is not in it). The dashpot's dissipation is in the energy balance
+(:class:`contactfx.driver.inertia.EnergyLedger`).
 """
 
 from __future__ import annotations
@@ -29,7 +53,7 @@ from typing import TYPE_CHECKING, ClassVar
 
 import ufl
 
-from contactfx.contact.laws import positive_part, tangential
+from contactfx.contact.laws import active, positive_part, tangential
 from contactfx.contact.method import MethodBase, Supports, TrialFriction
 from contactfx.contact.surface import Expr, Form, Surface
 from contactfx.params import param, validate
@@ -90,6 +114,19 @@ class Penalty(TrialFriction, MethodBase):
         n = s.normal()
         assert s.traction_prev is not None  # kept by the driver (traction_history)
         return tangential(s.traction_prev, n) - self.kappa(s) * s.slip_increment(n)
+
+    def dashpot_traction(self, s: Surface, C: Expr, velocity: Expr) -> Expr:
+        """C (-dg/dt) where g < 0, else 0 (module docstring): dg/dt the derivative of the gap
+        g(u) with respect to the state u (``s.u``, a Function) in the direction ``velocity``."""
+        s = self.law_surface(s)
+        g = s.gap()
+        rate = ufl.derivative(g, s.u, velocity)
+        return C * -rate * active(-g)
+
+    def dashpot_residual(self, s: Surface, C: Expr, velocity: Expr) -> Form:
+        """int C (-dg/dt) H(-g) v . n ds: the dashpot's share of the normal traction (module
+        docstring), beside :meth:`residual`'s spring."""
+        return self.dashpot_traction(s, C, velocity) * ufl.dot(s.v, s.normal()) * s.ds
 
     def residual(self, s: Surface) -> Form:
         form = self.pressure(s) * ufl.dot(s.v, s.normal()) * s.ds

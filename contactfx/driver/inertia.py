@@ -8,19 +8,28 @@ mass factor c, and gives the bulk its inertia terms: with density rho,
     nonlinear bulk: f_int(u; v) + c int rho u . v dx
     load:           f_ext + int rho a* . v dx
 
-(the effective stiffness K + c M of a linear bulk assembled once per step size). A static run
-has none of this (no mass matrix, no velocity field).
+(the effective stiffness K + c M of a linear bulk assembled once per step size). With a
+contact dashpot (``--dashpot C``, the penalty's against a rigid obstacle:
+:meth:`contactfx.contact.penalty.Penalty.dashpot_residual`) it holds C and the velocity at the
+force time, c_v u - v* (:mod:`contactfx.solvers.dynamics`: the velocity factor c_v, a Constant,
+and the velocity load v*, a Function). A static run has none of this (no mass matrix, no
+velocity field), a dynamic run without a dashpot none of the latter.
 
 :class:`EnergyLedger` keeps the balance at every step: the kinetic energy 1/2 v . M v, the
 strain energy (the material's density), the energy the contact terms store (the method's, e.g.
 Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_+^2), the work
 of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), friction's
 dissipation (the sum over the steps of -int t_T . du_T ds, the traction at the step's end on
-its slip increment: backward Euler's), and the remainder W_ext - D_friction - (E - E_0): what
-the scheme dissipated (or gained: the error of a non-conserving discretisation). The supports
-are fixed in the scenes that use it (no work); a moving support's or obstacle's work is not
-counted (it would appear in the remainder), nor the energy a penalty or Nitsche friction
-term stores while sticking.
+its slip increment: backward Euler's), with a contact dashpot its dissipation (trapezoidal:
+D_dashpot += 1/2 (f_d,n + f_d,n+1) . (u_n+1 - u_n), f_d the dashpot's force vector at the
+recorded state and velocity; with Newmark's average acceleration the rule under which the
+discrete energy identity holds exactly, M (v_n+1 - v_n) = dt / 2 (F_n + F_n+1) and
+u_n+1 - u_n = dt / 2 (v_n + v_n+1)), and the remainder W_ext - D_friction - D_dashpot
+- (E - E_0): what the scheme dissipated (or gained: the error of a non-conserving
+discretisation). A restart continues the balance (the ledger's totals and last force vectors
+are in the checkpoint, :mod:`contactfx.io.checkpoint`). The supports are fixed in the scenes
+that use it (no work); a moving support's or obstacle's work is not counted (it would appear
+in the remainder), nor the energy a penalty or Nitsche friction term stores while sticking.
 """
 
 from __future__ import annotations
@@ -78,6 +87,15 @@ class Inertia:
         self.a_star = dolfinx.fem.Function(W, name="inertia_load")
         self.c = dolfinx.fem.Constant(problem.mesh, 0.0)
         self.dx, self.rho = self._mass(problem, rho)
+        #: the contact dashpot's coefficient C (``--dashpot``), the velocity factor c_v and the
+        #: velocity load v* of the velocity at the force time c_v u - v*; None without one
+        self.dashpot: dolfinx.fem.Constant | None = None
+        self.c_v: dolfinx.fem.Constant | None = None
+        self.v_star: dolfinx.fem.Function | None = None
+        if problem.num.dashpot > 0.0:
+            self.dashpot = dolfinx.fem.Constant(problem.mesh, float(problem.num.dashpot))
+            self.c_v = dolfinx.fem.Constant(problem.mesh, 0.0)
+            self.v_star = dolfinx.fem.Function(W, name="velocity_load")
 
     @staticmethod
     def _mass(problem: Any, rho: Any) -> tuple[ufl.Measure, Any]:
@@ -117,6 +135,16 @@ class Inertia:
     def set_mass_factor(self, c: float) -> None:
         self.c.value = c
 
+    def set_velocity_factor(self, c_v: float) -> None:
+        assert self.c_v is not None  # (with a dashpot only)
+        self.c_v.value = c_v
+
+    def velocity(self, u: Any) -> Any:
+        """The velocity at the force time of the step whose unknown is ``u``: c_v u - v* (with
+        a dashpot only)."""
+        assert self.c_v is not None and self.v_star is not None
+        return self.c_v * u - self.v_star
+
     def mass_matrix(self, trial: Any, test: Any, bcs: list[Any]) -> PETSc.Mat:
         """M (rho du . v dx), its supported rows and columns replaced by the identity, and a
         unit diagonal where the mass is zero (the contact nodes of a redistributed mass:
@@ -136,13 +164,17 @@ class Inertia:
 def initial_acceleration(
     problem: Any, solver: Any, inertia: Inertia
 ) -> Any:  # a callable (x, a) -> None for the stepper
-    """a_0 from the balance at the initial state, M a_0 = f_ext(0) - f_int(u_0) - f_c(u_0) on
-    the free dofs (0 on the supported ones): the residual of the solver's equations with c = 0
-    and a* = 0, solved with M (LU: once per run)."""
+    """a_0 from the balance at the initial state, M a_0 = f_ext(0) - f_int(u_0) - f_c(u_0, v_0)
+    on the free dofs (0 on the supported ones): the residual of the solver's equations with
+    c = 0 and a* = 0 (and a dashpot's velocity c_v u - v* = v_0: c_v = 0, v* = -v_0), solved
+    with M (LU: once per run)."""
 
     def solve(x: PETSc.Vec, a: PETSc.Vec) -> None:
         inertia.set_mass_factor(0.0)
         inertia.a_star.x.array[:] = 0.0
+        if inertia.v_star is not None:
+            inertia.set_velocity_factor(0.0)
+            inertia.v_star.x.array[:] = -inertia.v.x.array
         solver.reassemble_bulk()  # K without c M
         problem.apply_load(0.0)
         solver.assemble_load()
@@ -219,6 +251,20 @@ class EnergyLedger:
         self.du = self.u_prev.duplicate()  # a step's displacement (work vector)
         self.rows: list[dict[str, float]] = []
         self.work = 0.0
+        #: the columns of the balance: with a dashpot its dissipation too
+        self.keys: tuple[str, ...] = self.KEYS
+        #: the contact dashpot's force vector (its residual at the state, at the velocity v),
+        #: None without a dashpot; ``f_d_prev`` the last step's, ``dashpot_dissipated`` the
+        #: trapezoidal sum of its work on the steps' displacements
+        self.dashpot = None
+        if inertia.dashpot is not None and problem.surface is not None:
+            self.dashpot = dolfinx.fem.form(
+                problem.method.dashpot_residual(problem.surface, inertia.dashpot, inertia.v)
+            )
+            self.f_d = _compat.create_vector(self.dashpot)
+            self.f_d_prev = self.f_d.duplicate()
+            self.keys = self.KEYS[:-1] + ("dashpot_dissipation", self.KEYS[-1])
+        self.dashpot_dissipated = 0.0
 
     def _load(self, out: PETSc.Vec) -> None:
         _compat.assemble_vector(out, self.load_form)
@@ -227,13 +273,19 @@ class EnergyLedger:
         """The balance at the state just accepted (time t): collective."""
         u = _compat.petsc_vec(self.u)
         self._load(self.f)
+        if self.dashpot is not None:
+            _compat.assemble_vector(self.f_d, self.dashpot)
         if self.rows:  # W += 1/2 (f_n + f_n+1) . (u_n+1 - u_n)
             du = self.du
             u.copy(du)
             du.axpy(-1.0, self.u_prev)
             self.work += 0.5 * (self.f.dot(du) + self.f_prev.dot(du))
+            if self.dashpot is not None:  # D += 1/2 (f_d,n + f_d,n+1) . (u_n+1 - u_n)
+                self.dashpot_dissipated += 0.5 * (self.f_d.dot(du) + self.f_d_prev.dot(du))
         u.copy(self.u_prev)
         self.f.copy(self.f_prev)
+        if self.dashpot is not None:
+            self.f_d.copy(self.f_d_prev)
         if self.friction is not None and self.rows:
             self.dissipated += global_sum(self.friction, self.comm)
         kin = global_sum(self.kinetic, self.comm)
@@ -249,14 +301,18 @@ class EnergyLedger:
             "total": total,
             "external_work": self.work,
             "friction_dissipation": self.dissipated,
-            "remainder": self.work - self.dissipated - (total - e0),
         }
+        given = self.work - self.dissipated  # the work done on the body, less what it lost
+        if self.dashpot is not None:
+            row["dashpot_dissipation"] = self.dashpot_dissipated
+            given -= self.dashpot_dissipated
+        row["remainder"] = given - (total - e0)
         self.rows.append(row)
         return row
 
     #: the energy gained beyond what the run was given (its initial energy, the work of its
-    #: loads and friction's dissipation) at which the run counts as unstable: a stable scheme
-    #: gains at most its balance error, a small fraction of that
+    #: loads, friction's and a dashpot's dissipation) at which the run counts as unstable: a
+    #: stable scheme gains at most its balance error, a small fraction of that
     BLOW_UP = 10.0
 
     def check_stable(self, step: int) -> None:
@@ -264,23 +320,27 @@ class EnergyLedger:
         what the run was given (the growth: minus the balance's remainder)."""
         row = self.rows[-1]
         given = abs(self.rows[0]["total"]) + max(abs(r["external_work"]) for r in self.rows)
-        given += row["friction_dissipation"]
+        given += row["friction_dissipation"] + row.get("dashpot_dissipation", 0.0)
         if -row["remainder"] > self.BLOW_UP * given and given > 0.0:
             raise EnergyBlowUp(step, row["time"], row["total"], given)
 
     def summary(self) -> dict[str, Any]:
-        """run.json's ``energy``: initial and final total, the largest |remainder| (absolute
-        and relative to the largest energy of the run), whether the contact's energy is
-        counted."""
+        """run.json's ``energy``: initial and final total, the external work, friction's (and
+        a dashpot's) dissipation, the largest |remainder| (absolute and relative to the
+        largest energy of the run), whether the contact's energy is counted."""
         if not self.rows:
             return {}
         scale = max(max(abs(r["total"]) for r in self.rows), 1e-300)
         worst = max(abs(r["remainder"]) for r in self.rows)
-        return {
+        out = {
             "initial_total": self.rows[0]["total"],
             "final_total": self.rows[-1]["total"],
             "external_work": self.rows[-1]["external_work"],
             "friction_dissipation": self.rows[-1]["friction_dissipation"],
+        }
+        if self.dashpot is not None:
+            out["dashpot_dissipation"] = self.rows[-1]["dashpot_dissipation"]
+        return out | {
             "largest_remainder": worst,
             "largest_remainder_relative": worst / scale,
             "contact_counted": self.contact_counted,
@@ -292,10 +352,10 @@ class EnergyLedger:
             return []
         path = out / "energy.csv"
         with path.open("w", newline="") as fh:
-            writer = csv.DictWriter(fh, fieldnames=list(self.KEYS))
+            writer = csv.DictWriter(fh, fieldnames=list(self.keys))
             writer.writeheader()
             for row in self.rows:
-                writer.writerow({k: f"{row[k]:.12g}" for k in self.KEYS})
+                writer.writerow({k: f"{row[k]:.12g}" for k in self.keys})
         return [path, self._plot(out / "energy.png")]
 
     def _plot(self, path: Path) -> Path:
@@ -307,9 +367,11 @@ class EnergyLedger:
         t = np.array([r["time"] for r in self.rows])
         fig, ax = plt.subplots(figsize=(7, 4))
         keys = ("kinetic", "strain", "contact", "total", "external_work")
-        for key in keys + ("friction_dissipation", "remainder"):
-            if (key == "contact" and not self.contact_counted) or (
-                key == "friction_dissipation" and self.friction is None
+        for key in keys + ("friction_dissipation", "dashpot_dissipation", "remainder"):
+            if (
+                (key == "contact" and not self.contact_counted)
+                or (key == "friction_dissipation" and self.friction is None)
+                or (key == "dashpot_dissipation" and self.dashpot is None)
             ):
                 continue
             ax.plot(t, [r[key] for r in self.rows], label=key.replace("_", " "))
@@ -325,6 +387,9 @@ class EnergyLedger:
     def destroy(self) -> None:
         for v in (self.f, self.f_prev, self.u_prev, self.du):
             v.destroy()
+        if self.dashpot is not None:
+            self.f_d.destroy()
+            self.f_d_prev.destroy()
 
 
 def plot_contact(times: list[float], force: list[float], peak: list[float], path: Path) -> Path:

@@ -56,6 +56,7 @@ class ObstacleProblem(Problem):
     nonlinear_bulk = True
     axisymmetric = True
     dynamic = True
+    dashpot = True
 
     surface: ContactSurface
     obstacle: Any

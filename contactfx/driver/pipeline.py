@@ -245,6 +245,11 @@ def _checked_method(scene: Scene, numerics: Numerics) -> Method:
             f"--dynamic: scene '{scene.name}': its problem kind is offered static only (time "
             "integration is offered against rigid obstacles and between two bodies)"
         )
+    if numerics.dashpot > 0.0 and not scene.problem.dashpot:
+        raise ValueError(
+            f"--dashpot: scene '{scene.name}': the contact dashpot is offered against a rigid "
+            "obstacle only (not between two bodies)"
+        )
     scene.configure(numerics)
     return method
 
@@ -574,6 +579,11 @@ class _Run:
             problem.prev.x.array[:] = problem.state.x.array
         self.energy = EnergyLedger(problem, inertia, problem.load_form)
         vec = _compat.petsc_vec
+        dashpot: dict[str, Any] = {}
+        if inertia.v_star is not None:  # the velocity c_v w - v* of the dashpot's law
+            dashpot = dict(
+                v_star=vec(inertia.v_star), set_velocity_factor=inertia.set_velocity_factor
+            )
         return Dynamic(
             Scheme.named(self.num.scheme, self.num.rho_inf),
             dt=self.num.dt,
@@ -584,6 +594,7 @@ class _Run:
             set_mass_factor=inertia.set_mass_factor,
             reassemble=solver.reassemble_bulk,
             initial_acceleration=initial_acceleration(problem, solver, inertia),
+            **dashpot,
         )
 
     def _output(self, suffix: str) -> str | None:

@@ -111,6 +111,9 @@ class Problem:
     axisymmetric = False
     #: whether the kind integrates in time (``--dynamic``: :mod:`contactfx.driver.inertia`)
     dynamic = False
+    #: whether the kind offers the penalty's contact dashpot in time (``--dashpot``: a law in
+    #: UFL on its surface, :meth:`contactfx.contact.penalty.Penalty.dashpot_residual`)
+    dashpot = False
     #: Newton stops at the residual's round-off level too (:class:`contactfx.solvers.snes.
     #: _RoundOffStop`): finite strain, and an interference fit (the interference's own contact
     #: forces set a floor that a well-predicted step's relative tolerance does not reach)
@@ -438,8 +441,16 @@ class Problem:
         return None
 
     def contact_residual(self) -> ufl.Form:
-        """The method's contact residual on the kind's surface (Newton's: ``newton_surface``)."""
-        return self.method.residual(self.newton_surface())
+        """The method's contact residual on the kind's surface (Newton's: ``newton_surface``),
+        with ``--dashpot`` the dashpot's at the velocity of the force time (c_v u - v*: the
+        step's unknown u, :mod:`contactfx.solvers.dynamics`)."""
+        s = self.newton_surface()
+        form = self.method.residual(s)
+        inertia = self.inertia
+        if inertia is not None and inertia.dashpot is not None:
+            velocity = inertia.velocity(self.state)
+            form = form + self.method.dashpot_residual(s, inertia.dashpot, velocity)
+        return form
 
     @overload
     def newton_surface(self) -> KindSurface: ...

@@ -20,7 +20,18 @@ state). With u_{n+1} = (w - alpha_f u_n) / (1 - alpha_f) the inertia term is
          - alpha_m a_n,
 
 so a step is a static solve of the bulk plus c M (its Jacobian K + c M: a linear bulk
-assembles it once per step size) under the extra load M a*. The schemes:
+assembles it once per step size) under the extra load M a*. The velocity at the force time is
+affine in w too: Newmark's updates give v_{n+1} = gamma / (beta dt) (u_{n+1} - u_n)
++ (1 - gamma / beta) v_n + dt (1 - gamma / (2 beta)) a_n, and with (1 - alpha_f)(u_{n+1} - u_n)
+= w - u_n,
+
+    v_{n+1-alpha_f} = c_v w - v*,   c_v = gamma / (beta dt),
+    v* = c_v u_n - (1 - alpha_f) ((1 - gamma / beta) v_n + dt (1 - gamma / (2 beta)) a_n)
+         - alpha_f v_n
+
+(a force that reads the velocity, a contact dashpot, is a law of w alone; with Newmark's
+average acceleration v_{n+1} = 2 (u_{n+1} - u_n) / dt - v_n, the trapezoidal rule). The
+schemes:
 
 * ``newmark``: alpha_m = alpha_f = 0, beta = 1/4, gamma = 1/2 (average acceleration: no
   numerical dissipation, the energy of a linear system conserved);
@@ -87,6 +98,10 @@ class Scheme:
         """c of the inertia term c M w - M a* (module docstring)."""
         return (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * dt * dt)
 
+    def velocity_factor(self, dt: float) -> float:
+        """c_v of the velocity at the force time c_v w - v* (module docstring)."""
+        return self.gamma / (self.beta * dt)
+
 
 class Dynamic(CutBack):
     """The time steps t = dt, 2 dt, ..., t_end of a :class:`Scheme` (see the module
@@ -102,6 +117,9 @@ class Dynamic(CutBack):
     load Functions, in the unknown's layout; ``initial_acceleration(x, a)``: a_0 from the
     balance at the initial state (collective), called at :meth:`start` unless ``a`` holds
     it already (``a0_given``). ``fields``: other vectors restored on a cut-back (a multiplier).
+    ``v_star`` (optional: a law that reads the velocity, the contact dashpot): the vector of
+    the velocity load v*, set with the velocity factor ``set_velocity_factor(c_v)`` at every
+    step (the velocity at the force time is c_v w - v*); without it neither is computed.
     """
 
     #: not restored by a restart: the restarted run's bulk was assembled with c = 0, and is
@@ -123,6 +141,8 @@ class Dynamic(CutBack):
         max_cutbacks: int = 6,
         fields: Sequence[PETSc.Vec] = (),
         t_start: float = 0.0,
+        v_star: PETSc.Vec | None = None,
+        set_velocity_factor: Callable[[float], None] | None = None,
     ) -> None:
         if not dt > 0.0:
             raise ValueError(f"--dt must be > 0, got {dt}")
@@ -134,6 +154,9 @@ class Dynamic(CutBack):
         self.initial_acceleration = initial_acceleration
         self.max_cutbacks, self.fields = max_cutbacks, list(fields)
         self.t_start = t_start
+        if (v_star is None) != (set_velocity_factor is None):
+            raise TypeError("v_star and set_velocity_factor go together")
+        self.v_star, self.set_velocity_factor = v_star, set_velocity_factor
         self.step = 0
 
     # -- the Stepper protocol ------------------------------------------------------------------
@@ -171,7 +194,8 @@ class Dynamic(CutBack):
         return (1.0 - af) * self.t + af * self.t_prev
 
     def predict(self) -> None:
-        """a* and c of the step; w starts at u_n + (1 - alpha_f)(dt v_n + dt^2 / 2 a_n)."""
+        """a* and c of the step (with ``v_star``, v* and c_v too); w starts at
+        u_n + (1 - alpha_f)(dt v_n + dt^2 / 2 a_n)."""
         s, dt = self.scheme, self.h
         self.previous.restore()
         c = s.mass_factor(dt)
@@ -192,6 +216,16 @@ class Dynamic(CutBack):
         self.a_star.axpy(k * dt, v_n)
         self.a_star.axpy((1.0 - am) * (0.5 / b - 1.0) - am, a_n)
         _ghost_update(self.a_star)
+        if self.v_star is not None and self.set_velocity_factor is not None:
+            # v* = c_v u_n - ((1 - af)(1 - g / b) + af) v_n - (1 - af) dt (1 - g / (2 b)) a_n
+            g = s.gamma
+            c_v = s.velocity_factor(dt)
+            self.set_velocity_factor(c_v)
+            self.v_star.set(0.0)
+            self.v_star.axpy(c_v, u_n)
+            self.v_star.axpy(-((1.0 - af) * (1.0 - g / b) + af), v_n)
+            self.v_star.axpy(-(1.0 - af) * dt * (1.0 - 0.5 * g / b), a_n)
+            _ghost_update(self.v_star)
         self.x.axpy((1.0 - af) * dt, v_n)
         self.x.axpy((1.0 - af) * 0.5 * dt * dt, a_n)
         _ghost_update(self.x)

@@ -55,11 +55,11 @@ boundary may carry the traction sigma n of a ``stress`` tensor (numbers or expre
 z) integrated with its ``quadrature_degree``.
 
 A ``[dynamics]`` section makes the run dynamic (against an obstacle): ``dt``, ``t_end``,
-``scheme``, ``rho_inf`` and ``mass`` as the numerics of the same names, ``gravity`` (an
-acceleration: rho g on each body, constant in time) and ``initial_velocity`` (per body, ``{
-ball = [0.0, -1.0] }``, or a field of expressions in x, y, z); each body then needs its
-``density`` in ``[[bodies]]``, and ``[initial] displacement`` is the initial state. The
-obstacle shape ``floor`` is the plane below its body, through ``position``.
+``scheme``, ``rho_inf``, ``mass`` and ``dashpot`` as the numerics of the same names,
+``gravity`` (an acceleration: rho g on each body, constant in time) and ``initial_velocity``
+(per body, ``{ ball = [0.0, -1.0] }``, or a field of expressions in x, y, z); each body then
+needs its ``density`` in ``[[bodies]]``, and ``[initial] displacement`` is the initial state.
+The obstacle shape ``floor`` is the plane below its body, through ``position``.
 
 Groups are the gmsh physical names. Everything is validated before anything is computed: an
 unknown key, a value of the wrong type or out of range, a group the mesh does not have (the error
