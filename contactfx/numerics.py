@@ -125,7 +125,20 @@ class _General:
         "at the contact, after Khenous, Laborde and Renard 2008)",
         choices=("consistent", "lumped", "redistributed"),
     )
-    dt: float = param(0.0, "time step of --dynamic (0: the scene's)", nonnegative=True)
+    dt: float = param(
+        0.0,
+        "time step of --dynamic (0: the scene's); with --time-tolerance the first and the "
+        "largest step",
+        nonnegative=True,
+    )
+    time_tolerance: float = param(
+        0.0,
+        "adaptive time step of --dynamic: the largest local error of a step, estimated from "
+        "the change of the acceleration (Zienkiewicz and Xie 1991), relative to the step's "
+        "displacement; a step above it is repeated at half the size, the step doubles (up to "
+        "--dt) where the estimate allows; 0: a fixed step",
+        nonnegative=True,
+    )
     t_end: float = param(0.0, "end time of --dynamic (0: the scene's)", nonnegative=True)
     dashpot: float = param(
         0.0,
@@ -261,6 +274,10 @@ class _Checks:
                 raise ValueError("--nested is offered for static load steps, not with --dynamic")
             if self.mass != "consistent" and self.degree != 1:
                 raise ValueError(f"--mass {self.mass} is a P1 lumping: use --degree 1")
+        elif self.time_tolerance > 0.0:
+            raise ValueError(
+                f"--time-tolerance {self.time_tolerance}: an adaptive time step needs --dynamic"
+            )
         if self.dashpot > 0.0:
             if not self.dynamic:
                 raise ValueError(

@@ -187,6 +187,9 @@ BAD = [
     (["run", "two-bars", "--mass", "redistributed"], "between two bodies use --mass consistent"),
     (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
     (["run", "bar-impact", "--mass", "lumped", "--degree", "2"], "is a P1 lumping"),
+    # the adaptive time step (contactfx/solvers/dynamics.py)
+    (["run", "hertz2d", "--time-tolerance", "1e-3"], "an adaptive time step needs --dynamic"),
+    (["run", "bar-impact", "--time-tolerance", "-1"], "--time-tolerance must be >= 0"),
     # the penalty's contact dashpot (contactfx/contact/penalty.py)
     (["run", "bar-impact", "--method", "penalty", "--dashpot", "-1"], "--dashpot must be >= 0"),
     (["run", "hertz2d", "--method", "penalty", "--dashpot", "1"], "use it with --dynamic"),

@@ -594,6 +594,7 @@ class _Run:
             set_mass_factor=inertia.set_mass_factor,
             reassemble=solver.reassemble_bulk,
             initial_acceleration=initial_acceleration(problem, solver, inertia),
+            time_tolerance=self.num.time_tolerance,
             **dashpot,
         )
 

@@ -117,6 +117,11 @@ class Stepper(Protocol):
     def cut_back(self) -> bool:
         """The step failed: a smaller step (True) or no more cut-backs (False)."""
 
+    def reject(self, stats: SolveStats) -> bool:
+        """The step converged, but asks to be repeated with a smaller one (an adaptive time
+        step's error estimate); :func:`march` then cuts it back, or accepts it when no
+        smaller step is left."""
+
     def restore(self) -> None:
         """Put back the state of the last accepted step (before an error propagates)."""
 
@@ -145,6 +150,9 @@ class CutBack:
 
     def restore(self) -> None:
         self.previous.restore()
+
+    def reject(self, stats: SolveStats) -> bool:
+        return False  # a converged step is accepted (an adaptive stepper's is checked)
 
 
 class QuasiStatic(CutBack):
@@ -309,6 +317,8 @@ def march(
                         when=stepper.describe(t),
                     ) from None
                 continue
+            if stepper.reject(stats) and stepper.cut_back():
+                continue  # converged, but above the adaptive step's error estimate
             record = stepper.accept(stats)
             records.append(record)
             if on_step is not None:

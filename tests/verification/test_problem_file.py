@@ -1077,6 +1077,10 @@ DROP = (DEMOS / "rubber-ball-drop.toml").read_text()
             lambda t: t.replace("{ disc = [0.0, -1.0] }", '["0.0", "-y +"]'),
             "dynamics.initial_velocity:",
         ),
+        (
+            lambda t: t.replace("dt = 0.0025", "dt = 0.0025\ntime_tolerance = -1e-3"),
+            "dynamics.time_tolerance: must be >= 0",
+        ),
         (lambda t: t + "\n[numerics]\ndt = 0.1\n", "numerics.dt: given in [dynamics] too"),
         (lambda t: t.replace("gravity", "gravitation"), "dynamics.gravitation: unknown"),
     ],

@@ -115,6 +115,7 @@ KEYS = {
         "t_end",
         "mass",
         "dashpot",
+        "time_tolerance",
         "gravity",
         "initial_velocity",
     ),
@@ -545,9 +546,9 @@ def read_dynamics(
     r: Reader, data: dict, bodies: tuple[BodySpec, ...], kind: str
 ) -> tuple[DynamicsSpec | None, dict]:
     """``[dynamics]`` (the file's run is then dynamic): its spec and its numerics (the time
-    scheme, rho_inf, dt, t_end, the mass matrix, the contact dashpot); each body needs its
-    density. Offered against an obstacle and between two bodies (interfaces in time are not
-    yet)."""
+    scheme, rho_inf, dt, t_end, the mass matrix, the contact dashpot, the adaptive step's
+    time_tolerance); each body needs its density. Offered against an obstacle and between two
+    bodies (interfaces in time are not yet)."""
     if "dynamics" not in data:
         return None, {}
     d = r.table(data["dynamics"], "dynamics", KEYS["dynamics"])
@@ -573,9 +574,10 @@ def read_dynamics(
         if k in ("scheme", "mass"):
             numerics[k] = r.string(d, "dynamics", k, _CHOICES[k])
         else:
-            numerics[k] = r.number(d, "dynamics", k, positive=k not in ("rho_inf", "dashpot"))
-        if k == "dashpot" and not numerics[k] >= 0.0:
-            r.fail("dynamics.dashpot", f"must be >= 0, got {numerics[k]}")
+            zero = ("rho_inf", "dashpot", "time_tolerance")  # 0 allowed (off)
+            numerics[k] = r.number(d, "dynamics", k, positive=k not in zero)
+        if k in ("dashpot", "time_tolerance") and not numerics[k] >= 0.0:
+            r.fail(f"dynamics.{k}", f"must be >= 0, got {numerics[k]}")
     try:  # rho_inf's range for the scheme, one line naming the key
         Scheme.named(numerics.get("scheme", "newmark"), numerics.get("rho_inf", 1.0))
     except ValueError as err:

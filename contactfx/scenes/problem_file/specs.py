@@ -48,7 +48,7 @@ SECTIONS = (
 )
 
 #: the keys of [dynamics] that are numerics (Numerics's fields of the same name)
-DYNAMICS_NUMERICS = ("scheme", "rho_inf", "dt", "t_end", "mass", "dashpot")
+DYNAMICS_NUMERICS = ("scheme", "rho_inf", "dt", "t_end", "mass", "dashpot", "time_tolerance")
 
 #: a (load factor, multiplier) table
 Amplitude = tuple[tuple[float, float], ...]
