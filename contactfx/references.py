@@ -111,6 +111,18 @@ def hertz_3d(force: float, radius: float, E_star: float) -> dict[str, float]:
     return {"a": a, "p0": 3.0 * force / (2.0 * np.pi * a**2), "delta": a**2 / radius}
 
 
+def hertz_impact(mass: float, speed: float, radius: float, E_star: float) -> dict[str, float]:
+    """The quasi-static impact of an elastic sphere (mass m, radius R) on a rigid plane at the
+    speed V (Johnson 1985, Contact Mechanics, doi:10.1017/CBO9781139171731, section 11.4): the
+    largest approach delta* = (15 m V^2 / (16 E* sqrt(R)))^(2/5) (the kinetic energy
+    1/2 m V^2 stored as Hertz's 8/15 E* sqrt(R) delta^(5/2)), the largest force
+    P* = 4/3 E* sqrt(R) delta*^(3/2) and the contact's duration T = 2.9432 delta* / V (twice
+    the integral of d delta / sqrt(V^2 - (delta / delta*)^(5/2) V^2) from 0 to delta*)."""
+    delta = (15.0 * mass * speed**2 / (16.0 * E_star * np.sqrt(radius))) ** 0.4
+    force = 4.0 / 3.0 * E_star * np.sqrt(radius) * delta**1.5
+    return {"delta": delta, "force": force, "duration": 2.9432 * delta / speed}
+
+
 def rigid_punch_2d(x, half_width: float, force: float):
     """Pressure P / (pi sqrt(a^2 - x^2)) under a rigid flat punch of half-width a pressed with
     the force P (per unit length) into an elastic half-plane, frictionless (Johnson 1985,

@@ -39,6 +39,7 @@ from contactfx.meshes._build import (
     file_groups,
     write_msh,
 )
+from contactfx.meshes.ball import BallCells, BallFacets, quarter_ball
 from contactfx.meshes.box import BoxCells, BoxFacets, box
 from contactfx.meshes.crack_plate import (
     CrackPlateCells,
@@ -99,10 +100,13 @@ BUILDERS = {
     "rounded-on-block": (rounded_on_block, 2),
     "die-on-block": (die_on_block, 2),
     "sphere-on-block": (sphere_on_block, 3),
+    "quarter-ball": (quarter_ball, 3),
 }
 
 __all__ = [
     "BUILDERS",
+    "BallCells",
+    "BallFacets",
     "BoxCells",
     "BoxFacets",
     "Builder",
@@ -153,6 +157,7 @@ __all__ = [
     "joint_column",
     "penny_block",
     "punch_foundation",
+    "quarter_ball",
     "rectangle",
     "rounded_on_block",
     "sphere_on_block",

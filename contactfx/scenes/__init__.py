@@ -9,6 +9,7 @@ from contactfx.scenes.crack import CrackInclined, CrackSet, CrackSneddon, Proppe
 from contactfx.scenes.disc_drop import DiscDrop
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D, HertzAxi
+from contactfx.scenes.hertz_impact import HertzImpact
 from contactfx.scenes.ironing import ShallowIroning
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
@@ -37,6 +38,7 @@ SCENES: dict[str, type[Scene]] = {
         Bar1D,
         BarImpact,
         DiscDrop,
+        HertzImpact,
         CrackSneddon,
         CrackInclined,
         ProppedFracture,

@@ -83,13 +83,18 @@ TWO_BODY_CASES = [
     ),
 ]
 #: in time: an impact and its contact phase, a free body dropped on a floor, Coulomb
-#: friction with an initial velocity, two free bodies colliding ([dynamics]: density,
-#: gravity, initial velocity)
+#: friction with an initial velocity, two free bodies colliding, a quarter ball thrown onto a
+#: floor ([dynamics]: density, gravity, initial velocity; mirror planes)
 DYNAMIC_CASES = [
     ("bar-impact", {"cells": 10}, {"dt": 0.01, "t_end": 1.5}),
     ("disc-drop", {"h_contact": 2.0, "h_far": 6.0}, {"dt": 0.5, "t_end": 12.0}),
     ("sliding-stop", {"h": 0.25}, {"t_end": 0.05}),
     ("two-bars", {"h": 0.1}, {"t_end": 0.5, "dt": 0.05}),
+    (
+        "hertz-impact",
+        {"h_contact": 0.04, "refine_radius": 0.2, "h_far": 0.4},
+        {"dt": 1.0, "t_end": 3.0},
+    ),
 ]
 CASES = OBSTACLE_CASES + INTERFACE_CASES + TWO_BODY_CASES + DYNAMIC_CASES
 #: Newton's count and stopping test in time: a free flight's first residual is already at
