@@ -209,6 +209,10 @@ CASES: dict[str, BenchCase] = {
         "neo-Hookean disc dropped on a plane, Nitsche, Newmark, t in [0, 30]",
         numerics={"material": "neo-hookean", "dt": 0.05, "t_end": 30.0},
     ),
+    # 3D in time: the quarter ball, level 1 the scene's default mesh
+    "hertz-impact": BenchCase(
+        "hertz-impact", {}, 2.0, "elastic sphere striking a rigid plane (3D), Nitsche, Newmark"
+    ),
     "sphere-slide": BenchCase(
         "sphere-slide",
         {},
