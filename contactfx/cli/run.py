@@ -128,6 +128,16 @@ def table(res: RunSummary) -> str:
                 f"{e['initial_total']:.6g} / {e['final_total']:.6g} / {e['external_work']:.6g}",
             )
         )
+        lost = {
+            k: e[f"{k}_dissipation"] for k in ("friction", "dashpot") if e.get(f"{k}_dissipation")
+        }
+        if lost:
+            rows.append(
+                (
+                    "energy dissipated by " + " / ".join(lost),
+                    " / ".join(f"{v:.6g}" for v in lost.values()),
+                )
+            )
         rows.append(
             (
                 "energy balance: largest remainder",
