@@ -509,6 +509,25 @@ class PointCoupling(PointReadout):
             dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
 
+    def energy(self, x: PETSc.Vec) -> float | None:
+        """The energy the pair's law stores at the state ``x``, summed over the Gauss points
+        (their weights) and the ranks (collective): the penalty's kappa / 2 [-g]_+^2 and
+        Nitsche's theta / (2 gamma) (P^2 - sigma_n^2), the obstacle forms' densities
+        (:meth:`contactfx.contact.nitsche.Nitsche.contact_energy`; with theta = 1 the
+        residual's contact terms are its derivative). None where the law stores none in this
+        form: with friction, and at finite strain (the laws of :meth:`_point_terms`)."""
+        if self.frictional or self.pointwise or self.geometric:
+            return None
+        if self.scatter is None:  # not searched yet: no point paired
+            return 0.0
+        vals = self._gather(x)
+        total = 0.0
+        for p in self.points:
+            P, _, _, sn = self._law(p, vals)
+            density = P**2 if sn is None else self.law.theta * (P**2 - sn**2)
+            total += float(np.sum(p["w"] * density / (2.0 * p["scale"])))
+        return float(self.comm.allreduce(total))
+
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         vals = self._gather(x)
         add = PETSc.InsertMode.ADD_VALUES

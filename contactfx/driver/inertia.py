@@ -230,10 +230,16 @@ class EnergyLedger:
         self.kinetic = inertia.kinetic_form()
         self.strain = dolfinx.fem.form(problem.material.strain_energy(problem.U) * problem.dx)
         energy = None
+        #: between two bodies the coupling's (its terms are not UFL forms): its ``energy(x)``
+        self.coupling = None
         if problem.surface is not None:
             energy = problem.method.contact_energy(problem.surface)
+        elif hasattr(problem, "coupling"):
+            coupling = problem.coupling()
+            if coupling.energy(_compat.petsc_vec(self.u)) is not None:
+                self.coupling = coupling
         #: whether the contact's stored energy is counted (else it is in the remainder)
-        self.contact_counted = energy is not None
+        self.contact_counted = energy is not None or self.coupling is not None
         self.contact = None if energy is None else dolfinx.fem.form(energy * problem.surface.ds)
         #: friction's dissipation per step, -int t_T . du_T ds (the work the friction
         #: traction t_T on the body does on the step's slip), or None without friction
@@ -291,6 +297,8 @@ class EnergyLedger:
         kin = global_sum(self.kinetic, self.comm)
         strain = global_sum(self.strain, self.comm)
         contact = 0.0 if self.contact is None else global_sum(self.contact, self.comm)
+        if self.coupling is not None:
+            contact = self.coupling.energy(u)
         total = kin + strain + contact
         e0 = self.rows[0]["total"] if self.rows else total
         row = {

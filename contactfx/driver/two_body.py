@@ -96,9 +96,9 @@ class TwoBodyProblem(Problem):
     _coupling: Any
     #: an interference fit's largest overlap at the start (0: none recorded)
     initial_overlap: float = 0.0
-    #: bodies in time (``--dynamic``): the contact's stored energy is not counted in the
-    #: energy balance (the coupling's terms are not UFL forms): it is in the remainder
-    #: while the bodies touch
+    #: bodies in time (``--dynamic``): the contact's stored energy is the coupling's sum
+    #: over its Gauss points (``PointCoupling.energy``; frictionless, small strain: else it
+    #: is in the balance's remainder while the bodies touch)
     dynamic = True
 
     @classmethod

@@ -5,9 +5,11 @@ the force rho c v0 w / 2, then the upper bar at rest and the lower one at v0."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from mpi4py import MPI
 
+from contactfx import _compat
 from contactfx.scenes.two_bars import TwoBars
 
 
@@ -53,3 +55,53 @@ def test_ranks_agree():
         assert ra[1] == pytest.approx(rb[1], rel=1e-8, abs=1e-8 * 0.005)
         for va, vb in zip(ra[2:], rb[2:], strict=True):
             assert va == pytest.approx(vb, rel=1e-8, abs=1e-8 * 0.1)
+
+
+class _Probe(TwoBars):
+    """two-bars stopped inside the contact phase (t = 0.4): the coupling's stored energy at
+    that state and the derivative of it along a direction d against its residual . d."""
+
+    def on_step(self, problem, solver, load: float, quantities) -> None:
+        super().on_step(problem, solver, load, quantities)
+        if abs(load - 0.4) > 1e-9:
+            return
+        coupling = problem.coupling()
+        x = _compat.petsc_vec(problem.state)
+        d = x.duplicate()
+        rng = np.random.default_rng(7 + problem.mesh.comm.rank)
+        d.getArray()[:] = rng.standard_normal(d.getLocalSize()) * 1e-3 * self.p.speed
+        F = x.duplicate()
+        F.set(0.0)
+        coupling.residual(x, F)
+        eps = 1e-3
+        energies = []
+        for s in (eps, -eps):
+            y = x.copy()
+            y.axpy(s, d)
+            energies.append(coupling.energy(y))
+            y.destroy()
+        self.probe = dict(
+            energy=coupling.energy(x), slope=(energies[0] - energies[1]) / (2 * eps), work=F.dot(d)
+        )
+        for v in (d, F):
+            v.destroy()
+
+
+@pytest.mark.parametrize("method", ["nitsche", "penalty"])
+def test_contact_energy_between_two_bodies(method):
+    """The contact's stored energy between two bodies (the coupling's sum over its Gauss points:
+    kappa / 2 [-g]_+^2, Nitsche's theta / (2 gamma) (P^2 - sigma_n^2) with theta = 1) is the
+    potential of the coupling's residual: its derivative along a direction d (central
+    differences, step 1e-3 of a perturbation of 1e-6: the law is quadratic on each branch, so
+    exact but for round-off and a branch change) equals residual . d to 1e-6 (measured 4e-12
+    Nitsche, 8e-12 penalty at 1 rank). The run's balance counts it (contact_counted)."""
+    scene = _Probe(TwoBars.Params())
+    res = scene.run(
+        TwoBars.default_numerics(method=method, t_end=0.4), comm=MPI.COMM_WORLD, verbose=False
+    )
+    probe = scene.probe
+    # the penalty's is positive; Nitsche's may not be (P^2 < sigma_n^2 where P > 0 at a small
+    # open gap): nonzero
+    assert probe["energy"] > 0.0 if method == "penalty" else probe["energy"] != 0.0
+    assert probe["slope"] == pytest.approx(probe["work"], rel=1e-6)
+    assert res.energy["contact_counted"]
