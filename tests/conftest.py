@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import weakref
@@ -223,3 +224,23 @@ def psi(model: str, m, F):
             + 0.5 * m.bulk * np.log(J) ** 2
         )
     return 0.5 * m.mu * (I1 - 3 - 2 * np.log(J)) + 0.5 * m.lmbda * np.log(J) ** 2
+
+
+class StopAt:
+    """A StopRequest that answers SIGTERM at the k-th step boundary (monkeypatched for
+    ``contactfx.driver.pipeline.StopRequest``: a run stopped there, as by a signal)."""
+
+    k = 0
+
+    def __init__(self, comm) -> None:
+        self.n = 0
+
+    def __enter__(self) -> StopAt:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+    def requested(self) -> int:
+        self.n += 1
+        return signal.SIGTERM if self.n == self.k else 0

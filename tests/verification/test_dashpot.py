@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import json
 import math
-import signal
 from pathlib import Path
 
 import dolfinx
@@ -61,6 +60,7 @@ import ufl
 from mpi4py import MPI
 
 import contactfx.driver.pipeline as pipeline
+from conftest import StopAt
 from contactfx import _compat
 from contactfx.contact.gap import ContactSurface
 from contactfx.contact.obstacles import Ball
@@ -331,25 +331,6 @@ def test_dashpot_jacobian_is_exact():
     assert fd.norm() <= 1e-8 * Jd.norm()
 
 
-class _StopAt:
-    """A StopRequest that answers SIGTERM at the k-th step boundary."""
-
-    k = 0
-
-    def __init__(self, comm) -> None:
-        self.n = 0
-
-    def __enter__(self) -> _StopAt:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        pass
-
-    def requested(self) -> int:
-        self.n += 1
-        return signal.SIGTERM if self.n == self.k else 0
-
-
 def test_restart_continues_the_dashpot_balance(tmp_path, monkeypatch):
     """Stopped in the middle of the contact (step 20 of 40, dt = 2e-3) and restarted from its
     checkpoint: the dashpot's dissipation and its last force vector continue (every step's
@@ -359,8 +340,8 @@ def test_restart_continues_the_dashpot_balance(tmp_path, monkeypatch):
     base = Path(COMM.bcast(str(tmp_path), root=0))
     kw = dict(C=6.0, dt=2e-3, t_end=0.08)
     _, whole = drop(**kw)
-    _StopAt.k = 20
-    monkeypatch.setattr(pipeline, "StopRequest", _StopAt)
+    StopAt.k = 20
+    monkeypatch.setattr(pipeline, "StopRequest", StopAt)
     with pytest.raises(Interrupted):
         drop(out=base / "cut", checkpoint_every=10, **kw)
     monkeypatch.undo()

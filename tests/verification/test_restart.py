@@ -27,7 +27,6 @@ Also: a restart refuses other numerics in one line, and a folder without a check
 from __future__ import annotations
 
 import json
-import signal
 from pathlib import Path
 
 import numpy as np
@@ -35,29 +34,11 @@ import pytest
 from mpi4py import MPI
 
 import contactfx.driver.pipeline as pipeline
+from conftest import StopAt
 from contactfx.io.xdmf import read_xdmf
 from contactfx.scenes import get_scene
 from contactfx.scenes.problem_file import load_problem
 from contactfx.solvers.interrupt import Interrupted
-
-
-class _StopAt:
-    """A StopRequest that answers SIGTERM at the k-th step boundary."""
-
-    k = 0
-
-    def __init__(self, comm) -> None:
-        self.n = 0
-
-    def __enter__(self) -> _StopAt:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        pass
-
-    def requested(self) -> int:
-        self.n += 1
-        return signal.SIGTERM if self.n == self.k else 0
 
 
 def _numbers(steps: list) -> dict[str, float]:
@@ -119,8 +100,8 @@ def _runs(tmp_path, monkeypatch, name, k, numerics, params=None, make=None):
             return make()[0]
 
     scene().run(num, out=base / "full", verbose=False)
-    _StopAt.k = k
-    monkeypatch.setattr(pipeline, "StopRequest", _StopAt)
+    StopAt.k = k
+    monkeypatch.setattr(pipeline, "StopRequest", StopAt)
     with pytest.raises(Interrupted):
         scene().run(num, out=base / "cut", verbose=False)
     monkeypatch.undo()
