@@ -63,7 +63,14 @@ class Oscillator:
     def initial_acceleration(self, x, a) -> None:
         a.setArray(-self.k / self.m * x.getArray())
 
-    def stepper(self, scheme: Scheme, dt: float, t_end: float, given: bool = False) -> Dynamic:
+    def stepper(
+        self,
+        scheme: Scheme,
+        dt: float,
+        t_end: float,
+        given: bool = False,
+        time_tolerance: float = 0.0,
+    ) -> Dynamic:
         vec = _compat.petsc_vec
         return Dynamic(
             scheme,
@@ -75,6 +82,7 @@ class Oscillator:
             set_mass_factor=self.set_mass_factor,
             reassemble=self.reassemble,
             initial_acceleration=None if given else self.initial_acceleration,
+            time_tolerance=time_tolerance,
         )
 
     def run(
@@ -193,19 +201,8 @@ def _one_step(scheme: Scheme, omega: float, t0: float, dt: float, tolerance: flo
     osc = Oscillator(k=omega**2)
     exact = (np.cos(omega * t0), -omega * np.sin(omega * t0), -(omega**2) * np.cos(omega * t0))
     osc.u.x.array[:], osc.v.x.array[:], osc.a.x.array[:] = exact
-    vec = _compat.petsc_vec
-    stepper = Dynamic(
-        scheme,
-        dt=dt,
-        t_end=dt,
-        v=vec(osc.v),
-        a=vec(osc.a),
-        a_star=vec(osc.a_star),
-        set_mass_factor=osc.set_mass_factor,
-        reassemble=osc.reassemble,
-        time_tolerance=tolerance,
-    )
-    stepper.start(vec(osc.u))
+    stepper = osc.stepper(scheme, dt, dt, given=True, time_tolerance=tolerance)
+    stepper.start(_compat.petsc_vec(osc.u))
     stepper.next_time()
     stepper.predict()
     osc.solve()
@@ -251,20 +248,8 @@ def test_adaptive_step_rejects_above_the_tolerance_and_grows_below():
     and back."""
     omega, dt, tol = 2.0 * np.pi, 0.2, 1e-3
     osc = Oscillator(k=omega**2)
-    vec = _compat.petsc_vec
     etas, sizes = [], []
-    stepper = Dynamic(
-        Scheme.named("newmark"),
-        dt=dt,
-        t_end=1.0,
-        v=vec(osc.v),
-        a=vec(osc.a),
-        a_star=vec(osc.a_star),
-        set_mass_factor=osc.set_mass_factor,
-        reassemble=osc.reassemble,
-        initial_acceleration=osc.initial_acceleration,
-        time_tolerance=tol,
-    )
+    stepper = osc.stepper(Scheme.named("newmark"), dt, 1.0, time_tolerance=tol)
     osc.u.x.array[:] = 1.0
 
     def record(rec) -> None:
