@@ -36,8 +36,8 @@ def _run(comm, t_end: float = 22.0):
 def test_hertz_impact_force_duration_impulse():
     scene, res = _run(MPI.COMM_WORLD)
     ref = res.reference
-    # Hertz (the mesh's mass): measured +4.7 % (P*) and -2.9 % (T) on this mesh, +4.1 % and
-    # -3.8 % on the scene's default; the finite size's part alone is about 4 % at this a / R
+    # Hertz (the mesh's mass): measured +4.7 % (P*) and -2.9 % (T) on this mesh, +4.4 % and
+    # -3.2 % on the scene's default; the finite size's part alone is about 4 % at this a / R
     # (the docs' speed series): 6 %
     assert abs(ref["peak_force_rel_error"]) < 0.06
     assert abs(ref["duration_rel_error"]) < 0.06
