@@ -166,6 +166,28 @@ def _adjacency_int32(data: np.ndarray, offsets: np.ndarray):
     return make(data, offsets)
 
 
+def create_rectangle(comm, points, n, diagonal: str = "right"):
+    """Structured triangle mesh of the rectangle between ``points`` with ``n`` = (nx, ny) cells a
+    side, its cells distributed by :func:`partition_graph` (the same partition at every run,
+    as the gmsh meshes': a checkpoint's mesh is found again at the restart) with the
+    ``shared_facet`` halo; ``diagonal`` one of dolfinx's DiagonalType names."""
+    kind = getattr(dolfinx.mesh.DiagonalType, diagonal)
+    if _NEW:
+        partitioner = dolfinx.mesh.create_cell_partitioner(
+            partition_graph, dolfinx.mesh.GhostMode.shared_facet
+        )
+    else:
+        partitioner = dolfinx.mesh.create_cell_partitioner(partition_graph)
+    return dolfinx.mesh.create_rectangle(
+        comm,
+        [np.asarray(points[0], dtype=float), np.asarray(points[1], dtype=float)],
+        list(n),
+        dolfinx.mesh.CellType.triangle,
+        partitioner=partitioner,
+        diagonal=kind,
+    )
+
+
 def create_interval(comm, n: int, length: float):
     """Interval mesh (0, length) with n cells."""
     return dolfinx.mesh.create_interval(comm, n, [0.0, length])
