@@ -509,15 +509,22 @@ class PointCoupling(PointReadout):
             dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
 
-    def energy(self, x: PETSc.Vec) -> float | None:
-        """The energy the pair's law stores at the state ``x``, summed over the Gauss points
-        (their weights) and the ranks (collective): the penalty's kappa / 2 [-g]_+^2 and
-        Nitsche's theta / (2 gamma) (P^2 - sigma_n^2), the obstacle forms' densities
-        (:meth:`contactfx.contact.nitsche.Nitsche.contact_energy`; with theta = 1 the
-        residual's contact terms are its derivative). None where the law stores none in this
-        form: with friction, and at finite strain (the laws of :meth:`_point_terms`)."""
-        if self.frictional or self.pointwise or self.geometric:
-            return None
+    @property
+    def stores_energy(self) -> bool:
+        """Whether :meth:`energy` is the law's stored energy: frictionless at small strain
+        (not with friction, nor for the laws of :meth:`_point_terms`)."""
+        return not (self.frictional or self.pointwise or self.geometric)
+
+    def energy(self, x: PETSc.Vec) -> float:
+        """The energy the pair's law stores at the state ``x`` (where :attr:`stores_energy`),
+        summed over the Gauss points (their weights) and the ranks (collective): the
+        penalty's kappa / 2 [-g]_+^2 and Nitsche's theta / (2 gamma) (P^2 - sigma_n^2), the
+        obstacle forms' densities (:meth:`contactfx.contact.nitsche.Nitsche.contact_energy`;
+        with theta = 1 the residual's contact terms are its derivative)."""
+        if not self.stores_energy:
+            raise ValueError(
+                "the pair's law stores no energy in this form (friction, finite strain)"
+            )
         if self.scatter is None:  # not searched yet: no point paired
             return 0.0
         vals = self._gather(x)

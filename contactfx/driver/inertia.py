@@ -234,10 +234,8 @@ class EnergyLedger:
         self.coupling = None
         if problem.surface is not None:
             energy = problem.method.contact_energy(problem.surface)
-        elif hasattr(problem, "coupling"):
-            coupling = problem.coupling()
-            if coupling.energy(_compat.petsc_vec(self.u)) is not None:
-                self.coupling = coupling
+        elif hasattr(problem, "coupling") and problem.coupling().stores_energy:
+            self.coupling = problem.coupling()
         #: whether the contact's stored energy is counted (else it is in the remainder)
         self.contact_counted = energy is not None or self.coupling is not None
         self.contact = None if energy is None else dolfinx.fem.form(energy * problem.surface.ds)

@@ -102,10 +102,10 @@ class HertzImpact(ObstacleScene):
         if self._forms is None:
             one = dolfinx.fem.Constant(problem.mesh, 1.0)
             volume = dolfinx.fem.assemble_scalar(dolfinx.fem.form(one * ufl.dx(problem.mesh)))
-            self.mass = self.symmetry * self.p.density * comm.allreduce(volume)
+            self._volume = comm.allreduce(volume)
+            self.mass = self.symmetry * self.p.density * self._volume
             v = problem.inertia.v if problem.inertia is not None else problem.state
             self._forms = dolfinx.fem.form(v[2] * ufl.dx(problem.mesh))
-            self._volume = comm.allreduce(volume)
         mean = comm.allreduce(dolfinx.fem.assemble_scalar(self._forms)) / self._volume
         self.track.append((load, quantities.force, mean))
 

@@ -262,27 +262,38 @@ class Dynamic(CutBack):
         self.x.axpy((1.0 - af) * 0.5 * dt * dt, a_n)
         _ghost_update(self.x)
 
+    def _end_displacement(self, w: PETSc.Vec) -> None:
+        """w (the unknown, u_{n+1-alpha_f}) made u_{n+1} = (w - alpha_f u_n) / (1 - alpha_f),
+        in place (ghosts not updated)."""
+        af = self.scheme.alpha_f
+        if af != 0.0:
+            w.axpy(-af, self.previous.copies[0])
+            w.scale(1.0 / (1.0 - af))
+
+    def _end_acceleration(self, u: PETSc.Vec, out: PETSc.Vec) -> None:
+        """Newmark's a_{n+1} = (u_{n+1} - u_n - dt v_n) / (b dt^2) - (1 / (2 b) - 1) a_n of the
+        step's end displacement ``u`` into ``out`` (ghosts not updated)."""
+        b, dt = self.scheme.beta, self.h
+        u_n, v_n, a_n = self.previous.copies[:3]
+        u.copy(out)
+        out.axpy(-1.0, u_n)
+        out.axpy(-dt, v_n)
+        out.scale(1.0 / (b * dt * dt))
+        out.axpy(-(0.5 / b - 1.0), a_n)
+
     def reject(self, stats: SolveStats) -> bool:
         """Whether a converged step's error estimate asks for a smaller step (the adaptive
         step, module docstring; always False at a fixed step). Sets ``eta``."""
         if not self.time_tolerance > 0.0:
             return False
-        s, dt = self.scheme, self.h
-        u_n, v_n, a_n = self.previous.copies[:3]
-        af, b = s.alpha_f, s.beta
-        u = self._u_new  # u_{n+1} = (w - af u_n) / (1 - af)
+        b, dt = self.scheme.beta, self.h
+        u = self._u_new
         self.x.copy(u)
-        if af != 0.0:
-            u.axpy(-af, u_n)
-            u.scale(1.0 / (1.0 - af))
-        u.axpy(-1.0, u_n)  # now u_{n+1} - u_n
-        e = self._error  # (b - 1/6) dt^2 (a_{n+1} - a_n), a_{n+1} from Newmark's update
-        u.copy(e)
-        e.axpy(-dt, v_n)
-        e.scale(1.0 / (b * dt * dt))
-        e.axpy(-(0.5 / b - 1.0) - 1.0, a_n)
+        self._end_displacement(u)
+        e = self._error  # (b - 1/6) dt^2 (a_{n+1} - a_n)
+        self._end_acceleration(u, e)
+        e.axpy(-1.0, self.previous.copies[2])
         e.scale((b - 1.0 / 6.0) * dt * dt)
-        u.axpy(1.0, u_n)  # u_{n+1}
         size, error = u.norm(), e.norm()
         self.eta = error / size if size > 0.0 else (0.0 if error == 0.0 else float("inf"))
         return self.eta > self.time_tolerance
@@ -290,20 +301,12 @@ class Dynamic(CutBack):
     def accept(self, stats: SolveStats) -> StepRecord:
         """u_{n+1} from w, then a_{n+1} and v_{n+1} (Newmark's updates); the unknown is set
         to u_{n+1} (the state of the output and of the next step's history)."""
-        s, dt = self.scheme, self.h
-        u_n, v_n, a_n = self.previous.copies[:3]
-        af, b, g = s.alpha_f, s.beta, s.gamma
-        if af != 0.0:  # u_{n+1} = (w - af u_n) / (1 - af)
-            self.x.axpy(-af, u_n)
-            self.x.scale(1.0 / (1.0 - af))
-            _ghost_update(self.x)
-        # a_{n+1} = (u_{n+1} - u_n - dt v_n) / (b dt^2) - (1 / (2 b) - 1) a_n
+        dt, g = self.h, self.scheme.gamma
+        _, v_n, a_n = self.previous.copies[:3]
+        self._end_displacement(self.x)
+        _ghost_update(self.x)
         a = self.a
-        self.x.copy(a)
-        a.axpy(-1.0, u_n)
-        a.axpy(-dt, v_n)
-        a.scale(1.0 / (b * dt * dt))
-        a.axpy(-(0.5 / b - 1.0), a_n)
+        self._end_acceleration(self.x, a)
         _ghost_update(a)
         # v_{n+1} = v_n + dt ((1 - g) a_n + g a_{n+1})
         v = self.v
