@@ -186,6 +186,12 @@ BAD = [
     (["run", "crack-sneddon", "--dynamic", "--dt", "0.1", "--t-end", "1"], "offered static only"),
     (["run", "two-bars", "--mass", "redistributed"], "between two bodies use --mass consistent"),
     (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
+    (["run", "bar-impact", "--method", "al-ssn"], "needs --mass redistributed"),
+    (
+        ["run", "disc-drop", "--formulation", "mixed-up", "--degree", "2"],
+        "the mixed u-p formulation is not offered in time yet",
+    ),
+    (["run", "bar-impact", "--al-coupling", "dual"], "--al-coupling must be one of"),
     (["run", "bar-impact", "--mass", "lumped", "--degree", "2"], "is a P1 lumping"),
     # the adaptive time step (contactfx/solvers/dynamics.py)
     (["run", "hertz2d", "--time-tolerance", "1e-3"], "an adaptive time step needs --dynamic"),

@@ -47,28 +47,32 @@ from contactfx import _compat
 from contactfx.driver.fields import global_sum, surface_mask, vertex_rule
 from contactfx.solvers.base import ConvergenceError
 
-__all__ = ["Inertia", "EnergyLedger", "EnergyBlowUp", "plot_contact"]
+__all__ = ["Inertia", "EnergyLedger", "EnergyBlowUp", "plot_contact", "EXACT_CONSTRAINT"]
+
+#: the methods whose converged state holds the Signorini condition exactly at the contact
+#: nodes (bound constraints, the augmented Lagrangian's multiplier): offered in time with the
+#: redistributed mass only (no inertia at the nodes the condition holds)
+EXACT_CONSTRAINT = ("vi", "al-ssn", "al-uzawa")
 
 
 class Inertia:
     """See the module docstring. ``problem``: the kind (its state, measures, material)."""
 
     def __init__(self, problem: Any) -> None:
-        if problem.split:
+        if problem.up:
             raise ValueError(
-                "--dynamic: a method with a multiplier field or the mixed u-p formulation is "
-                "not offered in time yet; use --method nitsche or penalty with --formulation "
-                "displacement"
+                "--dynamic: the mixed u-p formulation is not offered in time yet; use "
+                "--formulation displacement"
             )
         method, mass = problem.method.name, problem.num.mass
-        if method not in ("nitsche", "penalty", "compliance", "vi"):
+        if method not in ("nitsche", "penalty", "compliance", *EXACT_CONSTRAINT):
             raise ValueError(
                 f"--dynamic: method {method} is not offered in time yet; use nitsche, penalty, "
-                "compliance, or vi with --mass redistributed"
+                f"compliance, or {', '.join(EXACT_CONSTRAINT)} with --mass redistributed"
             )
-        if method == "vi" and mass != "redistributed":
+        if method in EXACT_CONSTRAINT and mass != "redistributed":
             raise ValueError(
-                "--dynamic --method vi needs --mass redistributed: the exact Signorini "
+                f"--dynamic --method {method} needs --mass redistributed: the exact Signorini "
                 "condition on nodes that carry mass is ill-posed in time (the energy of "
                 "bar-impact grows threefold over a period)"
             )
@@ -85,6 +89,14 @@ class Inertia:
         self.v = dolfinx.fem.Function(W, name="velocity")
         self.a = dolfinx.fem.Function(W, name="acceleration")
         self.a_star = dolfinx.fem.Function(W, name="inertia_load")
+        #: whether the unknown is mixed: (u, lambda) with a multiplier field, whose second
+        #: field has no inertia (the stepper's updates leave it out: :meth:`dynamic_dofs`)
+        self.split = problem.split
+        #: a mixed unknown's indicator of its displacement dofs (1 there, 0 on the
+        #: multiplier's): the stepper keeps the velocity and acceleration 0 on the multiplier,
+        #: whose value each step's contact law fixes with no history of its own; None unless
+        #: mixed
+        self.dynamic_dofs = self._dynamic_dofs(W) if self.split else None
         self.c = dolfinx.fem.Constant(problem.mesh, 0.0)
         self.dx, self.rho = self._mass(problem, rho)
         #: the contact dashpot's coefficient C (``--dashpot``), the velocity factor c_v and the
@@ -119,13 +131,27 @@ class Inertia:
         weight = ufl.conditional(ufl.lt(mean, 1.0 - 1e-12), (1.0 - chi) / (1.0 - mean), 0.0)
         return dx, rho * weight
 
+    def displacement(self, f: dolfinx.fem.Function) -> Any:
+        """The displacement part of a Function of the unknown's space (all of it unless
+        mixed)."""
+        return ufl.split(f)[0] if self.split else f
+
+    @staticmethod
+    def _dynamic_dofs(W: Any) -> dolfinx.fem.Function:
+        """A mixed space's indicator of its displacement dofs (1 there, 0 on the
+        multiplier's)."""
+        mask = dolfinx.fem.Function(W, name="dynamic_dofs")
+        _, dofs = W.sub(0).collapse()
+        mask.x.array[np.asarray(dofs)] = 1.0
+        return mask
+
     def mass_term(self, du: Any, v: Any) -> ufl.Form:
         """c int rho du . v dx (bilinear: the linear bulk's K + c M)."""
         return self.c * self.rho * ufl.inner(du, v) * self.dx
 
     def load_term(self, v: Any) -> ufl.Form:
         """int rho a* . v dx (the bulk's extra load)."""
-        return self.rho * ufl.inner(self.a_star, v) * self.dx
+        return self.rho * ufl.inner(self.displacement(self.a_star), v) * self.dx
 
     def internal_term(self, u: Any, v: Any) -> ufl.Form:
         """c int rho u . v dx (a nonlinear bulk's inertia in its residual; its tangent is the
@@ -148,7 +174,7 @@ class Inertia:
     def mass_matrix(self, trial: Any, test: Any, bcs: list[Any]) -> PETSc.Mat:
         """M (rho du . v dx), its supported rows and columns replaced by the identity, and a
         unit diagonal where the mass is zero (the contact nodes of a redistributed mass:
-        their acceleration is left 0)."""
+        their acceleration is left 0; a multiplier field's rows, which the stepper zeroes)."""
         form = dolfinx.fem.form(self.rho * ufl.inner(trial, test) * self.dx)
         M = _compat.assemble_matrix(_compat.create_matrix(form), form, bcs)
         d = M.getDiagonal()
@@ -158,7 +184,8 @@ class Inertia:
         return M
 
     def kinetic_form(self) -> Any:
-        return dolfinx.fem.form(0.5 * self.rho * ufl.inner(self.v, self.v) * self.dx)
+        v = self.displacement(self.v)
+        return dolfinx.fem.form(0.5 * self.rho * ufl.inner(v, v) * self.dx)
 
 
 def initial_acceleration(
@@ -181,7 +208,7 @@ def initial_acceleration(
         R = solver.reactions()  # f_int + f_c - f_ext on every row
         R.scale(-1.0)
         dolfinx.fem.petsc.set_bc(R, problem.bcs, x, 0.0)  # 0 on the supported rows
-        M = inertia.mass_matrix(problem.trial, problem.test, problem.bcs)
+        M = inertia.mass_matrix(problem.dU, problem.V_test, problem.bcs)
         ksp = PETSc.KSP().create(problem.mesh.comm)
         ksp.setOperators(M)
         ksp.setType("preonly")

@@ -574,16 +574,20 @@ class _Run:
             )
         inertia = problem.inertia
         assert inertia is not None  # built by the problem for a dynamic run
-        self.scene.initial_velocity(inertia.v)
+        self.scene.initial_velocity(inertia.v.sub(0) if problem.split else inertia.v)
         if problem.prev is not None:  # the friction history starts at the initial state
             problem.prev.x.array[:] = problem.state.x.array
         self.energy = EnergyLedger(problem, inertia, problem.load_form)
         vec = _compat.petsc_vec
-        dashpot: dict[str, Any] = {}
+        extra: dict[str, Any] = {}
         if inertia.v_star is not None:  # the velocity c_v w - v* of the dashpot's law
-            dashpot = dict(
+            extra = dict(
                 v_star=vec(inertia.v_star), set_velocity_factor=inertia.set_velocity_factor
             )
+        if inertia.dynamic_dofs is not None:  # a multiplier field: no inertia, no history
+            extra["dynamic_dofs"] = vec(inertia.dynamic_dofs)
+        if problem.multiplier is not None:  # a nodal multiplier: restored with a step's state
+            extra["fields"] = [vec(problem.multiplier)]
         return Dynamic(
             Scheme.named(self.num.scheme, self.num.rho_inf),
             dt=self.num.dt,
@@ -595,7 +599,7 @@ class _Run:
             reassemble=solver.reassemble_bulk,
             initial_acceleration=initial_acceleration(problem, solver, inertia),
             time_tolerance=self.num.time_tolerance,
-            **dashpot,
+            **extra,
         )
 
     def _output(self, suffix: str) -> str | None:

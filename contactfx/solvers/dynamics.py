@@ -139,6 +139,9 @@ class Dynamic(CutBack):
     ``v_star`` (optional: a law that reads the velocity, the contact dashpot): the vector of
     the velocity load v*, set with the velocity factor ``set_velocity_factor(c_v)`` at every
     step (the velocity at the force time is c_v w - v*); without it neither is computed.
+    ``dynamic_dofs`` (optional: a mixed unknown with a multiplier field): 1 on the dofs with
+    inertia, 0 on the multiplier's, whose velocity and acceleration are kept 0 (the multiplier
+    each step's contact law fixes is no state of the time integration).
     """
 
     #: not restored by a restart: the restarted run's bulk was assembled with c = 0, and is
@@ -165,6 +168,7 @@ class Dynamic(CutBack):
         time_tolerance: float = 0.0,
         v_star: PETSc.Vec | None = None,
         set_velocity_factor: Callable[[float], None] | None = None,
+        dynamic_dofs: PETSc.Vec | None = None,
     ) -> None:
         if not dt > 0.0:
             raise ValueError(f"--dt must be > 0, got {dt}")
@@ -179,6 +183,10 @@ class Dynamic(CutBack):
         if (v_star is None) != (set_velocity_factor is None):
             raise TypeError("v_star and set_velocity_factor go together")
         self.v_star, self.set_velocity_factor = v_star, set_velocity_factor
+        #: 1 on the dofs the updates apply to, 0 on an algebraic field's (a multiplier: its
+        #: velocity and acceleration are kept 0, the predictor leaves it at its last value,
+        #: the error estimate leaves it out); None: every dof
+        self.dynamic_dofs = dynamic_dofs
         if not time_tolerance >= 0.0:
             raise ValueError(f"--time-tolerance must be >= 0, got {time_tolerance}")
         #: the adaptive step's tolerance (module docstring); 0: a fixed step with cut-back
@@ -194,6 +202,10 @@ class Dynamic(CutBack):
         self.x = x
         if self.initial_acceleration is not None:
             self.initial_acceleration(x, self.a)
+        if self.dynamic_dofs is not None:
+            self._algebraic_zero(self.v, self.a)
+            _ghost_update(self.v)
+            _ghost_update(self.a)
         #: u_n, v_n, a_n (and the other fields) of the last accepted step
         self.previous = Snapshot([x, self.v, self.a, *self.fields])
         self.t_prev = self.t_start
@@ -294,6 +306,7 @@ class Dynamic(CutBack):
         self._end_acceleration(u, e)
         e.axpy(-1.0, self.previous.copies[2])
         e.scale((b - 1.0 / 6.0) * dt * dt)
+        self._algebraic_zero(u, e)
         size, error = u.norm(), e.norm()
         self.eta = error / size if size > 0.0 else (0.0 if error == 0.0 else float("inf"))
         return self.eta > self.time_tolerance
@@ -307,12 +320,14 @@ class Dynamic(CutBack):
         _ghost_update(self.x)
         a = self.a
         self._end_acceleration(self.x, a)
+        self._algebraic_zero(a)
         _ghost_update(a)
         # v_{n+1} = v_n + dt ((1 - g) a_n + g a_{n+1})
         v = self.v
         v_n.copy(v)
         v.axpy(dt * (1.0 - g), a_n)
         v.axpy(dt * g, a)
+        self._algebraic_zero(v)
         _ghost_update(v)
         self.step += 1
         self.previous.save()
@@ -325,6 +340,12 @@ class Dynamic(CutBack):
             self.dt = min(self.dt_base, 2.0 * self.dt)
         self.cutbacks = 0
         return record
+
+    def _algebraic_zero(self, *vectors: PETSc.Vec) -> None:
+        """0 on the dofs without inertia (``dynamic_dofs``), in place (ghosts not updated)."""
+        if self.dynamic_dofs is not None:
+            for vec in vectors:
+                vec.pointwiseMult(vec, self.dynamic_dofs)
 
     def describe(self, t: float) -> str:
         return f"time {t:.6g}"
