@@ -239,6 +239,11 @@ class AugmentedLagrangianSSN(_AugmentedBase):
         lumped = bool(getattr(options, "dynamic", False))
         return dataclasses.replace(method, al_coupling="lumped" if lumped else "consistent")
 
+    def traction_measure(self, s: Surface) -> Any:
+        """The vertex rule with the lumped coupling (module docstring), else the Gauss rule."""
+        lumped = self.al_coupling == "lumped" and s.ds_nodal is not None
+        return s.ds_nodal if lumped else s.ds
+
     def pressure(self, s: Surface) -> Expr:
         if s.ds_nodal is None:  # a projected multiplier (projected_law)
             return self._augmented(s)[0]
@@ -290,7 +295,7 @@ class AugmentedLagrangianSSN(_AugmentedBase):
             c_n = lam_n - p
         else:
             c_n = fischer_burmeister(lam_n, r * s.gap(), s.E)
-        ds = s.ds_nodal if self.al_coupling == "lumped" else s.ds
+        ds = self.traction_measure(s)
         if lam_t is None:  # scalar pressure multiplier
             return lam * ufl.dot(s.v, n) * ds + s.collocated(c_n) * mu * s.ds_nodal
         # traction multiplier t = lam: -int t . v, and C(lam, u) = -c_n n + (lam_T - T) = 0

@@ -183,6 +183,11 @@ class MethodBase:
         tangential terms' share is in the balance's remainder)."""
         return None
 
+    def traction_measure(self, s: Surface) -> Any:
+        """The measure the method's traction acts on the displacement with (its work, e.g.
+        friction's dissipation in a dynamic run's balance): the surface's Gauss rule."""
+        return s.ds
+
     def trial_traction(self, s: Surface) -> tuple[Expr, Expr] | None:
         """With friction, the trial tangential traction and the friction bound that Newton's
         reversal guard compares between iterates (:func:`contactfx.contact.laws.reversal`);

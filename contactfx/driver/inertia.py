@@ -273,7 +273,8 @@ class EnergyLedger:
         if surface is not None and problem.friction is not None:
             t_T = problem.method.tangential_traction(surface)
             slip = surface.slip_increment(surface.normal())
-            self.friction = dolfinx.fem.form(-ufl.dot(t_T, slip) * surface.ds)
+            ds = problem.method.traction_measure(surface)
+            self.friction = dolfinx.fem.form(-ufl.dot(t_T, slip) * ds)
         self.dissipated = 0.0
         self.load_form = load_form
         self.f = _compat.create_vector(load_form)

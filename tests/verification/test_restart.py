@@ -161,6 +161,24 @@ def test_restart_dynamic_with_friction(tmp_path, monkeypatch):
     _same_fields(base, "sliding-stop", 1e-8)
 
 
+def test_restart_dynamic_multiplier(tmp_path, monkeypatch):
+    """bar-impact with al-ssn (a mixed unknown: the multiplier has no velocity or
+    acceleration) and the redistributed mass, stopped in the contact phase (t = 1.1) and
+    restarted: the displacement, multiplier, velocity and acceleration continue (the numbers
+    to the solver's tolerance, 1e-8, as the dynamic restart above)."""
+    numerics = {"method": "al-ssn", "mass": "redistributed", "t_end": 1.2, "dt": 0.01}
+    base, run = _runs(tmp_path, monkeypatch, "bar-impact", 110, numerics)
+    full, cut = run["full"], run["cut"]
+    assert cut["status"] == "completed" and len(cut["steps"]) == len(full["steps"]) == 120
+    assert cut["restarted"]["step"] == 110
+    assert full["steps"][109]["force"] > 0.1  # stopped in the contact
+    a, b = _numbers(full["steps"]), _numbers(cut["steps"])
+    for k in [k for k in a if k.endswith((".newton", ".ksp"))]:
+        a.pop(k), b.pop(k)
+    assert _worst(a, b) <= 1e-8
+    _same_fields(base, "bar-impact", 1e-8)
+
+
 def test_restart_two_bodies(tmp_path, monkeypatch):
     base, run = _runs(tmp_path, monkeypatch, "hertz-cylinders", 2, {"method": "mortar", "steps": 4})
     full, cut = run["full"], run["cut"]
