@@ -184,7 +184,7 @@ BAD = [
     (["run", "hertz2d", "--dynamic", "--dt", "0.1", "--t-end", "1"], "needs the body's density"),
     (["run", "patch-test", "--dynamic", "--dt", "0.1", "--t-end", "1"], "needs the body's density"),
     (["run", "crack-sneddon", "--dynamic", "--dt", "0.1", "--t-end", "1"], "offered static only"),
-    (["run", "two-bars", "--mass", "redistributed"], "between two bodies use --mass consistent"),
+    (["run", "two-bars", "--method", "mortar"], "--method mortar needs --mass redistributed"),
     (["run", "bar-impact", "--method", "vi"], "needs --mass redistributed"),
     (["run", "bar-impact", "--method", "al-ssn"], "needs --mass redistributed"),
     (

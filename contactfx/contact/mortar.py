@@ -173,6 +173,10 @@ def _to_owners(
 class MortarCoupling:
     """The condensed dual-mortar contact of one pair (see the module docstring)."""
 
+    #: the nodal complementarity holds exactly at a converged state: the constraint stores no
+    #: energy (a dynamic run's balance counts its contact term as 0)
+    stores_energy = False
+
     def __init__(self, pair: ContactPair, r0: float, ncp: str) -> None:
         self.pair, self.r0, self.ncp = pair, r0, ncp
         self.layout: NodeLayout = pair.layout

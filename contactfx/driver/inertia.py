@@ -52,7 +52,7 @@ __all__ = ["Inertia", "EnergyLedger", "EnergyBlowUp", "plot_contact", "EXACT_CON
 #: the methods whose converged state holds the Signorini condition exactly at the contact
 #: nodes (bound constraints, the augmented Lagrangian's multiplier): offered in time with the
 #: redistributed mass only (no inertia at the nodes the condition holds)
-EXACT_CONSTRAINT = ("vi", "al-ssn", "al-uzawa")
+EXACT_CONSTRAINT = ("vi", "al-ssn", "al-uzawa", "mortar")
 
 
 class Inertia:

@@ -135,11 +135,6 @@ class TwoBodyProblem(Problem):
             )
         if scene.slave_tag == scene.master_tag:
             raise ValueError("the slave and master surfaces of a contact pair must differ")
-        if numerics.dynamic and numerics.mass == "redistributed":
-            raise ValueError(
-                "--mass redistributed is offered against a rigid obstacle; between two bodies "
-                "use --mass consistent or lumped"
-            )
         if scene.smoothing() == "normals" and method.name != "mortar":
             raise ValueError(
                 f'contact.0.smoothing = "{scene.smoothing()}" is mortar\'s (its weighted nodal '
