@@ -15,6 +15,16 @@ force time, c_v u - v* (:mod:`contactfx.solvers.dynamics`: the velocity factor c
 and the velocity load v*, a Function). A static run has none of this (no mass matrix, no
 velocity field), a dynamic run without a dashpot none of the latter.
 
+The methods that hold the Signorini condition exactly at nodes (``vi``; the augmented
+Lagrangian, ``al-ssn`` with its multiplier a field of the unknown, ``al-uzawa`` with its
+nodal multiplier; dual ``mortar`` at the slave nodes between two bodies) run in time with the
+redistributed mass only (Khenous, Laborde and Renard 2008; between two bodies the slave
+surface's nodes lose their mass, as in Hager, Hueeber and Wohlmuth 2008, Int. J. Numer. Meth.
+Engng 73, 205-225): a node without inertia takes its quasi-static place under the constraint
+at every step, where a node with mass would be stopped in one step (an impact the time
+scheme cannot resolve). A multiplier field has no inertia: its velocity and acceleration are
+kept 0 (:attr:`Inertia.dynamic_dofs`), its value fixed by each step's contact law.
+
 :class:`EnergyLedger` keeps the balance at every step: the kinetic energy 1/2 v . M v, the
 strain energy (the material's density), the energy the contact terms store (the method's, e.g.
 Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_+^2), the work
@@ -50,8 +60,9 @@ from contactfx.solvers.base import ConvergenceError
 __all__ = ["Inertia", "EnergyLedger", "EnergyBlowUp", "plot_contact", "EXACT_CONSTRAINT"]
 
 #: the methods whose converged state holds the Signorini condition exactly at the contact
-#: nodes (bound constraints, the augmented Lagrangian's multiplier): offered in time with the
-#: redistributed mass only (no inertia at the nodes the condition holds)
+#: nodes (bound constraints, the augmented Lagrangian's multiplier, dual mortar's at the slave
+#: nodes): offered in time with the redistributed mass only (no inertia at the nodes where the
+#: condition holds; Khenous, Laborde and Renard 2008, doi:10.1016/j.euromechsol.2007.12.001)
 EXACT_CONSTRAINT = ("vi", "al-ssn", "al-uzawa", "mortar")
 
 
@@ -65,11 +76,6 @@ class Inertia:
                 "--formulation displacement"
             )
         method, mass = problem.method.name, problem.num.mass
-        if method not in ("nitsche", "penalty", "compliance", *EXACT_CONSTRAINT):
-            raise ValueError(
-                f"--dynamic: method {method} is not offered in time yet; use nitsche, penalty, "
-                f"compliance, or {', '.join(EXACT_CONSTRAINT)} with --mass redistributed"
-            )
         if method in EXACT_CONSTRAINT and mass != "redistributed":
             raise ValueError(
                 f"--dynamic --method {method} needs --mass redistributed: the exact Signorini "
