@@ -147,7 +147,18 @@ class _KeptPreconditioner:
     (a two-body coupling's search). ``every_solve`` False: not refreshed at a solve's first
     iteration either (a dynamic run's steps, whose Jacobian changes with the contact status
     only); ``stale``: refreshed at the next Jacobian (the bulk was re-assembled). A
-    checkpoint holds P's values (a restarted run factorises the same matrix)."""
+    checkpoint holds P's values (a restarted run factorises the same matrix).
+
+    Kept across solves, P is also refreshed once the back-substitutions made with it (the
+    Krylov iterations since its factorisation) reach what a factorisation is worth: the
+    factor's elimination flops over the flops of one back-substitution, 2 per entry of the
+    factors (MUMPS's RINFOG(3) and INFOG(9); read after each factorisation, the same on
+    every rank). The kept matrix ages as the contact status drifts from the one it was
+    factorised at, and each solve then takes more iterations: in 2D, where a factorisation
+    costs 7 (sliding-stop) to 16 (disc-drop) back-substitutions, refreshing at that budget
+    halved disc-drop's time per step; in 3D (hertz-impact, 565) the budget is never reached
+    and the iteration limit alone refreshes, which is what measured fastest there
+    (docs/verification.md section 18, speed)."""
 
     checkpoint_values = ("P",)
 
@@ -161,20 +172,34 @@ class _KeptPreconditioner:
     ) -> None:
         self.rebuild_it, self.coupled, self.every_solve = rebuild_it, coupled, every_solve
         self.stale = False
+        #: Krylov iterations (back-substitutions) made with P since its factorisation, and
+        #: what a factorisation is worth in them (across solves only; None: not yet read)
+        self.spent = 0
+        self.budget: float | None = None
+        self._read_budget = False
         self.P = J.duplicate(copy=True)
         if nullspace is not None:  # AMG reads the near-nullspace from its own matrix
             self.P.setNearNullSpace(nullspace)
 
     def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
+        if not self.every_solve:  # the last solve's back-substitutions, and P's worth
+            its = ksp.getIterationNumber()
+            self.spent += its
+            if self._read_budget and its > 0:  # (a solve has factorised P since)
+                self.budget = _factorisation_worth(ksp)
+                self._read_budget = False
         fresh = (
             self.stale
             or (self.every_solve and snes.getIterationNumber() == 0)
             or ksp.getConvergedReason() < 0
             or ksp.getIterationNumber() >= self.rebuild_it
+            or (self.budget is not None and self.spent >= self.budget)
         )
         if fresh:
             self.stale = False
+            self.spent = 0
+            self._read_budget = not self.every_solve
             S = PETSc.Mat.Structure
             J.copy(
                 self.P,
@@ -183,6 +208,19 @@ class _KeptPreconditioner:
 
     def destroy(self) -> None:
         self.P.destroy()
+
+
+def _factorisation_worth(ksp: PETSc.KSP) -> float | None:
+    """A MUMPS LU factorisation's elimination flops over one back-substitution's (2 per entry
+    of the factors): what refactorising costs in Krylov iterations with the kept factors;
+    None before the first factorisation or with another factor package."""
+    try:
+        F = ksp.getPC().getFactorMatrix()
+        flops, entries = F.getMumpsRinfog(3), F.getMumpsInfog(9)
+    except PETSc.Error:
+        return None
+    entries = entries if entries >= 0 else -entries * 1e6  # negative: millions
+    return flops / (2.0 * entries) if flops > 0.0 and entries > 0 else None
 
 
 class _StepHalving:
@@ -278,6 +316,10 @@ class ContactSNES:
 
     #: Krylov iterations at most with a reused factorisation (then it is refactorised)
     REUSE_MAX_IT = 20
+    #: FGMRES's relative tolerance on the factorisation kept across solves (a dynamic run):
+    #: Newton's steps exact to 1e-6 (hertz-impact's 3D steps 30 % faster than at 1e-12, at
+    #: the same Newton iterations; docs/verification.md section 18, speed)
+    REUSE_RTOL_ACROSS = 1e-6
     #: Krylov iterations above which a kept AMG preconditioner is rebuilt at the next Jacobian
     AMG_REBUILD_IT = 30
     #: continued solves with the reversal guard before one without it (see _newton)
@@ -418,14 +460,21 @@ class ContactSNES:
         failed Krylov solve and after the bulk is re-assembled (a dynamic run with a linear
         bulk: K + c M factorised once per step size, the contact's rows changing the
         Jacobian only when the contact status changes; an unchanged Jacobian costs one
-        back-substitution)."""
+        back-substitution). Across solves FGMRES stops at REUSE_RTOL_ACROSS (1e-6), within a
+        solve at 1e-12: the Jacobians of a step's Newton iterations differ from the kept
+        one in the rows of the nodes whose contact status changed since, a low-rank change
+        that FGMRES resolves in about as many iterations as its rank (a 3D contact zone's
+        ring of nodes: 13 back-substitutions a Newton iteration at 1e-12, 10 at 1e-6, the
+        Newton iterations unchanged; a fresh factorisation at every step's start saved
+        fewer back-substitutions than it cost)."""
         ksp = self.snes.getKSP()
         if ksp.getPC().getType() != "lu" or ksp.getType() != "preonly":
             return
         # flexible GMRES (preconditioned on the right) keeps the preconditioned directions, so
         # k iterations cost k back-substitutions (left-preconditioned GMRES takes one more)
         ksp.setType("fgmres")
-        ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=self.REUSE_MAX_IT)
+        rtol = self.REUSE_RTOL_ACROSS if across_solves else 1e-12
+        ksp.setTolerances(rtol=rtol, atol=0.0, max_it=self.REUSE_MAX_IT)
         # a Krylov solve stopped at REUSE_MAX_IT is still a descent step: take it, refactorise
         self.snes.setMaxLinearSolveFailures(10**6)
         self._keep_preconditioner(self.REUSE_MAX_IT, every_solve=not across_solves)
