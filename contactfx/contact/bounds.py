@@ -103,10 +103,14 @@ class _Bounded(SolverWrapper):
         mesh = V.mesh
         gdim = mesh.geometry.dim
         self.obstacle, self.offset, self.gdim = obstacle, offset, gdim
-        Vd, _ = V.sub(gdim - 1).collapse()
-        dofs = _compat.locate_dofs_topological((V.sub(gdim - 1), Vd), gdim - 1, facets)
-        self.dofs = np.asarray(dofs[0])  # indices into V's local (unrolled) dofs
-        coords = _compat.dof_coordinates(Vd)[np.asarray(dofs[1])][:, :gdim]
+        if V.num_sub_spaces == 0:  # a one-component space (1D on dolfinx 0.9): V itself
+            self.dofs = np.asarray(_compat.locate_dofs_topological(V, gdim - 1, facets))
+            coords = _compat.dof_coordinates(V)[self.dofs][:, :gdim]
+        else:
+            Vd, _ = V.sub(gdim - 1).collapse()
+            dofs = _compat.locate_dofs_topological((V.sub(gdim - 1), Vd), gdim - 1, facets)
+            self.dofs = np.asarray(dofs[0])  # indices into V's local (unrolled) dofs
+            coords = _compat.dof_coordinates(Vd)[np.asarray(dofs[1])][:, :gdim]
         self._template = dolfinx.fem.Function(V)  # owns the memory the bounds are copied from
         x = _compat.petsc_vec(self._template)
         self.lower, self.upper = x.copy(), x.copy()

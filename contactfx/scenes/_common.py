@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 
+import dolfinx
 import numpy as np
 from mpi4py import MPI
 
@@ -34,7 +35,12 @@ def fix(V, facet_tags, tag: int):
     displacement part of a mixed space)."""
     if V.num_sub_spaces == 0:  # a one-component space (1D on dolfinx 0.9) has no sub-spaces
         mesh = V.mesh
-        dofs = _compat.locate_dofs_topological(V, mesh.topology.dim - 1, _facets(facet_tags, tag))
+        facets = _facets(facet_tags, tag)
+        if V.component():  # the displacement part of a mixed space: a zero of its collapse
+            collapsed, _ = V.collapse()
+            dofs = _compat.locate_dofs_topological((V, collapsed), mesh.topology.dim - 1, facets)
+            return [_compat.dirichletbc(dolfinx.fem.Function(collapsed), dofs, V)]
+        dofs = _compat.locate_dofs_topological(V, mesh.topology.dim - 1, facets)
         return [_compat.dirichletbc(np.zeros(mesh.geometry.dim), dofs, V)]
     return [fix_component(V, facet_tags, tag, i) for i in range(V.mesh.geometry.dim)]
 
