@@ -50,7 +50,8 @@ __all__ = ["GridMultiplier"]
 
 
 class _CrackView(Protocol):
-    """What the multiplier reads of an unfitted crack (``contactfx.driver.unfitted_cracks.Crack``)."""
+    """What the multiplier reads of an unfitted crack
+    (``contactfx.driver.unfitted_cracks.Crack``)."""
 
     @property
     def ds(self) -> ufl.Measure: ...

@@ -275,10 +275,11 @@ class UnfittedProblem(InterfaceProblem):
         return u + sum((c.H * c.enrichment(X) for c in self.cracks), ufl.zero(d))
 
     def boundary_total(self, X: Expr) -> Expr:
-        """w = u + sum_k H_k a_k with each H_k the side of the point (:meth:`contactfx.driver.unfitted_cracks.Crack.side`):
-        the boundary's test function and quantities, which on a facet of a cut cell see the
-        facet's own side (the cell's larger side may be the other one); a loaded facet that a
-        crack crosses is refused (:meth:`_refuse_loaded_crossings`)."""
+        """w = u + sum_k H_k a_k with each H_k the side of the point
+        (:meth:`contactfx.driver.unfitted_cracks.Crack.side`): the boundary's test function and
+        quantities, which on a facet of a cut cell see the facet's own side (the cell's larger side
+        may be the other one); a loaded facet that a crack crosses is refused
+        (:meth:`_refuse_loaded_crossings`)."""
         d, x = self.gdim, ufl.SpatialCoordinate(self.mesh)
         u = ufl.as_vector([X[i] for i in range(d)])
         return u + sum((c.side(x) * c.enrichment(X) for c in self.cracks), ufl.zero(d))
