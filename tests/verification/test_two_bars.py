@@ -117,8 +117,8 @@ def test_mortar_with_redistributed_mass():
     """Dual mortar (the nodal complementarity at the slave nodes) with the slave nodes' mass
     redistributed (Hager, Hueeber and Wohlmuth 2008, Int. J. Numer. Meth. Engng 73, 205-225):
     with Newmark's average acceleration, which the consistent mass's chatter makes gain energy
-    here, the bars keep their energy to 0.5 % (measured +0.14 %, gained at the separation's
-    status change), the discrete momentum 1^T M v is kept to the Newton residual (measured
+    here, the bars keep their energy to 0.5 % (measured +0.14 % after they part), the
+    discrete momentum 1^T M v is kept to the Newton residual (measured
     2e-12), the force stays positive and within 40 % of rho c v0 w / 2 inside the contact
     (0.0031-0.0069 about 0.005), the bars part within two steps of 2 L / c (2.04). With
     generalised-alpha (the scene's) the velocities are exchanged to 3 % of v0 (measured 2.0 %
