@@ -30,6 +30,11 @@ def _facets(facet_tags, tag: int) -> np.ndarray:
     return facet_tags.indices[facet_tags.values == tag]
 
 
+#: a contact force below this fraction of a scene's force scale counts as open: a multiplier
+#: (al-ssn's, mortar's) vanishes only to Newton's tolerance where the contact has opened
+OPEN_FORCE = 1e-6
+
+
 def fix(V, facet_tags, tag: int):
     """u = 0 on the facets tagged ``tag`` (one condition per component, so that V may be the
     displacement part of a mixed space)."""

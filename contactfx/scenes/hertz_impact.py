@@ -31,7 +31,7 @@ from contactfx.meshes import BallFacets, quarter_ball
 from contactfx.params import param
 from contactfx.references import hertz_impact
 from contactfx.scenes import export
-from contactfx.scenes._common import fix_component
+from contactfx.scenes._common import OPEN_FORCE, fix_component
 from contactfx.scenes.base import ObstacleScene, elastic
 
 __all__ = ["HertzImpact"]
@@ -131,8 +131,7 @@ class HertzImpact(ObstacleScene):
             return out
         t = np.array([r[0] for r in track])
         f = np.array([r[1] for r in track])
-        # (a multiplier, al-ssn's, vanishes to Newton's tolerance where open)
-        closed = np.flatnonzero(f > 1e-6 * ref["force"])
+        closed = np.flatnonzero(f > OPEN_FORCE * ref["force"])
         out["peak_force_computed"] = float(f.max())
         out["peak_force_rel_error"] = float(f.max() / ref["force"] - 1.0)
         if closed.size and closed[-1] + 1 < len(t):  # the ball has left the plane

@@ -22,6 +22,7 @@ import ufl
 from contactfx.mechanics.elasticity import Elastic
 from contactfx.meshes import StackedBlocksCells, StackedBlocksFacets, stacked_blocks
 from contactfx.params import Params, param
+from contactfx.scenes._common import OPEN_FORCE
 from contactfx.scenes.two_body_base import TwoBodyScene
 
 __all__ = ["TwoBars"]
@@ -136,8 +137,7 @@ class TwoBars(TwoBodyScene):
         track = getattr(self, "track", [])
         if not track:
             return out
-        # a multiplier (mortar's) vanishes to Newton's tolerance where open
-        touching = [t for t, f, _, _ in track if f > 1e-6 * out["contact_force"]]
+        touching = [t for t, f, _, _ in track if f > OPEN_FORCE * out["contact_force"]]
         t, _, v_up, v_low = track[-1]
         start = -p.speed * p.length * p.width * p.density
         momentum = self.momentum or [start]

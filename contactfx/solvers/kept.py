@@ -54,8 +54,8 @@ class KeptPreconditioner:
 
     def update(self, snes: PETSc.SNES, J: PETSc.Mat) -> None:
         ksp = snes.getKSP()
-        if not self.every_solve:  # the last solve's back-substitutions, and P's worth
-            its = ksp.getIterationNumber()
+        its = ksp.getIterationNumber()  # the last Krylov solve's
+        if not self.every_solve:  # the back-substitutions made with P, and P's worth
             self.spent += its
             if self._read_budget and its > 0:  # (a solve has factorised P since)
                 self.budget = factorisation_worth(ksp)
@@ -64,7 +64,7 @@ class KeptPreconditioner:
             self.stale
             or (self.every_solve and snes.getIterationNumber() == 0)
             or ksp.getConvergedReason() < 0
-            or ksp.getIterationNumber() >= self.rebuild_it
+            or its >= self.rebuild_it
             or (self.budget is not None and self.spent >= self.budget)
         )
         if fresh:
