@@ -61,10 +61,11 @@ class Coupling(Protocol):
 class PairCoupling(Coupling, Protocol):
     """A two-body coupling also gives the two-body kind's post-processing its nodal state at
     the last converged solve: ``nodal()`` (the slave contact nodes, their weights, pressure
-    and gap), ``nodal_friction()`` and ``friction_state()`` (with friction), ``force()`` (the
-    total normal force), ``slave_force()`` (the force vector on the slave body;
-    ``force_parts()`` its normal and tangential parts), ``search_gaps()`` (the gaps the last
-    search measured) and ``nodal_normals()`` (a unit normal per node of ``nodal()``);
+    and gap), ``nodal_friction()``, ``friction_state()`` and ``friction_work()`` (with
+    friction; the last: friction's dissipation on the step), ``force()`` (the total normal
+    force), ``slave_force()`` (the force vector on the slave body; ``force_parts()`` its normal
+    and tangential parts), ``search_gaps()`` (the gaps the last search measured) and
+    ``nodal_normals()`` (a unit normal per node of ``nodal()``);
     ``record_start()`` takes the last search's gaps (at the start) as an interference fit's
     initial overlaps (hidden by ``pair.hidden()``).
     ``converged()`` is called when a load step converged (a coupling that keeps a history,
@@ -79,6 +80,8 @@ class PairCoupling(Coupling, Protocol):
     def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
 
     def friction_state(self) -> dict[str, float]: ...
+
+    def friction_work(self) -> float: ...
 
     def force(self) -> float: ...
 

@@ -813,6 +813,18 @@ class MortarCoupling:
             "tangential": float(np.sum(D * np.linalg.norm(self.lam_t, axis=1))),
         }
 
+    def friction_work(self) -> float:
+        """Friction's dissipation on the last step, sum_j D_j lambda_T,j . v_j over the contact
+        nodes (v_j the weighted slip increment of the step, at the last residual): the work
+        of the tangential forces -D_j lambda_T,jc t_jc on the slave node and M_jk lambda_T,jc
+        t_jc on the master nodes, sign reversed. Collective."""
+        from mpi4py import MPI
+
+        assert self.mu is not None  # with friction
+        slip = np.where(self.tmask, self._g.getArray()[self.tangent_rows()], 0.0)
+        local = float(np.sum(self.D * np.einsum("jc,jc->j", self.lam_t, slip)))
+        return self.comm.allreduce(local, op=MPI.SUM)
+
     def nodal_friction(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per node of :meth:`nodal`: the nominal |lambda_T| (D_j |lambda_T| / D0_j), |weighted
         slip increment of the step| and the stick mask."""

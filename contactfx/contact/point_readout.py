@@ -158,6 +158,20 @@ class PointReadout:
             "tangential": float(np.sum(w * np.linalg.norm(t, axis=1))),
         }
 
+    def friction_work(self) -> float:
+        """Friction's dissipation on the last step, -sum_p w_p t_p . s_p over the Gauss points
+        of both directions (t the slave's tangential traction, s its slip increment of the
+        step relative to the master, both at the last residual: the converged state), the
+        pair's counterpart of the obstacle's -int t_T . du_T ds. Collective."""
+        from mpi4py import MPI
+
+        local = 0.0
+        for p, s in zip(self.points, self.state, strict=True):
+            t, slip = s[2], s[4]
+            assert t is not None and slip is not None  # with friction
+            local -= float(np.sum(p["w"] * np.einsum("pg,pg->p", t, slip)))
+        return self.comm.allreduce(local, op=MPI.SUM)
+
     def force(self) -> float:
         """The normal contact force (the quadrature sum of P over both directions)."""
         local = sum(

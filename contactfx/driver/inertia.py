@@ -30,7 +30,8 @@ strain energy (the material's density), the energy the contact terms store (the 
 Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_+^2), the work
 of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), friction's
 dissipation (the sum over the steps of -int t_T . du_T ds, the traction at the step's end on
-its slip increment: backward Euler's), with a contact dashpot its dissipation (trapezoidal:
+its slip increment: backward Euler's; between two bodies the pair's coupling sums the
+traction of the step's balance, at t_{n+1-alpha_f}, on the step's slip), with a contact dashpot its dissipation (trapezoidal:
 D_dashpot += 1/2 (f_d,n + f_d,n+1) . (u_n+1 - u_n), f_d the dashpot's force vector at the
 recorded state and velocity; with Newmark's average acceleration the rule under which the
 discrete energy identity holds exactly, M (v_n+1 - v_n) = dt / 2 (F_n + F_n+1) and
@@ -257,7 +258,9 @@ class EnergyLedger:
         "remainder",
     )
 
-    def __init__(self, problem: Any, inertia: Inertia, load_form: Any) -> None:
+    def __init__(
+        self, problem: Any, inertia: Inertia, load_form: Any, alpha_f: float = 0.0
+    ) -> None:
         self.comm = problem.mesh.comm
         self.u = problem.state
         self.kinetic = inertia.kinetic_form()
@@ -273,14 +276,24 @@ class EnergyLedger:
         self.contact_counted = energy is not None or self.coupling is not None
         self.contact = None if energy is None else dolfinx.fem.form(energy * problem.surface.ds)
         #: friction's dissipation per step, -int t_T . du_T ds (the work the friction
-        #: traction t_T on the body does on the step's slip), or None without friction
+        #: traction t_T on the body does on the step's slip), or None without friction;
+        #: between two bodies the pair's coupling sums it (``friction_work()``): its traction
+        #: and slip are the last residual's, at the force time t_{n+1-alpha_f} of the time
+        #: scheme (:mod:`contactfx.solvers.dynamics`), where the slip is (1 - alpha_f) times
+        #: the step's; ``pair_scale`` = 1 / (1 - alpha_f) makes it the traction that entered
+        #: the step's balance on the step's slip
         self.friction = None
+        self.pair_friction = None
+        self.pair_scale = 1.0 / (1.0 - alpha_f)
         surface = problem.surface
         if surface is not None and problem.friction is not None:
             t_T = problem.method.tangential_traction(surface)
             slip = surface.slip_increment(surface.normal())
             ds = problem.method.traction_measure(surface)
             self.friction = dolfinx.fem.form(-ufl.dot(t_T, slip) * ds)
+        elif hasattr(problem, "coupling") and problem.friction is not None:
+            self.pair_friction = problem.coupling()
+        self.frictional = self.friction is not None or self.pair_friction is not None
         self.dissipated = 0.0
         self.load_form = load_form
         self.f = _compat.create_vector(load_form)
@@ -326,6 +339,8 @@ class EnergyLedger:
             self.f_d.copy(self.f_d_prev)
         if self.friction is not None and self.rows:
             self.dissipated += global_sum(self.friction, self.comm)
+        if self.pair_friction is not None and self.rows:
+            self.dissipated += self.pair_scale * self.pair_friction.friction_work()
         kin = global_sum(self.kinetic, self.comm)
         strain = global_sum(self.strain, self.comm)
         contact = 0.0 if self.contact is None else global_sum(self.contact, self.comm)
@@ -410,7 +425,7 @@ class EnergyLedger:
         for key in keys + ("friction_dissipation", "dashpot_dissipation", "remainder"):
             if (
                 (key == "contact" and not self.contact_counted)
-                or (key == "friction_dissipation" and self.friction is None)
+                or (key == "friction_dissipation" and not self.frictional)
                 or (key == "dashpot_dissipation" and self.dashpot is None)
             ):
                 continue

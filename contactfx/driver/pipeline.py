@@ -577,7 +577,8 @@ class _Run:
         self.scene.initial_velocity(inertia.v.sub(0) if problem.split else inertia.v)
         if problem.prev is not None:  # the friction history starts at the initial state
             problem.prev.x.array[:] = problem.state.x.array
-        self.energy = EnergyLedger(problem, inertia, problem.load_form)
+        scheme = Scheme.named(self.num.scheme, self.num.rho_inf)
+        self.energy = EnergyLedger(problem, inertia, problem.load_form, alpha_f=scheme.alpha_f)
         vec = _compat.petsc_vec
         extra: dict[str, Any] = {}
         if inertia.v_star is not None:  # the velocity c_v w - v* of the dashpot's law
@@ -589,7 +590,7 @@ class _Run:
         if problem.multiplier is not None:  # a nodal multiplier: restored with a step's state
             extra["fields"] = [vec(problem.multiplier)]
         return Dynamic(
-            Scheme.named(self.num.scheme, self.num.rho_inf),
+            scheme,
             dt=self.num.dt,
             t_end=self.num.t_end,
             v=vec(inertia.v),

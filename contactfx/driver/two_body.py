@@ -399,6 +399,9 @@ class TwoBodyProblem(Problem):
                     f"one at the start (closest gap {least:.3g}): the solve would "
                     "be singular"
                 )
+        # the scene's initial state (a problem file's ``initial.displacement``; in time the
+        # initial displacement)
+        scene.initial_guess(self.state, 0.0)
 
     def check_edge_rule(self) -> None:
         """Refuse a contact edge rule that does not apply to the slave surface (x-band on a

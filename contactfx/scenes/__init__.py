@@ -14,7 +14,7 @@ from contactfx.scenes.ironing import ShallowIroning
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
-from contactfx.scenes.sliding_stop import SlidingStop
+from contactfx.scenes.sliding_stop import SlidingStop, SlidingStopPlinth
 from contactfx.scenes.sphere_slide import SphereSlide
 from contactfx.scenes.two_bars import TwoBars
 from contactfx.scenes.two_body import HertzCylinders, HertzSpheres, PatchTest
@@ -34,6 +34,7 @@ SCENES: dict[str, type[Scene]] = {
         FlatPunch3D,
         SlidingBlock,
         SlidingStop,
+        SlidingStopPlinth,
         TwoBars,
         Bar1D,
         BarImpact,

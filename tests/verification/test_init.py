@@ -83,12 +83,14 @@ TWO_BODY_CASES = [
     ),
 ]
 #: in time: an impact and its contact phase, a free body dropped on a floor, Coulomb
-#: friction with an initial velocity, two free bodies colliding, a quarter ball thrown onto a
+#: friction with an initial velocity (on a floor and on a meshed plinth: a two-body problem
+#: file's initial displacement), two free bodies colliding, a quarter ball thrown onto a
 #: floor ([dynamics]: density, gravity, initial velocity; mirror planes)
 DYNAMIC_CASES = [
     ("bar-impact", {"cells": 10}, {"dt": 0.01, "t_end": 1.5}),
     ("disc-drop", {"h_contact": 2.0, "h_far": 6.0}, {"dt": 0.5, "t_end": 12.0}),
     ("sliding-stop", {"h": 0.25}, {"t_end": 0.05}),
+    ("sliding-stop-plinth", {"h": 0.25}, {"t_end": 0.05}),
     ("two-bars", {"h": 0.1}, {"t_end": 0.5, "dt": 0.05}),
     (
         "hertz-impact",

@@ -11,6 +11,16 @@ v0 = 1, generalised-alpha with rho_inf = 0.5, dt = 0.005, Nitsche theta = 1.
    dissipation of the high modes is the rest of the balance), and the block never leaves the
    plane.
 3. One rank against two: the mean displacement at every step to 1e-8 relative.
+
+The same block on a meshed plinth (``sliding-stop-plinth``: two bodies, the plinth 2 x 0.5 of
+the same material, fixed at its bottom), Nitsche (theta = 1) and dual mortar with the slave
+nodes' mass redistributed:
+
+4. The rigid block's stop as in 1 (measured 0.55 % and 0.58 % from v0^2 / (2 mu g), at
+   t = 0.335 both; the plinth's shear under mu rho g H displaces its top by some 1e-5 of the
+   stop distance), and the pair's friction dissipation, summed by its coupling, equal to the
+   kinetic energy lost within 1 % (measured 0.40 % for both, as on the rigid plane).
+5. One rank against two: the mean displacement at every step and the dissipation to 1e-8.
 """
 
 from __future__ import annotations
@@ -19,7 +29,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from contactfx.scenes.sliding_stop import SlidingStop
+from contactfx.scenes.sliding_stop import SlidingStop, SlidingStopPlinth
 
 COMM = MPI.COMM_WORLD
 
@@ -50,3 +60,33 @@ def test_sliding_stop_one_rank_against_two():
     x2 = np.array([m for _, m, _ in together.track])
     assert len(x1) == len(x2) == 40
     assert np.max(np.abs(x1 - x2)) <= 1e-8 * np.max(np.abs(x1))
+
+
+def run_plinth(comm, method: str, t_end: float = 0.4):
+    scene = SlidingStopPlinth(SlidingStopPlinth.Params())
+    extra = {"mass": "redistributed"} if method == "mortar" else {}
+    numerics = scene.default_numerics(t_end=t_end, method=method, **extra)
+    res = scene.run(numerics, comm=comm, verbose=False)
+    return scene, res
+
+
+@pytest.mark.parametrize("method", ["nitsche", "mortar"])
+def test_block_on_a_plinth_stops_and_its_pair_dissipates_the_kinetic_energy(method):
+    scene, res = run_plinth(COMM, method)
+    ref = res.reference
+    assert ref["stop_distance_rel_error"] <= 0.01
+    assert abs(ref["stop_time_computed"] - ref["stop_time"]) <= 2 * 0.005 + 1e-9
+    kinetic_lost = 0.5 * 0.5 * 1.0**2 - res.steps[-1].energy["kinetic"]
+    assert res.energy["friction_dissipation"] == pytest.approx(kinetic_lost, rel=0.01)
+
+
+@pytest.mark.skipif(COMM.size == 1, reason="compares the run on all ranks with one rank")
+def test_block_on_a_plinth_one_rank_against_two():
+    alone, a = run_plinth(MPI.COMM_SELF, "nitsche", t_end=0.1)
+    together, b = run_plinth(COMM, "nitsche", t_end=0.1)
+    x1 = np.array([m for _, m, _ in alone.track])
+    x2 = np.array([m for _, m, _ in together.track])
+    assert len(x1) == len(x2) == 20
+    assert np.max(np.abs(x1 - x2)) <= 1e-8 * np.max(np.abs(x1))
+    d1, d2 = a.energy["friction_dissipation"], b.energy["friction_dissipation"]
+    assert d1 == pytest.approx(d2, rel=1e-8)
