@@ -31,7 +31,8 @@ Nitsche's theta / (2 gamma_N) (P_n^2 - sigma_n^2), the penalty's kappa / 2 [-g]_
 of the external loads (trapezoidal: 1/2 (f_ext,n + f_ext,n+1) . (u_n+1 - u_n)), friction's
 dissipation (the sum over the steps of -int t_T . du_T ds, the traction at the step's end on
 its slip increment: backward Euler's; between two bodies the pair's coupling sums the
-traction of the step's balance, at t_{n+1-alpha_f}, on the step's slip), with a contact dashpot its dissipation (trapezoidal:
+traction of the step's balance, at t_{n+1-alpha_f}, on the step's slip), with a contact
+dashpot its dissipation (trapezoidal:
 D_dashpot += 1/2 (f_d,n + f_d,n+1) . (u_n+1 - u_n), f_d the dashpot's force vector at the
 recorded state and velocity; with Newmark's average acceleration the rule under which the
 discrete energy identity holds exactly, M (v_n+1 - v_n) = dt / 2 (F_n + F_n+1) and
