@@ -285,6 +285,16 @@ class PointCoupling(PointReadout):
         #: the frame-indifferent slip (False: the jump's increment alone, which reads the
         #: rotation of the penetration vector g n as slip: the objectivity test's contrast)
         self.objective = True
+        #: small-strain Nitsche friction: Newton's reversal guard, as mortar's
+        #: (:meth:`contactfx.contact.mortar.MortarCoupling._reversed`; ContactSNES drives it
+        #: through ``remember_iterate``, ``forget_iterate`` and ``guard_active``): a point
+        #: that slipped at the iterate remembered at the last Jacobian and whose trial
+        #: traction z now points against the one there sticks. Per direction, the trial
+        #: tractions and slip masks of the last residual (``_z``) and of that iterate
+        self.guarded = self.frictional and not self.pointwise
+        self.guard_active = True
+        self._z: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._z_last: dict[int, tuple[np.ndarray, np.ndarray]] | None = None
 
     # -- search ---------------------------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -477,11 +487,11 @@ class PointCoupling(PointReadout):
         return P, dP, g, sn
 
     def _friction(
-        self, p: _Points, vals: np.ndarray, P: np.ndarray, dP: np.ndarray
+        self, p: _Points, vals: np.ndarray, P: np.ndarray, dP: np.ndarray, k: int
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Nitsche's friction: t = proj_{B(0, s)}(sigma_T(u) - gamma P_T [u - u_prev]), s = mu P
         (Coulomb) or Tresca's threshold where closed (P > 0), and its derivative (P, gdim,
-        ndofs); the stick mask."""
+        ndofs); the stick mask (with the reversal guard's points, direction k)."""
         u = vals[p["idx"]]
         gamma = p["scale"]
         Z = p["ST"] - gamma[:, None, None] * np.einsum("pig,pgh->pih", p["Jvec"], p["P_T"])
@@ -495,6 +505,9 @@ class PointCoupling(PointReadout):
             s = np.where(P > 0.0, self.threshold, 0.0)
         nz = np.linalg.norm(z, axis=1)
         stick = nz <= s
+        closed = P > 0.0
+        self._z[k] = (z, ~stick & closed)
+        stick |= self._reversed(k, z) & closed
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
         t = np.where(stick[:, None], z, s[:, None] * zhat)
         ratio = np.where(stick, 1.0, s / np.where(nz > 0.0, nz, 1.0))
@@ -508,6 +521,24 @@ class PointCoupling(PointReadout):
         if self.mu is not None:  # the bound's derivative (Tresca's is constant)
             dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
+
+    def _reversed(self, k: int, z: np.ndarray) -> np.ndarray:
+        """The reversal guard (direction k): True at a point that slipped at the remembered
+        iterate and whose trial traction z now points against the one there (semi-smooth
+        Newton 2-cycles on such points: a block stopped by friction on a plinth, its slave
+        nodes without mass, alternated between two residuals 0.49 and 0.53 until max_it)."""
+        last = None if self._z_last is None else self._z_last.get(k)
+        if not self.guard_active or last is None or len(last[0]) != len(z):
+            return np.zeros(len(z), dtype=bool)
+        z_last, slipped = last
+        return slipped & (np.einsum("pg,pg->p", z, z_last) < 0.0)
+
+    def remember_iterate(self) -> None:
+        """The last residual's trial tractions become the guard's previous iterate."""
+        self._z_last = dict(self._z)
+
+    def forget_iterate(self) -> None:
+        self._z_last = None
 
     @property
     def stores_energy(self) -> bool:
@@ -542,14 +573,14 @@ class PointCoupling(PointReadout):
         if self.pointwise:
             self._pointwise_residual(vals, F)
             return
-        for p in self.points:
+        for k, p in enumerate(self.points):
             P, dP, g, sn = self._law(p, vals)
             r = P[:, None] * p["Jn"]
             if sn is not None and self.law.theta != 0:
                 r -= (self.law.theta / p["scale"])[:, None] * (P + sn)[:, None] * p["S"]
             t = stick = slip = None
             if self.frictional:
-                t, _, stick = self._friction(p, vals, P, dP)
+                t, _, stick = self._friction(p, vals, P, dP, k)
                 du = vals[p["idx"]] - p["u_prev"]
                 slip = np.einsum("pgh,pih,pi->pg", p["P_T"], p["Jvec"], du)
                 tt = (self.law.theta / p["scale"])[:, None]
@@ -571,11 +602,11 @@ class PointCoupling(PointReadout):
         J.axpy(1.0, K, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         add = PETSc.InsertMode.ADD_VALUES
         theta = self.law.theta
-        for p in self.points:
+        for k, p in enumerate(self.points):
             if self.pointwise:  # the whole law by complex steps (module docstring)
                 A = self._tangent(p, vals, np.ones(len(p["w"]), dtype=bool), geometric=False)
             else:
-                A = self._law_jacobian(p, vals, theta)
+                A = self._law_jacobian(p, vals, theta, k)
             if self.geometric:
                 inside = p["inside"]
                 A[inside] = self._tangent(p, vals, inside, geometric=True)
@@ -584,16 +615,16 @@ class PointCoupling(PointReadout):
                 J.setValues(rows, rows, block, addv=add)
         J.assemble()
 
-    def _law_jacobian(self, p: _Points, vals: np.ndarray, theta: int) -> np.ndarray:
+    def _law_jacobian(self, p: _Points, vals: np.ndarray, theta: int, k: int) -> np.ndarray:
         """(P, m, m): the Jacobian blocks of the penalty / Nitsche law (with Nitsche's
-        Coulomb friction) at the projection of the last search, weighted."""
+        Coulomb friction) at the projection of the last search, weighted (direction k)."""
         P, dP, _, sn = self._law(p, vals)
         A = np.einsum("pi,pj->pij", p["Jn"], dP)
         if sn is not None and theta != 0:
             t = (theta / p["scale"])[:, None]
             A -= np.einsum("pi,pj->pij", p["S"], t * (dP + p["S"]))
         if self.frictional:
-            _, dt, _ = self._friction(p, vals, P, dP)
+            _, dt, _ = self._friction(p, vals, P, dP, k)
             tt = (theta / p["scale"])[:, None, None]
             A -= np.einsum("pig,pgj->pij", p["Jvec"] - tt * p["ST"], dt)
             if theta != 0:

@@ -186,6 +186,14 @@ class Scene:
         None for the homogeneous ``material().density``."""
         return None
 
+    def initial_guess(self, u, t: float) -> None:
+        """Set a starting state before the first load step (default: zero); a dynamic run's
+        initial displacement."""
+
+    def initial_velocity(self, v) -> None:
+        """Set a dynamic run's initial velocity ``v`` (a Function of the unknown's space;
+        default: at rest)."""
+
 
 class ObstacleScene(Scene):
     """A body pressed against a rigid obstacle: geometry and supports, the obstacle and its
@@ -210,14 +218,6 @@ class ObstacleScene(Scene):
         """Young's modulus as a field over ``mesh`` (UFL) for a heterogeneous body, or None for
         the homogeneous ``material().E``."""
         return None
-
-    def initial_guess(self, u, t: float) -> None:
-        """Set a starting state before the first load step (default: zero); a dynamic run's
-        initial displacement."""
-
-    def initial_velocity(self, v) -> None:
-        """Set a dynamic run's initial velocity ``v`` (a Function of the unknown's space;
-        default: at rest)."""
 
     def contact_size(self, measure: float) -> float:
         """Contact half-width / radius from the measure of the contact set (full model)."""
