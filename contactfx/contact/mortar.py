@@ -96,6 +96,7 @@ from contactfx.contact.pair import node_held, owners
 from contactfx.contact.projection import (
     transport,
 )
+from contactfx.contact.reversal import ReversalMemory
 from contactfx.contact.smoothing import (
     bulges,
     conforming,
@@ -170,7 +171,7 @@ def _to_owners(
     return out[0], out[1:]
 
 
-class MortarCoupling:
+class MortarCoupling(ReversalMemory):
     """The condensed dual-mortar contact of one pair (see the module docstring)."""
 
     #: the nodal complementarity holds exactly at a converged state: the constraint stores no
@@ -219,14 +220,8 @@ class MortarCoupling:
             empty,
             empty,
         )
-        #: Coulomb: Newton's reversal guard (:meth:`_reversed`; ContactSNES drives it through
-        #: ``remember_iterate``, ``forget_iterate`` and ``guard_active``): the trial
-        #: tractions z = lambda_T + c v of the last residual, and of the iterate remembered
-        #: at the last Jacobian (global nodes, z, slipping there)
-        self.guarded = self.mu is not None
-        self.guard_active = True
-        self._z: np.ndarray | None = None
-        self._z_last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        #: Coulomb: Newton's reversal guard (:mod:`.reversal`) at the slave nodes
+        self.init_reversals(self.mu is not None)
 
     # -- search and mortar integrals -------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -500,8 +495,8 @@ class MortarCoupling:
         tie = 1e-12 * self.c * self.h
         closed = arg >= -tie
         stick = (nz <= xi + self.mu * tie) & closed
-        self._z, self._slipping = z, ~stick & closed
-        stick |= self._reversed(z) & closed
+        self._record_trial(0, self.nodes, z, ~stick & closed)
+        stick |= self._reversed(0, self.nodes, z) & closed
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
         ratio = np.where(stick, 1.0, xi / np.where(nz > 0.0, nz, 1.0))
         proj = np.where(stick[:, None], z, xi[:, None] * zhat)
@@ -513,30 +508,6 @@ class MortarCoupling:
         d_lam = -zhat * dxi[:, None]
         self.stick, self.xi, self._bound = stick, xi, arg > 0.0
         return (lt - proj, eye - dproj, -dproj * c[:, :, None], d_lam, -d_lam * self.c[:, None])
-
-    def _reversed(self, z: np.ndarray) -> np.ndarray:
-        """The reversal guard: True at a node that slipped at Newton's previous iterate and
-        whose trial traction z now points against the one there. Semi-smooth Newton can
-        2-cycle on such a node (an edge node of a contact pressed and dragged: z of 1e8
-        flipping sign while the bound is 7e6, the slip never seen to stop); a reversal went
-        through stick, so the next step takes the node as sticking (v = 0, linear in u), as
-        the penalty's guard (:func:`contactfx.contact.laws.reversal`). At a converged iterate
-        nothing reverses: the solution is the law's own."""
-        out = np.zeros(len(z), dtype=bool)
-        if not self.guard_active or self._z_last is None:
-            return out
-        nodes, z_last, slipped = self._z_last
-        _, here, there = np.intersect1d(self.nodes, nodes, return_indices=True)
-        out[here] = slipped[there] & (np.einsum("ij,ij->i", z[here], z_last[there]) < 0.0)
-        return out
-
-    def remember_iterate(self) -> None:
-        """The last residual's trial tractions become the guard's previous iterate."""
-        if self._z is not None and len(self._z) == len(self.nodes):
-            self._z_last = (self.nodes.copy(), self._z.copy(), self._slipping)
-
-    def forget_iterate(self) -> None:
-        self._z_last = None
 
     def residual(self, x: PETSc.Vec, F: PETSc.Vec) -> None:
         lam, cg, C, self._da, self._db = self._state(x, F)

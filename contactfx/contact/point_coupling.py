@@ -122,6 +122,7 @@ from contactfx.contact.projection import (
     gauss_triangle,
     transport,
 )
+from contactfx.contact.reversal import ReversalMemory
 from contactfx.mechanics.elasticity import basis_tractions
 from contactfx.mechanics.piola import LINEAR, STRESS_MODELS, first_piola
 
@@ -237,7 +238,7 @@ class _Directed:
         return self._history
 
 
-class PointCoupling(PointReadout):
+class PointCoupling(PointReadout, ReversalMemory):
     """Penalty / Nitsche terms of a contact pair at Gauss points (module docstring)."""
 
     # set by the search (update) and by the residual
@@ -285,16 +286,11 @@ class PointCoupling(PointReadout):
         #: the frame-indifferent slip (False: the jump's increment alone, which reads the
         #: rotation of the penetration vector g n as slip: the objectivity test's contrast)
         self.objective = True
-        #: small-strain Nitsche friction: Newton's reversal guard, as mortar's
-        #: (:meth:`contactfx.contact.mortar.MortarCoupling._reversed`; ContactSNES drives it
-        #: through ``remember_iterate``, ``forget_iterate`` and ``guard_active``): a point
-        #: that slipped at the iterate remembered at the last Jacobian and whose trial
-        #: traction z now points against the one there sticks. Per direction, the trial
-        #: tractions and slip masks of the last residual (``_z``) and of that iterate
-        self.guarded = self.frictional and not self.pointwise
-        self.guard_active = True
-        self._z: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        self._z_last: dict[int, tuple[np.ndarray, np.ndarray]] | None = None
+        #: friction: Newton's reversal guard (:mod:`.reversal`), at the Gauss points of each
+        #: direction (named by their positions: the slave facets' points are the same at
+        #: every search); the pointwise laws' points that it makes stick at the last residual
+        self.init_reversals(self.frictional)
+        self._forced: dict[int, np.ndarray] = {}
 
     # -- search ---------------------------------------------------------------------------
     def update(self, u: np.ndarray) -> None:
@@ -506,8 +502,9 @@ class PointCoupling(PointReadout):
         nz = np.linalg.norm(z, axis=1)
         stick = nz <= s
         closed = P > 0.0
-        self._z[k] = (z, ~stick & closed)
-        stick |= self._reversed(k, z) & closed
+        ids = np.arange(len(z))
+        self._record_trial(k, ids, z, ~stick & closed)
+        stick |= self._reversed(k, ids, z) & closed
         zhat = z / np.where(nz > 0.0, nz, 1.0)[:, None]
         t = np.where(stick[:, None], z, s[:, None] * zhat)
         ratio = np.where(stick, 1.0, s / np.where(nz > 0.0, nz, 1.0))
@@ -521,24 +518,6 @@ class PointCoupling(PointReadout):
         if self.mu is not None:  # the bound's derivative (Tresca's is constant)
             dt += (~stick)[:, None, None] * self.mu * zhat[:, :, None] * dP[:, None, :]
         return t, dt, stick
-
-    def _reversed(self, k: int, z: np.ndarray) -> np.ndarray:
-        """The reversal guard (direction k): True at a point that slipped at the remembered
-        iterate and whose trial traction z now points against the one there (semi-smooth
-        Newton 2-cycles on such points: a block stopped by friction on a plinth, its slave
-        nodes without mass, alternated between two residuals 0.49 and 0.53 until max_it)."""
-        last = None if self._z_last is None else self._z_last.get(k)
-        if not self.guard_active or last is None or len(last[0]) != len(z):
-            return np.zeros(len(z), dtype=bool)
-        z_last, slipped = last
-        return slipped & (np.einsum("pg,pg->p", z, z_last) < 0.0)
-
-    def remember_iterate(self) -> None:
-        """The last residual's trial tractions become the guard's previous iterate."""
-        self._z_last = dict(self._z)
-
-    def forget_iterate(self) -> None:
-        self._z_last = None
 
     @property
     def stores_energy(self) -> bool:
@@ -604,12 +583,13 @@ class PointCoupling(PointReadout):
         theta = self.law.theta
         for k, p in enumerate(self.points):
             if self.pointwise:  # the whole law by complex steps (module docstring)
-                A = self._tangent(p, vals, np.ones(len(p["w"]), dtype=bool), geometric=False)
+                every = np.ones(len(p["w"]), dtype=bool)
+                A = self._tangent(p, vals, every, geometric=False, k=k)
             else:
                 A = self._law_jacobian(p, vals, theta, k)
             if self.geometric:
                 inside = p["inside"]
-                A[inside] = self._tangent(p, vals, inside, geometric=True)
+                A[inside] = self._tangent(p, vals, inside, geometric=True, k=k)
             keep = np.any(A != 0.0, axis=(1, 2))
             for rows, block in zip(p["rows"][keep], A[keep], strict=True):
                 J.setValues(rows, rows, block, addv=add)
@@ -632,7 +612,12 @@ class PointCoupling(PointReadout):
         return A * p["w"][:, None, None]
 
     def _point_terms(
-        self, p: _Points, x: np.ndarray, sel: np.ndarray, geometric: bool
+        self,
+        p: _Points,
+        x: np.ndarray,
+        sel: np.ndarray,
+        geometric: bool,
+        forced: np.ndarray | None = None,
     ) -> dict[str, np.ndarray]:
         """The penalty terms of the points ``sel`` of p at the current nodal positions x
         (P, 2d + 1, gdim) of their slave cell and master facet, real or complex (what
@@ -642,7 +627,8 @@ class PointCoupling(PointReadout):
         the master normal n_m and with friction t, the stick mask and the slip. With
         ``geometric`` the master facet's unit normal and the closest point y on its line /
         plane are recomputed from x (their variations enter the derivative), else they are the
-        search's (frozen)."""
+        search's (frozen). ``forced``: points of ``sel`` that stick whatever the trial (the
+        reversal guard's)."""
         d = x.shape[1] // 2
         N = p["N"][sel]
         xs = np.einsum("pa,pag->pg", N, x[:, : d + 1])
@@ -725,6 +711,9 @@ class PointCoupling(PointReadout):
             # the start) sticks: the same branch on every partition, whatever the round-off
             tie = p["tie"][sel]
             stick = active & (norm.real <= np.maximum(bound.real, 0.0) + tie)
+            out.update(trial=trial.real, slipping=active & ~stick)
+            if forced is not None:
+                stick |= forced & active
             safe = np.where(norm.real > 0.0, norm, 1.0)
             t = np.where(stick[:, None], trial, (bound / safe)[:, None] * trial)
             tau = tau + t
@@ -796,11 +785,14 @@ class PointCoupling(PointReadout):
         return T, dT.reshape(len(F), dT.shape[1] * dT.shape[2], dT.shape[3])
 
     def _tangent(
-        self, p: _Points, vals: np.ndarray, sel: np.ndarray, geometric: bool
+        self, p: _Points, vals: np.ndarray, sel: np.ndarray, geometric: bool, k: int
     ) -> np.ndarray:
         """(P, m, m): the exact derivative of the residual of :meth:`_point_terms` of the
         points ``sel`` in their m dofs, by complex steps (one per dof, vectorised over the
-        points)."""
+        points), with the reversal guard's sticking points of the last residual (direction
+        k)."""
+        forced = self._forced.get(k)
+        forced = None if forced is None else forced[sel]
         gdim = self.layout.gdim
         x = (p["X"][sel] + vals[p["idx"][sel]]).astype(complex)
         m = x.shape[1]
@@ -810,7 +802,8 @@ class PointCoupling(PointReadout):
         for j in range(m):
             xj = x.reshape(len(x), m).copy()
             xj[:, j] += 1j * step
-            A[:, :, j] = self._point_terms(p, xj.reshape(x.shape), sel, geometric)["r"].imag / step
+            o = self._point_terms(p, xj.reshape(x.shape), sel, geometric, forced)
+            A[:, :, j] = o["r"].imag / step
         return A
 
     def _pointwise_residual(self, vals: np.ndarray, F: PETSc.Vec) -> None:
@@ -818,11 +811,17 @@ class PointCoupling(PointReadout):
         finite-strain Nitsche), and the state the post-processing and the history read."""
         gdim = self.layout.gdim
         self.state, self._last = [], []
-        for p in self.points:
+        for k, p in enumerate(self.points):
             every = np.ones(len(p["w"]), dtype=bool)
             m = p["X"].shape[1]
             x = (p["X"] + vals[p["idx"]]).reshape(len(every), m // gdim, gdim)
             o = self._point_terms(p, x, every, geometric=False)
+            if self.frictional:  # the reversal guard (:mod:`.reversal`)
+                ids = np.arange(len(every))
+                self._record_trial(k, ids, o["trial"], o["slipping"])
+                self._forced[k] = self._reversed(k, ids, o["trial"])
+                if np.any(self._forced[k]):
+                    o = self._point_terms(p, x, every, geometric=False, forced=self._forced[k])
             F.setValues(p["rows"].ravel(), o["r"].ravel(), addv=PETSc.InsertMode.ADD_VALUES)
             g = np.where(p["paired"], o["g_law"], np.inf)
             self.state.append((o["P"], g, o.get("t"), o.get("stick"), o.get("slip")))
