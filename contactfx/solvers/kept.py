@@ -72,6 +72,11 @@ class KeptPreconditioner:
             self.spent = 0
             self._read_budget = not self.every_solve
             S = PETSc.Mat.Structure
+            if self.coupled:
+                # a coupling adds nonzeros as the search pairs new points: a factorisation
+                # from scratch (MUMPS 5.7 under PETSc 3.22 crashed, at 2 ranks, refactorising
+                # numerically a matrix whose pattern had grown since its analysis)
+                ksp.getPC().reset()
             J.copy(
                 self.P,
                 structure=S.DIFFERENT_NONZERO_PATTERN if self.coupled else S.SAME_NONZERO_PATTERN,
