@@ -294,7 +294,6 @@ class EnergyLedger:
             self.friction = dolfinx.fem.form(-ufl.dot(t_T, slip) * ds)
         elif hasattr(problem, "coupling") and problem.friction is not None:
             self.pair_friction = problem.coupling()
-        self.frictional = self.friction is not None or self.pair_friction is not None
         self.dissipated = 0.0
         self.load_form = load_form
         self.f = _compat.create_vector(load_form)
@@ -426,7 +425,11 @@ class EnergyLedger:
         for key in keys + ("friction_dissipation", "dashpot_dissipation", "remainder"):
             if (
                 (key == "contact" and not self.contact_counted)
-                or (key == "friction_dissipation" and not self.frictional)
+                or (
+                    key == "friction_dissipation"
+                    and self.friction is None
+                    and self.pair_friction is None
+                )
                 or (key == "dashpot_dissipation" and self.dashpot is None)
             ):
                 continue

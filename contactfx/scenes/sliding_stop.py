@@ -68,21 +68,25 @@ class _Stopping:
 
     p: SlidingStopParams
 
-    def settlement(self, x: np.ndarray) -> np.ndarray:
-        """The vertical settlement of a column under its weight, u_y = -(1 - nu^2) rho g
-        (H y - y^2 / 2) / E (plane strain, uniaxial stress sigma_yy = -rho g (H - y)), at the
-        block's points (y >= 0; zero below): the contact pressure rho g H at the start, the
-        block's own vertical vibration small."""
+    @property
+    def settlement_rate(self) -> float:
+        """k = (1 - nu^2) rho g / E of :meth:`settlement`."""
         p = self.p
-        k = (1.0 - p.nu**2) * p.density * p.gravity / p.E
+        return (1.0 - p.nu**2) * p.density * p.gravity / p.E
+
+    def settlement(self, x: np.ndarray) -> np.ndarray:
+        """The vertical settlement of a column under its weight, u_y = -k (H y - y^2 / 2),
+        k = (1 - nu^2) rho g / E (plane strain, uniaxial stress sigma_yy = -rho g (H - y)), at
+        the block's points (y >= 0; zero below): the contact pressure rho g H at the start,
+        the block's own vertical vibration small."""
         y = np.maximum(x[1], 0.0)
-        return np.vstack([np.zeros(x.shape[1]), -k * (p.height * y - 0.5 * y**2)])
+        k, H = self.settlement_rate, self.p.height
+        return np.vstack([np.zeros(x.shape[1]), -k * (H * y - 0.5 * y**2)])
 
     def settlement_expressions(self) -> list[str]:
         """:meth:`settlement` as a problem file's ``initial.displacement``."""
-        p = self.p
-        k = (1.0 - p.nu**2) * p.density * p.gravity / p.E
-        return ["0.0", f"-{k!r} * ({p.height!r} * max(y, 0) - 0.5 * max(y, 0) ** 2)"]
+        k, H = self.settlement_rate, self.p.height
+        return ["0.0", f"-{k!r} * ({H!r} * max(y, 0) - 0.5 * max(y, 0) ** 2)"]
 
     def initial_guess(self, u, t: float) -> None:
         u.interpolate(self.settlement)
