@@ -20,7 +20,8 @@ and distributes the mesh with dolfinx, :func:`write_msh` writes a gmsh ``.msh`` 
 Two-body geometries with non-matching contact surfaces (:mod:`contactfx.meshes.two_body`: the
 bodies share no node): :func:`stacked_blocks`, :func:`stacked_boxes`, :func:`cylinders`,
 :func:`spheres`, :func:`punch_foundation`, :func:`rounded_on_block`, :func:`die_on_block`;
-:mod:`contactfx.meshes.sphere_on_block`: :func:`sphere_on_block`.
+:mod:`contactfx.meshes.sphere_on_block`: :func:`sphere_on_block`;
+:mod:`contactfx.meshes.die_on_slab`: :func:`die_on_slab`.
 
 Command line: ``python3 -m contactfx.meshes {rectangle,box,crack-plate,penny-block,joint-column,
 stacked-blocks,stacked-boxes,cylinders,spheres,punch-foundation,rounded-on-block} ...
@@ -48,6 +49,7 @@ from contactfx.meshes.crack_plate import (
     crack_set_plate,
     structured_plate,
 )
+from contactfx.meshes.die_on_slab import DieOnSlabCells, DieOnSlabFacets, die_on_slab
 from contactfx.meshes.disc import DiscCells, DiscFacets, disc
 from contactfx.meshes.interval import IntervalCells, IntervalFacets, interval
 from contactfx.meshes.joint_column import JointColumnCells, JointColumnFacets, joint_column
@@ -99,6 +101,7 @@ BUILDERS = {
     "punch-foundation": (punch_foundation, 2),
     "rounded-on-block": (rounded_on_block, 2),
     "die-on-block": (die_on_block, 2),
+    "die-on-slab": (die_on_slab, 3),
     "sphere-on-block": (sphere_on_block, 3),
     "quarter-ball": (quarter_ball, 3),
 }
@@ -120,6 +123,8 @@ __all__ = [
     "CylindersFacets",
     "DieOnBlockCells",
     "DieOnBlockFacets",
+    "DieOnSlabCells",
+    "DieOnSlabFacets",
     "Group",
     "JointColumnCells",
     "JointColumnFacets",
@@ -154,6 +159,7 @@ __all__ = [
     "interval",
     "cylinders",
     "die_on_block",
+    "die_on_slab",
     "joint_column",
     "penny_block",
     "punch_foundation",

@@ -376,6 +376,13 @@ def matheval_number(value: float) -> str:
     return f"({float(value)!r})"
 
 
+def distance_along_x(end: float) -> str:
+    """A gmsh MathEval expression of the distance along x from the segment [0, ``end``]
+    (0 over it, |x| left of it, x - end right of it)."""
+    e = matheval_number(end)
+    return f"(Fabs(x)+Fabs(x-{e})-{e})/2"
+
+
 @dataclass(frozen=True)
 class Group:
     """A named physical group of a mesh file: its dimension, tag and number of elements."""

@@ -13,7 +13,7 @@ from contactfx.meshes._build import (
     check_less,
     check_less_equal,
     check_positive,
-    matheval_number,
+    distance_along_x,
 )
 from contactfx.meshes.two_body import (
     add_body_groups,
@@ -149,8 +149,7 @@ def sphere_on_block(
             SphereOnBlockCells.SPHERE: (sphere, sphere_faces),
         },
     )
-    end = matheval_number(track)
-    along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
+    along = distance_along_x(track)
     set_body_sizes(
         model,
         3,

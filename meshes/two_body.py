@@ -50,7 +50,7 @@ from contactfx.meshes._build import (
     check_less,
     check_less_equal,
     check_positive,
-    matheval_number,
+    distance_along_x,
     set_graded_size,
 )
 
@@ -843,8 +843,7 @@ def punch_foundation(
         },
     )
     # Distance to the segment [0, b] x {0}, as in rectangle().
-    zone = matheval_number(b)
-    along = f"(Fabs(x)+Fabs(x-{zone})-{zone})/2"
+    along = distance_along_x(b)
     set_body_sizes(
         model,
         2,
@@ -994,8 +993,7 @@ def _mesh_body_on_block(
     if split_arcs is not None:
         model.mesh.setTransfiniteCurve(split_arcs[1], 2)
     add_body_groups(model, {block[0]: block[1:], body[0]: body[1:]})
-    end = matheval_number(track)
-    along = f"(Fabs(x)+Fabs(x-{end})-{end})/2"
+    along = distance_along_x(track)
     set_body_sizes(
         model,
         2,

@@ -10,7 +10,7 @@ from contactfx.scenes.disc_drop import DiscDrop
 from contactfx.scenes.flat_punch import FlatPunch2D, FlatPunch3D
 from contactfx.scenes.hertz import Hertz2D, Hertz3D, HertzAxi
 from contactfx.scenes.hertz_impact import HertzImpact
-from contactfx.scenes.ironing import ShallowIroning
+from contactfx.scenes.ironing import ShallowIroning, ShallowIroning3D
 from contactfx.scenes.joint import JointColumn
 from contactfx.scenes.penny import FaultBlock, PennyCrack, PennyShear
 from contactfx.scenes.sliding_block import SlidingBlock
@@ -55,6 +55,7 @@ SCENES: dict[str, type[Scene]] = {
         SlidingContact,
         CattaneoCylinders,
         ShallowIroning,
+        ShallowIroning3D,
         SphereSlide,
     )
 }

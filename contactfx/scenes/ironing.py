@@ -79,13 +79,23 @@ import numpy as np
 from mpi4py import MPI
 
 from contactfx.mechanics.elasticity import Elastic
-from contactfx.meshes import DieOnBlockCells, DieOnBlockFacets, die_on_block
+from contactfx.meshes import (
+    DieOnBlockCells,
+    DieOnBlockFacets,
+    DieOnSlabCells,
+    DieOnSlabFacets,
+    die_on_block,
+    die_on_slab,
+)
 from contactfx.params import param
-from contactfx.scenes.two_body_2d import PressThenDrag, press_drag
+from contactfx.scenes import export
+from contactfx.scenes._common import fix, fix_component, prescribe_component
+from contactfx.scenes.two_body_2d import PressThenDrag, press_drag, press_then_drag
 from contactfx.scenes.two_body_base import two_elastic
 
 __all__ = [
     "ShallowIroning",
+    "ShallowIroning3D",
     "PUBLISHED_P",
     "PUBLISHED_Q",
     "PUBLISHED_MU",
@@ -123,52 +133,96 @@ class _DieParams(two_elastic(68.96e7, 0.32)):
         "Newton fails as the die starts to slide)",
         choices=("upper", "lower"),
     )
+
+
+@dataclass(frozen=True)
+class _SectionParams(_DieParams):
     section: str = param(
         "plane-stress",
         "the 2D section: plane-stress (each body's plane-stress-equivalent E and nu in the "
         "plane-strain equations; the published 3D slab's free face) or plane-strain",
         choices=("plane-stress", "plane-strain"),
     )
-    radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
-    half_width: float = param(0.6, "half-width of the die", positive=True)
-    height: float = param(1.2, "height of the die (its top above its lowest point)", positive=True)
+
+
+def _ironing_params(base: type, h: tuple[float, float]) -> type:
+    """The parameters of an ironing scene on ``base`` (the bodies'): the die's shape, the
+    load program (:func:`press_drag`), the block, the mesh sizes (``h``: the defaults of
+    h_contact and h_far) and the plateau window (checked: plateau_from < plateau_to <= 1)."""
+
+    @dataclass(frozen=True)
+    class _Shape(base):  # type: ignore[valid-type, misc]
+        radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
+        half_width: float = param(0.6, "half-width of the die", positive=True)
+        height: float = param(
+            1.2, "height of the die (its top above its lowest point)", positive=True
+        )
+
+    @dataclass(frozen=True)
+    class IroningParams(
+        press_drag(
+            _Shape,
+            press=(0.8, "downward displacement of the die's top"),
+            slide=(10.0, "displacement of the die's top along +x after pressing"),
+            press_fraction=0.1,
+        )
+    ):
+        left: float = param(
+            0.8, "extent of the block left of the die's lowest point", positive=True
+        )
+        right: float = param(
+            11.2, "extent of the block right of the die's lowest point", positive=True
+        )
+        depth: float = param(4.0, "depth of the block", positive=True)
+        h_contact: float = param(h[0], "element size of the block along the track", positive=True)
+        h_far: float = param(h[1], "element size far from the contact", positive=True)
+        refine: float = param(
+            0.3, "distance from the track meshed with the contact sizes", positive=True
+        )
+        ratio: float = param(0.6, "element size of the die / that of the block", positive=True)
+        plateau_from: float = param(
+            0.3, "start of the plateau, a fraction of the slide", nonnegative=True
+        )
+        plateau_to: float = param(0.7, "end of the plateau, a fraction of the slide", positive=True)
+
+        def __post_init__(self) -> None:
+            super().__post_init__()
+            if not self.plateau_from < self.plateau_to <= 1.0:
+                raise ValueError(
+                    "need plateau_from < plateau_to <= 1, got "
+                    f"{self.plateau_from} and {self.plateau_to}"
+                )
+
+    return IroningParams
 
 
 @dataclass(frozen=True)
-class ShallowIroningParams(
-    press_drag(
-        _DieParams,
-        press=(0.8, "downward displacement of the die's top"),
-        slide=(10.0, "displacement of the die's top along +x after pressing"),
-        press_fraction=0.1,
-    )
-):
-    left: float = param(0.8, "extent of the block left of the die's lowest point", positive=True)
-    right: float = param(11.2, "extent of the block right of the die's lowest point", positive=True)
-    depth: float = param(4.0, "depth of the block", positive=True)
-    h_contact: float = param(0.1, "element size of the block along the track", positive=True)
-    h_far: float = param(0.2, "element size far from the contact", positive=True)
-    refine: float = param(
-        0.3, "distance from the track meshed with the contact sizes", positive=True
-    )
-    ratio: float = param(0.6, "element size of the die / that of the block", positive=True)
+class ShallowIroningParams(_ironing_params(_SectionParams, h=(0.1, 0.2))):
     offset: float = param(
         0.3,
         "shift of the die's contact nodes (fraction of an element, in [0, 1))",
         nonnegative=True,
     )
-    plateau_from: float = param(
-        0.3, "start of the plateau, a fraction of the slide", nonnegative=True
-    )
-    plateau_to: float = param(0.7, "end of the plateau, a fraction of the slide", positive=True)
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if not self.plateau_from < self.plateau_to <= 1.0:
-            raise ValueError(
-                "need plateau_from < plateau_to <= 1, got "
-                f"{self.plateau_from} and {self.plateau_to}"
-            )
+
+@dataclass(frozen=True)
+class ShallowIroning3DParams(_ironing_params(_DieParams, h=(0.2, 0.4))):
+    slave: str = param(
+        "upper",
+        "the slave surface of the contact pair (the die: with the block's top as the slave, "
+        "its points bulge out past the die's free face z = thickness, each drops out of "
+        "contact there at once and Newton 2-cycles at the end of the pressing)",
+        choices=("upper", "lower"),
+    )
+    thickness: float = param(
+        1.0,
+        "extent of both bodies along z (u_z = 0 on z = 0, the face z = thickness free: half of "
+        "a free slab twice as thick)",
+        positive=True,
+    )
+    grading: float = param(
+        0.3, "element size growth per unit distance from the refined zones", positive=True
+    )
 
 
 class ShallowIroning(PressThenDrag):
@@ -234,6 +288,11 @@ class ShallowIroning(PressThenDrag):
             ref["Q_plateau_published"] = Q
         return ref
 
+    def forces_PQ(self, forces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(P, Q) per step: P the y component of the pair's force on the die (vertical in 2D
+        and in the 3D slab), Q minus its x component."""
+        return forces[:, 1], -forces[:, 0]
+
     def plateau(self, loads: np.ndarray) -> np.ndarray:
         """The indices of the steps on the plateau (slide within [plateau_from, plateau_to] of
         ``slide``)."""
@@ -297,6 +356,66 @@ class ShallowIroning(PressThenDrag):
                     Path(out) / "history.png",
                 )
         return res
+
+
+class ShallowIroning3D(ShallowIroning):
+    """The published 3D slab: the section of :class:`ShallowIroning` extruded through z in
+    [0, ``thickness``], u_z = 0 on the face z = 0 of both bodies and on the die's top, the
+    face z = thickness free (Kratos's ``shallow_ironing3D.mdpa``: half of a free slab of
+    thickness 2); the same load program, published forces and scores, the forces the totals
+    over the thickness (per unit thickness for thickness 1, as published)."""
+
+    name = "shallow-ironing-3d"
+    summary = (
+        "the shallow ironing on the published 3D slab (its face z = 1 free): force plateaus "
+        "against the published curves without a 2D section's assumption"
+    )
+    Params = ShallowIroning3DParams
+    cells = {"lower": DieOnSlabCells.BLOCK, "upper": DieOnSlabCells.DIE}
+    surfaces = {"lower": DieOnSlabFacets.BLOCK_TOP, "upper": DieOnSlabFacets.DIE_CONTACT}
+    # 60 steps: the die moves 1.9 block elements (h_contact 0.2) a step while sliding
+    numerics_defaults = {**ShallowIroning.numerics_defaults, "steps": 60}
+    builder = staticmethod(die_on_slab)
+    block_params = (
+        "left",
+        "right",
+        "depth",
+        "thickness",
+        "h_contact",
+        "h_far",
+        "refine",
+        "ratio",
+        "grading",
+    )
+    dim = 3
+    clamped = (DieOnSlabFacets.BLOCK_BOTTOM, "block_bottom")
+    driven = (DieOnSlabFacets.DIE_TOP, "die_top")
+
+    def materials(self) -> dict[str, Elastic]:
+        """The bodies' constants as given: no section in 3D."""
+        return PressThenDrag.materials(self)
+
+    def dirichlet(self, V, facet_tags) -> list:
+        f = DieOnSlabFacets
+        top = self.driven[0]
+        return [
+            *fix(V, facet_tags, self.clamped[0]),
+            fix_component(V, facet_tags, f.BLOCK_Z0, 2),
+            fix_component(V, facet_tags, f.DIE_Z0, 2),
+            prescribe_component(V, facet_tags, top, 0, self.drag),
+            prescribe_component(V, facet_tags, top, 1, self.push),
+            fix_component(V, facet_tags, top, 2),
+        ]
+
+    def boundary_data(self) -> list[dict]:
+        p = self.p
+        return [
+            export.fixed(self.clamped[1], (0, 1, 2)),
+            export.fixed("block_z0", (2,)),
+            export.fixed("die_z0", (2,)),
+            export.fixed(self.driven[1], (2,)),
+            *press_then_drag(self.driven[1], p.slide, -p.press, p.press_fraction),
+        ]
 
 
 def plot_history(scene: ShallowIroning, rows: np.ndarray, path: Path) -> None:

@@ -32,6 +32,8 @@ from contactfx.meshes import (
     CrackPlateFacets,
     CylindersCells,
     CylindersFacets,
+    DieOnSlabCells,
+    DieOnSlabFacets,
     JointColumnCells,
     JointColumnFacets,
     MeshData,
@@ -53,6 +55,7 @@ from contactfx.meshes import (
     build,
     crack_plate,
     cylinders,
+    die_on_slab,
     joint_column,
     punch_foundation,
     quarter_ball,
@@ -1046,6 +1049,62 @@ def test_sphere_on_block() -> None:
             distance = np.linalg.norm(midpoints, axis=1)
         graded = p["refine"] + (p["h_far"] - h) / p["grading"]
         _check_sizes(sizes, distance, p["refine"], graded, h, p["h_far"])
+
+
+DIE_ON_SLAB = dict(
+    radius=0.75,
+    half_width=0.6,
+    height=1.2,
+    left=0.8,
+    right=3.0,
+    depth=1.5,
+    thickness=0.5,
+    track=1.0,
+    h_contact=0.2,
+    h_far=0.4,
+    refine=0.3,
+    ratio=0.6,
+)
+
+
+def test_die_on_slab() -> None:
+    """The block (a box) tiles exactly, its faces and the die's flat faces have their exact
+    areas; every node of the die's contact face is on the cylinder of radius R about the line
+    x = 0, y = R; the die's volume, its faces z = 0 and z = thickness lie between the chord
+    bound and the exact (extruded) section (its bottom inscribed in the arc); the bodies are
+    separate; the die's contact face has nodes on its lowest line (the arc split there)."""
+    p = DIE_ON_SLAB
+    data = build(MPI.COMM_WORLD, partial(die_on_slab, **p), gdim=3, name="slab")
+    r, w, hd, t = p["radius"], p["half_width"], p["height"], p["thickness"]
+    length, depth = p["left"] + p["right"], p["depth"]
+    cells, facets = DieOnSlabCells, DieOnSlabFacets
+    _check_boundary_tagged_once(data)
+    assert _measure(data, cells.BLOCK, "dx") == pytest.approx(length * depth * t, rel=1e-12)
+    rise = r - math.sqrt(r**2 - w**2)  # the arc's height at x = +-w
+    areas = {
+        facets.BLOCK_TOP: length * t,
+        facets.BLOCK_BOTTOM: length * t,
+        facets.BLOCK_Z0: length * depth,
+        facets.BLOCK_SIDES: 2 * depth * t + length * depth,
+        facets.DIE_TOP: 2 * w * t,
+    }
+    for tag, area in areas.items():
+        assert _measure(data, tag) == pytest.approx(area, rel=1e-12), tag.name
+    # the section: the strip |x| <= w below hd minus the circle's segment below the chord
+    # y = rise: 2 w hd - (2 w r - w sqrt(r^2 - w^2) - r^2 asin(w / r))
+    section = 2 * w * hd - (2 * w * r - w * math.sqrt(r**2 - w**2) - r**2 * math.asin(w / r))
+    # each chord of length <= h_far cuts at most its sagitta h^2 / (8 R) over its width
+    lost = 2 * w * p["h_far"] ** 2 / (8 * r) * t
+    assert section * t - lost <= _measure(data, cells.DIE, "dx") <= section * t * (1 + 1e-12)
+    assert section - lost / t <= _measure(data, facets.DIE_Z0) <= section * (1 + 1e-12)
+    z1 = _measure(data, facets.DIE_SIDES) - 2 * (hd - rise) * t  # the sides x = -w, x = w
+    assert section - lost / t <= z1 <= section * (1 + 1e-12)
+    nodes = _tagged_vertices(data, facets.DIE_CONTACT)
+    distance = np.hypot(nodes[:, 0], nodes[:, 1] - r)
+    assert np.all(np.abs(distance - r) <= 1e-12 * r)
+    assert np.any((np.abs(nodes[:, 0]) < 1e-12) & (np.abs(nodes[:, 1]) < 1e-12))
+    assert np.all((nodes[:, 2] > -1e-12) & (nodes[:, 2] < t + 1e-12))
+    _check_separate_bodies(data, cells.BLOCK, cells.DIE)
 
 
 @pytest.mark.parametrize(

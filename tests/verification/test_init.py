@@ -81,6 +81,11 @@ TWO_BODY_CASES = [
         {"h_contact": 0.3, "h_far": 0.8, "refine": 0.5, "slide": 0.25, "press": 0.15},
         {"steps": 4},
     ),
+    (
+        "shallow-ironing-3d",
+        {"h_contact": 0.4, "h_far": 0.8, "press": 0.2, "slide": 0.6, "right": 3.0, "depth": 1.5},
+        {"steps": 4},
+    ),
 ]
 #: in time: an impact and its contact phase, a free body dropped on a floor, Coulomb
 #: friction with an initial velocity (on a floor and on a meshed plinth: a two-body problem
