@@ -554,3 +554,33 @@ def test_progress_on_a_terminal_is_one_line():
         piped = run_cli("run", "hertz2d", *FAST, "--steps", "3", ranks=ranks)
         lines = [s for s in piped.stdout.splitlines() if s.lstrip().startswith("step ")]
         assert len(lines) == 3 and "\r" not in piped.stdout and "\x1b" not in piped.stdout
+
+
+@pytest.mark.parametrize(
+    "args, mu, threshold",
+    [
+        ([], 0.3, 0.0),  # the scene's defaults: Coulomb mu = 0.3
+        (["--friction", "none"], 0.0, 0.0),  # the default mu gives way to no friction
+        (["--friction", "tresca", "--threshold", "2"], 0.0, 2.0),
+        (["--mu", "0.5"], 0.5, 0.0),
+    ],
+)
+def test_scene_friction_default_gives_way_to_another_law(args, mu, threshold):
+    # sliding-stop's defaults are Coulomb mu = 0.3: --friction none alone used to be refused
+    # ("--mu needs --friction coulomb")
+    from contactfx.cli.run import scene_numerics, scene_parser
+    from contactfx.scenes import get_scene
+
+    cls = get_scene("sliding-stop")
+    num = scene_numerics(cls, vars(scene_parser(cls).parse_args(args)))
+    assert (num.mu, num.threshold) == (mu, threshold)
+
+
+def test_a_coefficient_given_with_another_law_is_still_refused():
+    from contactfx.cli.run import scene_numerics, scene_parser
+    from contactfx.scenes import get_scene
+
+    cls = get_scene("sliding-stop")
+    ns = vars(scene_parser(cls).parse_args(["--friction", "none", "--mu", "0.2"]))
+    with pytest.raises(ValueError, match="--mu needs --friction coulomb"):
+        scene_numerics(cls, ns)

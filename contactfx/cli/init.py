@@ -6,8 +6,7 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
-from contactfx.cli.run import fields_of, scene_parser
-from contactfx.numerics import Numerics
+from contactfx.cli.run import fields_of, scene_numerics, scene_parser
 from contactfx.scenes import get_scene
 
 __all__ = ["cmd_init"]
@@ -30,7 +29,7 @@ def cmd_init(argv: list[str], comm) -> int:
     if ns["out"] is None:
         raise ValueError("contactfx init: give the output folder with --out DIR")
     scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
-    numerics = Numerics(**fields_of(Numerics, ns))
+    numerics = scene_numerics(scene_cls, ns)
     command = "contactfx init " + shlex.join(argv)
     from contactfx.scenes.export import write_problem
 

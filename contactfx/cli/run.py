@@ -75,6 +75,25 @@ def fields_of(cls, values: dict) -> dict:
     return {f.name: values[f.name] for f in dataclasses.fields(cls)}
 
 
+#: each friction law's coefficient
+COEFFICIENTS = {"mu": "coulomb", "threshold": "tresca"}
+
+
+def scene_numerics(scene_cls, ns: dict) -> Numerics:
+    """The numerics of the parsed options ``ns``: a scene's default friction coefficient gives
+    way when its friction law is replaced on the command line (``--friction none`` on a scene
+    whose defaults are Coulomb mu = 0.3) without the coefficient given again."""
+    values = fields_of(Numerics, ns)
+    defaults = scene_cls.numerics_defaults
+    law = values["friction"]
+    if law != defaults.get("friction", law):
+        unset = {f.name: f.default for f in dataclasses.fields(Numerics)}
+        for key, owner in COEFFICIENTS.items():
+            if law != owner and key in defaults and values[key] == defaults[key]:
+                values[key] = unset[key]
+    return Numerics(**values)
+
+
 def cmd_list() -> int:
     def options(cls):
         for f in dataclasses.fields(cls):
@@ -218,7 +237,7 @@ def cmd_run(argv: list[str], petsc_options: dict, comm) -> int:
     ns = vars(scene_parser(scene_cls).parse_args(argv[1:]))
     try:
         scene = scene_cls(scene_cls.Params(**fields_of(scene_cls.Params, ns)))
-        numerics = Numerics(**fields_of(Numerics, ns))
+        numerics = scene_numerics(scene_cls, ns)
     except ValueError as error:
         if ns["out"] is not None:
             write_failed(ns["out"], error, "input", comm, scene=scene_cls.name)

@@ -188,6 +188,17 @@ CASES: dict[str, BenchCase] = {
         numerics={"friction": "coulomb", "mu": 0.3},
         beside="shallow-ironing",
     ),
+    # the published 3D slab: level 0 is the scene's default mesh (h_contact 0.2, 6822 dofs),
+    # level 1 (24747 dofs) takes about an hour on one core
+    "shallow-ironing-3d": BenchCase(
+        "shallow-ironing-3d",
+        {},
+        1.0,
+        "neo-Hookean die ironing a block, the published 3D slab, frictionless (force plateau "
+        "against Yang et al. 2005)",
+        p2_levels=0,
+        levels=2,
+    ),
     # 3D, two finite-strain bodies, Coulomb friction: no closed form; the columns to read are
     # the load steps, Newton iterations, times, memory and the equilibrium of the reactions
     # with the contact force. Level 1 is the scene's default mesh (penalty only); level 3
