@@ -9,15 +9,10 @@ import math
 from enum import IntEnum
 from typing import TYPE_CHECKING
 
-from contactfx.meshes._build import (
-    check_finite,
-    check_less,
-    check_less_equal,
-    check_positive,
-    distance_along_x,
-)
+from contactfx.meshes._build import check_finite, check_positive, distance_along_x
 from contactfx.meshes.two_body import (
     add_body_groups,
+    check_die,
     check_graded,
     faces_by_plane,
     generate_mesh,
@@ -108,34 +103,11 @@ def die_on_slab(
 
     Raises ValueError before any gmsh call if a parameter is invalid.
     """
-    check_finite(
-        radius=radius,
-        half_width=half_width,
-        height=height,
-        left=left,
-        right=right,
-        depth=depth,
-        thickness=thickness,
-        track=track,
-    )
-    check_positive(
-        radius=radius,
-        half_width=half_width,
-        height=height,
-        left=left,
-        right=right,
-        depth=depth,
-        thickness=thickness,
-    )
-    check_less_equal("half_width", half_width, "radius", radius)
-    if not track >= 0.0:
-        raise ValueError(f"track must be >= 0, got {track}")
-    check_less("half_width", half_width, "left", left)
-    check_less("track + half_width", track + half_width, "right", right)
+    half = check_die(radius, half_width, height, left, right, depth, track)
+    check_finite(thickness=thickness)
+    check_positive(thickness=thickness)
     check_graded(h_contact, h_far, refine, grading, ratio, 0.0)
     r, w = radius, half_width
-    half = math.asin(w / r)  # half the arc's angle
-    check_less("the arc's height", r * (1.0 - math.cos(half)), "height", height)
 
     occ = model.occ
     block = occ.addBox(-left, -depth, 0.0, left + right, depth, thickness)

@@ -1111,6 +1111,40 @@ class DieOnBlockFacets(IntEnum):
     DIE_TOP = 7
 
 
+def check_die(
+    radius: float,
+    half_width: float,
+    height: float,
+    left: float,
+    right: float,
+    depth: float,
+    track: float,
+) -> float:
+    """Validate a die with a rounded bottom on a block (:func:`die_on_block` and its 3D
+    extrusion): finite, positive sizes, the die's half-width within its radius and the block,
+    its arc below its top; return half the arc's angle."""
+    check_finite(
+        radius=radius,
+        half_width=half_width,
+        height=height,
+        left=left,
+        right=right,
+        depth=depth,
+        track=track,
+    )
+    check_positive(
+        radius=radius, half_width=half_width, height=height, left=left, right=right, depth=depth
+    )
+    check_less_equal("half_width", half_width, "radius", radius)
+    if not track >= 0.0:
+        raise ValueError(f"track must be >= 0, got {track}")
+    check_less("half_width", half_width, "left", left)
+    check_less("track + half_width", track + half_width, "right", right)
+    half = math.asin(half_width / radius)
+    check_less("the arc's height", radius * (1.0 - math.cos(half)), "height", height)
+    return half
+
+
 def die_on_block(
     model: type[gmsh.model],
     *,
@@ -1157,28 +1191,9 @@ def die_on_block(
 
     Raises ValueError before any gmsh call if a parameter is invalid.
     """
-    check_finite(
-        radius=radius,
-        half_width=half_width,
-        height=height,
-        left=left,
-        right=right,
-        depth=depth,
-        track=track,
-    )
-    check_positive(
-        radius=radius, half_width=half_width, height=height, left=left, right=right, depth=depth
-    )
-    check_less_equal("half_width", half_width, "radius", radius)
-    if not track >= 0.0:
-        raise ValueError(f"track must be >= 0, got {track}")
-    check_less("half_width", half_width, "left", left)
-    check_less("track + half_width", track + half_width, "right", right)
+    half = check_die(radius, half_width, height, left, right, depth, track)
     check_graded(h_contact, h_far, refine, grading, ratio, offset)
     r, w = radius, half_width
-    half = math.asin(w / r)  # half the arc's angle
-    e = r * (1.0 - math.cos(half))
-    check_less("the arc's height", e, "height", height)
     l0 = offset_length(offset, ratio * h_contact)
     if offset > 0:
         _check_first_element(l0, "the right half of the arc", half * r)
