@@ -133,6 +133,9 @@ class _DieParams(two_elastic(68.96e7, 0.32)):
         "Newton fails as the die starts to slide)",
         choices=("upper", "lower"),
     )
+    radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
+    half_width: float = param(0.6, "half-width of the die", positive=True)
+    height: float = param(1.2, "height of the die (its top above its lowest point)", positive=True)
 
 
 @dataclass(frozen=True)
@@ -146,22 +149,14 @@ class _SectionParams(_DieParams):
 
 
 def _ironing_params(base: type, h: tuple[float, float]) -> type:
-    """The parameters of an ironing scene on ``base`` (the bodies'): the die's shape, the
+    """The parameters of an ironing scene on ``base`` (the bodies' and the die's shape): the
     load program (:func:`press_drag`), the block, the mesh sizes (``h``: the defaults of
     h_contact and h_far) and the plateau window (checked: plateau_from < plateau_to <= 1)."""
 
     @dataclass(frozen=True)
-    class _Shape(base):  # type: ignore[valid-type, misc]
-        radius: float = param(0.75, "radius of the die's rounded bottom", positive=True)
-        half_width: float = param(0.6, "half-width of the die", positive=True)
-        height: float = param(
-            1.2, "height of the die (its top above its lowest point)", positive=True
-        )
-
-    @dataclass(frozen=True)
     class IroningParams(
         press_drag(
-            _Shape,
+            base,
             press=(0.8, "downward displacement of the die's top"),
             slide=(10.0, "displacement of the die's top along +x after pressing"),
             press_fraction=0.1,
@@ -232,6 +227,8 @@ class ShallowIroning(PressThenDrag):
         "(Yang et al. 2005); force plateaus against the published curves"
     )
     Params = ShallowIroningParams
+    # P: the y component in 2D and on the 3D slab (its thickness along z)
+    vertical = 1
     cells = {"lower": DieOnBlockCells.BLOCK, "upper": DieOnBlockCells.DIE}
     surfaces = {"lower": DieOnBlockFacets.BLOCK_TOP, "upper": DieOnBlockFacets.DIE_CONTACT}
     # 120 steps: the die moves 0.93 of a block element a step while sliding (Kratos's
@@ -287,11 +284,6 @@ class ShallowIroning(PressThenDrag):
         if Q is not None:
             ref["Q_plateau_published"] = Q
         return ref
-
-    def forces_PQ(self, forces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(P, Q) per step: P the y component of the pair's force on the die (vertical in 2D
-        and in the 3D slab), Q minus its x component."""
-        return forces[:, 1], -forces[:, 0]
 
     def plateau(self, loads: np.ndarray) -> np.ndarray:
         """The indices of the steps on the plateau (slide within [plateau_from, plateau_to] of

@@ -326,6 +326,9 @@ class PressThenDrag(TwoBodyScene):
     #: Q = q_sign times the x component of the pair's force on the driven body: -1 the force
     #: that drags the body along +x, +1 the force along +x
     q_sign: ClassVar[float] = -1.0
+    #: the vertical axis (P's component, the pressing's direction): None for the last one
+    #: (y in 2D, z in 3D)
+    vertical: ClassVar[int | None] = None
 
     friction = "none"
     mu = 0.0
@@ -384,7 +387,8 @@ class PressThenDrag(TwoBodyScene):
         """(P, Q) per step from the pair's force on the driven body (``forces``, a row a
         step): P its vertical component (the block pushes the body up), Q ``q_sign`` times its
         x component."""
-        return forces[:, self.dim - 1], self.q_sign * forces[:, 0]
+        axis = self.dim - 1 if self.vertical is None else self.vertical
+        return forces[:, axis], self.q_sign * forces[:, 0]
 
     @staticmethod
     def last_step(P: np.ndarray, Q: np.ndarray) -> dict[str, float]:
